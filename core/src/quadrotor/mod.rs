@@ -1,0 +1,15 @@
+//! The 3D quadrotor of seed 001, with the reference's numbers and without its bugs.
+//!
+//! See [`dynamics`] for the equations, [`params`] for the parameter table, [`variables`] for
+//! the table the FMU and the SITL read.
+
+pub mod dynamics;
+pub mod model;
+pub mod params;
+pub mod state;
+pub mod variables;
+pub mod wind;
+
+pub use model::{CommandError, Quadrotor};
+pub use params::{QuadrotorInitial, QuadrotorParams};
+pub use state::{BodyState, WindState};

@@ -1,0 +1,130 @@
+//! A quadrotor instance: parameters, state, command, wind and its random generator — what
+//! an FMU instance or a SITL vehicle holds.
+
+use super::dynamics::{accelerations, integrate};
+use super::params::{QuadrotorInitial, QuadrotorParams};
+use super::state::{BodyState, WindState};
+use super::wind::{advance_wind, reset_wind};
+use crate::error::ParamError;
+use crate::params::Parameters;
+use crate::rng::SimRng;
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// One simulated quadrotor. Plain data: clone it to save it, serde it to store it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Quadrotor {
+    pub params: QuadrotorParams,
+    pub body: BodyState,
+    pub wind: WindState,
+    /// Wind added from outside (the FMU's wind input), world ENU, m/s.
+    pub external_wind: Vector3<f64>,
+    /// Motor commands in [0, 1], held until changed.
+    command: [f64; 4],
+    grounded: bool,
+    rng: SimRng,
+}
+
+impl Quadrotor {
+    /// A vehicle in `body` state with the episode's wind drawn from `rng`.
+    pub fn new(params: QuadrotorParams, body: BodyState, mut rng: SimRng) -> Result<Self, ParamError> {
+        params.validate()?;
+        let wind = reset_wind(&params, &mut rng);
+        Ok(Quadrotor {
+            params,
+            body,
+            wind,
+            external_wind: Vector3::zeros(),
+            command: [0.0; 4],
+            grounded: false,
+            rng,
+        })
+    }
+
+    /// A vehicle from start values (the FMU's parameters), command = initial motor state.
+    pub fn from_initial(params: QuadrotorParams, initial: &QuadrotorInitial) -> Result<Self, ParamError> {
+        initial.validate()?;
+        let i = initial;
+        let mut body = BodyState::at_rest(
+            Vector3::new(i.initial_x, i.initial_y, i.initial_z),
+            i.initial_roll,
+            i.initial_pitch,
+            i.initial_yaw,
+            i.initial_motor,
+        );
+        body.velocity = Vector3::new(i.initial_vx, i.initial_vy, i.initial_vz);
+        body.body_rates = Vector3::new(i.initial_wx, i.initial_wy, i.initial_wz);
+        let mut quad = Quadrotor::new(params, body, SimRng::new(u64::from(i.seed)))?;
+        quad.command = [i.initial_motor; 4];
+        Ok(quad)
+    }
+
+    /// Sets the motor commands. Each must be finite; values are clamped into [0, 1].
+    pub fn set_command(&mut self, command: [f64; 4]) -> Result<(), CommandError> {
+        for (index, &value) in command.iter().enumerate() {
+            if !value.is_finite() {
+                return Err(CommandError { index, value });
+            }
+        }
+        self.command = command.map(|c| c.clamp(0.0, 1.0));
+        Ok(())
+    }
+
+    /// The motor commands in effect, each in [0, 1].
+    pub fn command(&self) -> [f64; 4] {
+        self.command
+    }
+
+    /// Advances the vehicle by `dt` seconds: physics under the wind of the step's start, then
+    /// the turbulence moves on by `dt`.
+    pub fn step(&mut self, dt: f64) {
+        let wind = self.wind_velocity();
+        self.grounded = integrate(&self.params, &mut self.body, &self.command, &wind, dt);
+        advance_wind(&self.params, &mut self.wind, dt, &mut self.rng);
+    }
+
+    /// Total wind at the vehicle (episode wind + external), world ENU, m/s.
+    pub fn wind_velocity(&self) -> Vector3<f64> {
+        self.wind.velocity() + self.external_wind
+    }
+
+    /// Whether the last step ended resting on the ground plane.
+    pub fn is_grounded(&self) -> bool {
+        self.grounded
+    }
+
+    /// Linear acceleration (world, total force / mass) and angular acceleration (body) now.
+    pub fn accelerations(&self) -> (Vector3<f64>, Vector3<f64>) {
+        accelerations(&self.params, &self.body, &self.command, &self.wind_velocity(), self.grounded)
+    }
+
+    /// Attitude as a unit quaternion (body → world).
+    pub fn attitude(&self) -> UnitQuaternion<f64> {
+        UnitQuaternion::new_unchecked(self.body.attitude)
+    }
+
+    /// Replaces the attitude (normalised).
+    pub fn set_attitude(&mut self, q: Quaternion<f64>) {
+        self.body.attitude = q.normalize();
+    }
+
+    /// The instance's random generator (for tasks that sample from the same stream).
+    pub fn rng_mut(&mut self) -> &mut SimRng {
+        &mut self.rng
+    }
+}
+
+/// A motor command that is not a finite number.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CommandError {
+    pub index: usize,
+    pub value: f64,
+}
+
+impl std::fmt::Display for CommandError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "motor command {} is {}, not a finite number", self.index, self.value)
+    }
+}
+
+impl std::error::Error for CommandError {}

@@ -1,0 +1,124 @@
+//! Wind: per-episode mean wind and Ornstein–Uhlenbeck turbulence.
+
+use super::params::QuadrotorParams;
+use super::state::WindState;
+use crate::rng::SimRng;
+use nalgebra::Vector3;
+
+/// A fresh episode's wind: mean speed uniform in [wind_speed_min, wind_speed_max], horizontal
+/// direction uniform in [0, 2π), turbulence at zero. No wind (and no draws) when disabled.
+pub fn reset_wind(params: &QuadrotorParams, rng: &mut SimRng) -> WindState {
+    if !params.wind_enabled {
+        return WindState::default();
+    }
+    let speed = rng.uniform(params.wind_speed_min, params.wind_speed_max);
+    let direction = rng.uniform(0.0, std::f64::consts::TAU);
+    WindState {
+        mean: Vector3::new(speed * direction.cos(), speed * direction.sin(), 0.0),
+        turbulence: Vector3::zeros(),
+    }
+}
+
+/// Advances the turbulence by `dt` with the exact OU transition
+/// x ← x e^(−θ dt) + σ √((1 − e^(−2θ dt)) / 2θ) ξ (for θ → 0, Brownian motion σ √dt ξ),
+/// σ on x and y, σ · turbulence_vertical_ratio on z.
+pub fn advance_wind(params: &QuadrotorParams, wind: &mut WindState, dt: f64, rng: &mut SimRng) {
+    if !params.wind_enabled {
+        return;
+    }
+    let theta = params.turbulence_theta;
+    let decay = (-theta * dt).exp();
+    let spread = if theta * dt > 1e-12 {
+        ((1.0 - decay * decay) / (2.0 * theta)).sqrt()
+    } else {
+        dt.sqrt()
+    };
+    let sigma = params.turbulence_sigma * spread;
+    let sigma_z = sigma * params.turbulence_vertical_ratio;
+    let t = &mut wind.turbulence;
+    t.x = t.x * decay + sigma * rng.normal();
+    t.y = t.y * decay + sigma * rng.normal();
+    t.z = t.z * decay + sigma_z * rng.normal();
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Sample statistics of a long OU run against the process's θ and σ.
+    #[test]
+    fn ou_turbulence_matches_theta_and_sigma() {
+        let params = QuadrotorParams {
+            turbulence_theta: 0.5,
+            turbulence_sigma: 1.0,
+            ..Default::default()
+        };
+        let dt = 0.01;
+        let mut rng = SimRng::new(42);
+        let mut wind = WindState::default();
+        // Burn in 10 time constants, then sample 40,000 s (20,000 time constants).
+        for _ in 0..2_000 {
+            advance_wind(&params, &mut wind, dt, &mut rng);
+        }
+        let n = 4_000_000;
+        let lag = 100; // 1 s
+        let mut history = vec![0.0; lag];
+        let (mut sx, mut sxx, mut sxy, mut sz2) = (0.0, 0.0, 0.0, 0.0);
+        for i in 0..n {
+            advance_wind(&params, &mut wind, dt, &mut rng);
+            let x = wind.turbulence.x;
+            let earlier = history[i % lag];
+            if i >= lag {
+                sxy += x * earlier;
+            }
+            history[i % lag] = x;
+            sx += x;
+            sxx += x * x;
+            sz2 += wind.turbulence.z * wind.turbulence.z;
+        }
+        let nf = n as f64;
+        let var = sxx / nf - (sx / nf).powi(2);
+        // Stationary variance σ²/(2θ) = 1 m²/s²; autocorrelation at 1 s e^(−θ) = 0.6065.
+        let expected_var = 1.0 / (2.0 * 0.5);
+        assert!((var - expected_var).abs() < 0.05, "variance {var}");
+        let autocorr = (sxy / (nf - lag as f64)) / var;
+        assert!((autocorr - (-0.5f64).exp()).abs() < 0.03, "autocorrelation {autocorr}");
+        let var_z = sz2 / nf;
+        assert!((var_z - 0.04 * expected_var).abs() < 0.004, "vertical variance {var_z}");
+    }
+
+    #[test]
+    fn mean_wind_speed_and_direction_are_drawn_in_range() {
+        let params = QuadrotorParams {
+            wind_speed_min: 2.0,
+            wind_speed_max: 3.0,
+            ..Default::default()
+        };
+        let mut rng = SimRng::new(5);
+        let mut quadrant = [0usize; 4];
+        for _ in 0..1000 {
+            let w = reset_wind(&params, &mut rng);
+            let speed = w.mean.norm();
+            assert!((2.0..3.0 + 1e-12).contains(&speed), "{speed}");
+            assert_eq!(w.mean.z, 0.0);
+            assert_eq!(w.turbulence, Vector3::zeros());
+            let q = usize::from(w.mean.x < 0.0) * 2 + usize::from(w.mean.y < 0.0);
+            quadrant[q] += 1;
+        }
+        assert!(quadrant.iter().all(|&c| c > 200), "{quadrant:?}");
+    }
+
+    #[test]
+    fn wind_off_is_still_air() {
+        let params = QuadrotorParams {
+            wind_enabled: false,
+            ..Default::default()
+        };
+        let mut rng = SimRng::new(5);
+        let before = rng.clone();
+        let mut w = reset_wind(&params, &mut rng);
+        advance_wind(&params, &mut w, 0.01, &mut rng);
+        assert_eq!(w.velocity(), Vector3::zeros());
+        assert_eq!(rng, before, "disabled wind must not consume random numbers");
+    }
+}

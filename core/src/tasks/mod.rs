@@ -1,0 +1,102 @@
+//! Tasks: reset sampling, observation, reward, termination and info on top of a model.
+//!
+//! Every front end (FMU, SITL, gymnasium adapter) drives a task through [`Task`]; none
+//! re-implements a reward or a termination.
+
+use std::fmt;
+
+/// One value of a task's info dictionary.
+#[derive(Debug, Clone, PartialEq)]
+pub enum InfoValue {
+    Real(f64),
+    Integer(i64),
+    Flag(bool),
+    Vector(Vec<f64>),
+}
+
+/// The info dictionary: ordered (name, value) pairs, the same names every step.
+pub type Info = Vec<(&'static str, InfoValue)>;
+
+/// Result of one task step (the observation is read with [`Task::write_observation`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepOutcome {
+    pub reward: f64,
+    /// The episode ended inside the MDP (crash, out of bounds, landed, …).
+    pub terminated: bool,
+    /// The episode was cut short from outside the MDP (time limit, all waypoints done).
+    pub truncated: bool,
+}
+
+/// An action the task cannot take: wrong length or a non-finite entry.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ActionError {
+    WrongLength { expected: usize, got: usize },
+    NotFinite { index: usize, value: f64 },
+}
+
+impl fmt::Display for ActionError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ActionError::WrongLength { expected, got } => {
+                write!(f, "action has {got} values, the task takes {expected}")
+            }
+            ActionError::NotFinite { index, value } => {
+                write!(f, "action value {index} is {value}, not a finite number")
+            }
+        }
+    }
+}
+
+impl std::error::Error for ActionError {}
+
+/// Checks an action's length and that every entry is finite.
+pub fn check_action(action: &[f64], expected: usize) -> Result<(), ActionError> {
+    if action.len() != expected {
+        return Err(ActionError::WrongLength {
+            expected,
+            got: action.len(),
+        });
+    }
+    match action.iter().position(|a| !a.is_finite()) {
+        Some(index) => Err(ActionError::NotFinite {
+            index,
+            value: action[index],
+        }),
+        None => Ok(()),
+    }
+}
+
+/// A reinforcement-learning task over one model instance.
+pub trait Task {
+    /// Number of action values; the action space is [`Task::action_bounds`].
+    fn action_size(&self) -> usize;
+    /// Inclusive per-value action bounds (actions outside are clipped, not refused).
+    fn action_bounds(&self) -> (Vec<f64>, Vec<f64>);
+    /// Number of observation values.
+    fn observation_size(&self) -> usize;
+    /// Inclusive per-value observation bounds; every observation lies inside them.
+    fn observation_bounds(&self) -> (Vec<f32>, Vec<f32>);
+    /// Starts a new episode; the same seed gives the same episode, bit for bit.
+    fn reset(&mut self, seed: u64);
+    /// Applies `action` for one control period.
+    fn step(&mut self, action: &[f64]) -> Result<StepOutcome, ActionError>;
+    /// Writes the current observation into `out` (length [`Task::observation_size`]).
+    fn write_observation(&self, out: &mut [f32]);
+    /// The info dictionary of the current step.
+    fn info(&self) -> Info;
+    /// Control period, s.
+    fn dt(&self) -> f64;
+
+    /// The current observation as a new vector.
+    fn observation(&self) -> Vec<f32> {
+        let mut out = vec![0.0; self.observation_size()];
+        self.write_observation(&mut out);
+        out
+    }
+}
+
+/// Clips `value` into [lo, hi] and narrows it to f32, staying inside the bounds after rounding.
+pub fn clip_f32(value: f64, lo: f32, hi: f32) -> f32 {
+    let v = value as f32;
+    if v.is_nan() { 0.0f32.clamp(lo, hi) } else { v.clamp(lo, hi) }
+}
