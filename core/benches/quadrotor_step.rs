@@ -1,1 +1,61 @@
-fn main() {}
+//! One 10 ms control step of the quadrotor (default substep: one RK4 step), and one Hover
+//! task step (physics + reward + termination + 33-value observation).
+//!
+//! cargo bench -p flyloop-core --bench quadrotor_step
+
+// Helpers are test code too: a failed setup is a failed test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use flyloop_core::SimRng;
+use flyloop_core::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
+use flyloop_core::tasks::Task;
+use flyloop_core::tasks::flight::FlightParams;
+use flyloop_core::tasks::hover::Hover;
+use nalgebra::Vector3;
+use std::hint::black_box;
+
+fn quadrotor_step(c: &mut Criterion) {
+    let params = QuadrotorParams::default();
+    let hover = params.hover_motor_state().unwrap_or(0.5);
+    let body = BodyState::at_rest(Vector3::new(0.0, 0.0, 1.5), 0.05, -0.03, 0.1, hover);
+    let mut quad = Quadrotor::new(params, body, SimRng::new(1)).expect("valid defaults");
+    quad.set_command([hover; 4]).expect("finite command");
+    c.bench_function("quadrotor_control_step_10ms", |b| {
+        b.iter(|| {
+            quad.step(black_box(0.01));
+        })
+    });
+
+    let still = QuadrotorParams {
+        wind_enabled: false,
+        ..QuadrotorParams::default()
+    };
+    let mut calm = Quadrotor::new(still, body, SimRng::new(1)).expect("valid defaults");
+    calm.set_command([hover; 4]).expect("finite command");
+    c.bench_function("quadrotor_control_step_10ms_no_wind", |b| {
+        b.iter(|| {
+            calm.step(black_box(0.01));
+        })
+    });
+    let mut rng = SimRng::new(3);
+    c.bench_function("normal_draw", |b| b.iter(|| black_box(rng.normal())));
+
+    let mut task =
+        Hover::new(QuadrotorParams::default(), FlightParams::default()).expect("valid defaults");
+    let action = [hover; 4];
+    let mut obs = [0f32; 33];
+    c.bench_function("hover_task_step_with_observation", |b| {
+        b.iter(|| {
+            let out = task.step(black_box(&action)).expect("valid action");
+            if out.terminated || out.truncated {
+                task.reset(0);
+            }
+            task.write_observation(&mut obs);
+            black_box(&obs);
+        })
+    });
+}
+
+criterion_group!(benches, quadrotor_step);
+criterion_main!(benches);

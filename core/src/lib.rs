@@ -9,6 +9,7 @@
 //! y left, z up); quaternions are `[w, x, y, z]` (Hamilton, body → world).
 
 pub mod error;
+pub mod lander2d;
 pub mod params;
 pub mod quadrotor;
 pub mod rng;

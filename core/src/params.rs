@@ -184,7 +184,9 @@ pub trait Parameters: Sized + Clone + Default + Serialize + DeserializeOwned + '
     /// The table as Markdown (name, unit, default, range, description), for the README.
     fn markdown_table() -> String {
         let defaults = Self::default();
-        let mut out = String::from("| name | unit | default | range | description |\n|---|---|---|---|---|\n");
+        let mut out = String::from(
+            "| name | unit | default | range | description |\n|---|---|---|---|---|\n",
+        );
         for s in Self::specs() {
             let range = match s.kind {
                 ValueKind::Boolean => "0 / 1".to_string(),
@@ -256,7 +258,11 @@ pub(crate) fn assert_table_is_consistent<P: Parameters + std::fmt::Debug>() {
     for spec in P::specs() {
         assert!(names.insert(spec.name), "duplicate parameter {}", spec.name);
         assert!(spec.min <= spec.max, "{}: min > max", spec.name);
-        assert!(!spec.description.is_empty(), "{}: no description", spec.name);
+        assert!(
+            !spec.description.is_empty(),
+            "{}: no description",
+            spec.name
+        );
         // Every row reads and writes its own field.
         let mut p = defaults.clone();
         let probe = if spec.kind == ValueKind::Boolean {

@@ -58,18 +58,21 @@ pub fn parameter_variables<P: Parameters>(
     variability: Variability,
 ) -> impl Iterator<Item = Variable> {
     let defaults = P::default();
-    P::specs().iter().zip(first_vr..).map(move |(s, vr)| Variable {
-        name: s.name,
-        value_reference: vr,
-        kind: s.kind,
-        causality: Causality::Parameter,
-        variability,
-        unit: s.unit,
-        description: s.description,
-        start: Some((s.get)(&defaults)),
-        min: (s.kind != ValueKind::Boolean).then_some(s.min),
-        max: (s.kind != ValueKind::Boolean).then_some(s.max),
-    })
+    P::specs()
+        .iter()
+        .zip(first_vr..)
+        .map(move |(s, vr)| Variable {
+            name: s.name,
+            value_reference: vr,
+            kind: s.kind,
+            causality: Causality::Parameter,
+            variability,
+            unit: s.unit,
+            description: s.description,
+            start: Some((s.get)(&defaults)),
+            min: (s.kind != ValueKind::Boolean).then_some(s.min),
+            max: (s.kind != ValueKind::Boolean).then_some(s.max),
+        })
 }
 
 /// Looks up the parameter row behind `vr` in a block that starts at `first_vr`.

@@ -111,8 +111,8 @@ fn derivatives_with(
 
 fn advanced(s: &BodyState, d: &Derivative, h: f64) -> BodyState {
     let mut motors = s.motors;
-    for i in 0..4 {
-        motors[i] += h * d.motor_rates[i];
+    for (m, rate) in motors.iter_mut().zip(d.motor_rates) {
+        *m += h * rate;
     }
     BodyState {
         position: s.position + d.velocity * h,
@@ -139,11 +139,14 @@ fn rk4(
     let sixth = h / 6.0;
     let combine3 = |a: Vector3<f64>, b, cc, d| (a + (b + cc) * 2.0 + d) * sixth;
     let mut motors = s.motors;
-    for i in 0..4 {
-        motors[i] += (k1.motor_rates[i]
-            + 2.0 * (k2.motor_rates[i] + k3.motor_rates[i])
-            + k4.motor_rates[i])
-            * sixth;
+    for (i, m) in motors.iter_mut().enumerate() {
+        let (a, b, c, d) = (
+            k1.motor_rates[i],
+            k2.motor_rates[i],
+            k3.motor_rates[i],
+            k4.motor_rates[i],
+        );
+        *m += (a + 2.0 * (b + c) + d) * sixth;
     }
     let attitude = s.attitude
         + (k1.attitude_rate + (k2.attitude_rate + k3.attitude_rate) * 2.0 + k4.attitude_rate)
@@ -151,7 +154,12 @@ fn rk4(
     BodyState {
         position: s.position + combine3(k1.velocity, k2.velocity, k3.velocity, k4.velocity),
         velocity: s.velocity
-            + combine3(k1.acceleration, k2.acceleration, k3.acceleration, k4.acceleration),
+            + combine3(
+                k1.acceleration,
+                k2.acceleration,
+                k3.acceleration,
+                k4.acceleration,
+            ),
         attitude: attitude / attitude.norm(),
         body_rates: s.body_rates
             + combine3(
@@ -207,7 +215,10 @@ pub fn accelerations(
 ) -> (Vector3<f64>, Vector3<f64>) {
     let d = derivatives(params, state, command, wind);
     if grounded {
-        (Vector3::new(0.0, 0.0, d.acceleration.z.max(0.0)), Vector3::zeros())
+        (
+            Vector3::new(0.0, 0.0, d.acceleration.z.max(0.0)),
+            Vector3::zeros(),
+        )
     } else {
         (d.acceleration, d.angular_acceleration)
     }

@@ -27,7 +27,11 @@ pub struct Quadrotor {
 
 impl Quadrotor {
     /// A vehicle in `body` state with the episode's wind drawn from `rng`.
-    pub fn new(params: QuadrotorParams, body: BodyState, mut rng: SimRng) -> Result<Self, ParamError> {
+    pub fn new(
+        params: QuadrotorParams,
+        body: BodyState,
+        mut rng: SimRng,
+    ) -> Result<Self, ParamError> {
         params.validate()?;
         let wind = reset_wind(&params, &mut rng);
         Ok(Quadrotor {
@@ -42,7 +46,10 @@ impl Quadrotor {
     }
 
     /// A vehicle from start values (the FMU's parameters), command = initial motor state.
-    pub fn from_initial(params: QuadrotorParams, initial: &QuadrotorInitial) -> Result<Self, ParamError> {
+    pub fn from_initial(
+        params: QuadrotorParams,
+        initial: &QuadrotorInitial,
+    ) -> Result<Self, ParamError> {
         initial.validate()?;
         let i = initial;
         let mut body = BodyState::at_rest(
@@ -95,7 +102,13 @@ impl Quadrotor {
 
     /// Linear acceleration (world, total force / mass) and angular acceleration (body) now.
     pub fn accelerations(&self) -> (Vector3<f64>, Vector3<f64>) {
-        accelerations(&self.params, &self.body, &self.command, &self.wind_velocity(), self.grounded)
+        accelerations(
+            &self.params,
+            &self.body,
+            &self.command,
+            &self.wind_velocity(),
+            self.grounded,
+        )
     }
 
     /// Attitude as a unit quaternion (body → world).
@@ -123,7 +136,11 @@ pub struct CommandError {
 
 impl std::fmt::Display for CommandError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "motor command {} is {}, not a finite number", self.index, self.value)
+        write!(
+            f,
+            "motor command {} is {}, not a finite number",
+            self.index, self.value
+        )
     }
 }
 

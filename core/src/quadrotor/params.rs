@@ -245,10 +245,18 @@ mod tests {
     #[test]
     fn named_errors_for_the_classic_mistakes() {
         let cases = [
-            ("mass", -1.0, "parameter `mass` = -1 kg is out of range: it must be in [0.001, 10000] kg"),
+            (
+                "mass",
+                -1.0,
+                "parameter `mass` = -1 kg is out of range: it must be in [0.001, 10000] kg",
+            ),
             ("mass", 0.0, "parameter `mass` = 0 kg"),
             ("inertia_zz", 0.0, "`inertia_zz`"),
-            ("motor_time_constant", 0.0, "`motor_time_constant` = 0 s is out of range"),
+            (
+                "motor_time_constant",
+                0.0,
+                "`motor_time_constant` = 0 s is out of range",
+            ),
             ("max_substep", -0.01, "`max_substep`"),
             ("gravity", f64::NAN, "`gravity` = NaN"),
         ];
@@ -256,15 +264,23 @@ mod tests {
             let mut p = QuadrotorParams::default();
             let err = p.set(name, value).unwrap_err().to_string();
             assert!(err.contains(expected), "{err}");
-            assert_eq!(p, QuadrotorParams::default(), "a refused set changed the parameters");
+            assert_eq!(
+                p,
+                QuadrotorParams::default(),
+                "a refused set changed the parameters"
+            );
         }
     }
 
     #[test]
     fn wind_range_must_be_ordered() {
         let err = QuadrotorParams::from_toml_str("wind_speed_min = 6.0").unwrap_err();
-        assert!(err.to_string().contains("wind_speed_min (6) must not exceed wind_speed_max (5)"));
-        let ok = QuadrotorParams::from_toml_str("wind_speed_min = 6.0\nwind_speed_max = 8.0").unwrap();
+        assert!(
+            err.to_string()
+                .contains("wind_speed_min (6) must not exceed wind_speed_max (5)")
+        );
+        let ok =
+            QuadrotorParams::from_toml_str("wind_speed_min = 6.0\nwind_speed_max = 8.0").unwrap();
         assert_eq!(ok.wind_speed_min, 6.0);
     }
 
@@ -273,7 +289,8 @@ mod tests {
         let p = QuadrotorParams::from_toml_str("mass = 2\nground_enabled = false").unwrap();
         assert_eq!(p.mass, 2.0);
         assert!(!p.ground_enabled);
-        let p = QuadrotorParams::from_json_str(r#"{"arm_length": 0.2, "wind_enabled": false}"#).unwrap();
+        let p = QuadrotorParams::from_json_str(r#"{"arm_length": 0.2, "wind_enabled": false}"#)
+            .unwrap();
         assert_eq!(p.arm_length, 0.2);
         assert!(!p.wind_enabled);
         let e = QuadrotorParams::from_toml_str("mas = 2").unwrap_err();
@@ -283,14 +300,20 @@ mod tests {
         let e = QuadrotorParams::from_toml_str("mass = ").unwrap_err();
         assert!(e.to_string().starts_with("invalid parameter file"), "{e}");
         let e = QuadrotorInitial::from_toml_str("seed = 1.5").unwrap_err();
-        assert!(e.to_string().contains("`seed` = 1.5 is not an integer"), "{e}");
+        assert!(
+            e.to_string().contains("`seed` = 1.5 is not an integer"),
+            "{e}"
+        );
     }
 
     #[test]
     fn hover_motor_state_is_the_analytic_value() {
         let m = QuadrotorParams::default().hover_motor_state().unwrap();
         assert!((m - 0.49523).abs() < 5e-6, "{m}");
-        let heavy = QuadrotorParams { mass: 10.0, ..Default::default() };
+        let heavy = QuadrotorParams {
+            mass: 10.0,
+            ..Default::default()
+        };
         assert_eq!(heavy.hover_motor_state(), None);
     }
 }

@@ -82,9 +82,15 @@ mod tests {
         let expected_var = 1.0 / (2.0 * 0.5);
         assert!((var - expected_var).abs() < 0.05, "variance {var}");
         let autocorr = (sxy / (nf - lag as f64)) / var;
-        assert!((autocorr - (-0.5f64).exp()).abs() < 0.03, "autocorrelation {autocorr}");
+        assert!(
+            (autocorr - (-0.5f64).exp()).abs() < 0.03,
+            "autocorrelation {autocorr}"
+        );
         let var_z = sz2 / nf;
-        assert!((var_z - 0.04 * expected_var).abs() < 0.004, "vertical variance {var_z}");
+        assert!(
+            (var_z - 0.04 * expected_var).abs() < 0.004,
+            "vertical variance {var_z}"
+        );
     }
 
     #[test]

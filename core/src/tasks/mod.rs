@@ -98,5 +98,14 @@ pub trait Task {
 /// Clips `value` into [lo, hi] and narrows it to f32, staying inside the bounds after rounding.
 pub fn clip_f32(value: f64, lo: f32, hi: f32) -> f32 {
     let v = value as f32;
-    if v.is_nan() { 0.0f32.clamp(lo, hi) } else { v.clamp(lo, hi) }
+    if v.is_nan() {
+        0.0f32.clamp(lo, hi)
+    } else {
+        v.clamp(lo, hi)
+    }
 }
+
+pub mod flight;
+pub mod hover;
+pub mod landing;
+pub mod waypoints;

@@ -1,0 +1,479 @@
+//! A Lander2D instance: parameters, its rapier world, battery, wind, contact outcome and its
+//! random generator — what an FMU instance, a SITL vehicle or the Landing task holds.
+
+use super::contact::ContactState;
+use super::params::{Lander2dInitial, Lander2dParams};
+use super::snapshot::{self, SnapshotError};
+use super::world::{self, DroneGeometry, DroneState, Handles};
+use crate::error::ParamError;
+use crate::params::Parameters;
+use crate::rng::SimRng;
+use rapier2d_f64::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// One simulated 2D drone over its landing platform.
+///
+/// Plain data with its whole physics world inside: [`Lander2d::save`] stores it and
+/// [`Lander2d::restore`] brings back an instance that continues bit-identically.
+#[derive(Serialize, Deserialize)]
+pub struct Lander2d {
+    params: Lander2dParams,
+    world: PhysicsWorld,
+    handles: Handles,
+    rng: SimRng,
+    /// Motor commands (left, right) in [-1, 1], held until changed.
+    command: [f64; 2],
+    /// Wind force added from outside (the FMU's input), N.
+    external_wind_force: [f64; 2],
+    /// The episode's constant wind force, N (derived from `params` and `draws`).
+    wind_force: [f64; 2],
+    draws: EpisodeDraws,
+    /// Thrust of each motor during the last control period, N.
+    thrust: [f64; 2],
+    battery: f64,
+    /// +1 or −1: where a moving platform is heading.
+    platform_direction: f64,
+    /// Mean acceleration over the last control period, m/s².
+    acceleration: [f64; 2],
+    contact: ContactState,
+    /// Control periods since the start.
+    steps: u64,
+}
+
+impl std::fmt::Debug for Lander2d {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Lander2d")
+            .field("drone", &self.drone())
+            .field("platform_x", &self.platform_x())
+            .field("battery", &self.battery)
+            .field("thrust", &self.thrust)
+            .field("contact", &self.contact)
+            .field("steps", &self.steps)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Lander2d {
+    /// A lander with the drone in `drone` state. The episode's wind direction, the platform's
+    /// start direction and (if random) its start x are drawn from `rng`, always in that order
+    /// and always all three, so switching an option does not shift the rest of the stream.
+    pub fn new(params: Lander2dParams, drone: DroneState, rng: SimRng) -> Result<Self, ParamError> {
+        params.validate()?;
+        check_start(&drone)?;
+        Ok(Self::new_unchecked(params, drone, rng))
+    }
+
+    /// A lander from start values (the FMU's parameters).
+    pub fn from_initial(
+        params: Lander2dParams,
+        initial: &Lander2dInitial,
+    ) -> Result<Self, ParamError> {
+        initial.validate()?;
+        let drone = DroneState {
+            x: initial.initial_x,
+            y: initial.initial_y,
+            angle: initial.initial_angle,
+            vx: initial.initial_vx,
+            vy: initial.initial_vy,
+            angular_velocity: initial.initial_angular_velocity,
+        };
+        Lander2d::new(params, drone, SimRng::new(u64::from(initial.seed)))
+    }
+
+    /// [`Lander2d::new`] for parameters and a start already checked.
+    pub(crate) fn new_unchecked(
+        params: Lander2dParams,
+        drone: DroneState,
+        mut rng: SimRng,
+    ) -> Self {
+        let draws = EpisodeDraws {
+            wind_angle: rng.uniform(0.0, std::f64::consts::TAU),
+            platform_heading: if rng.unit() < 0.5 { 1.0 } else { -1.0 },
+            platform_start: rng.unit(),
+        };
+        let platform_direction = draws.platform_heading;
+        let wind_force = draws.wind_force(&params);
+        let (world, handles) = world::build(
+            &params,
+            &drone,
+            draws.platform_start_x(&params),
+            platform_direction * params.platform_speed,
+        );
+        Lander2d {
+            battery: params.initial_battery,
+            params,
+            world,
+            handles,
+            rng,
+            command: [-1.0; 2],
+            external_wind_force: [0.0; 2],
+            wind_force,
+            draws,
+            thrust: [0.0; 2],
+            platform_direction,
+            acceleration: [0.0; 2],
+            contact: ContactState::default(),
+            steps: 0,
+        }
+    }
+
+    /// Sets the motor commands (left, right). Each must be finite; values are clamped into
+    /// [-1, 1], which maps linearly onto [0, max_thrust].
+    pub fn set_command(&mut self, command: [f64; 2]) -> Result<(), CommandError> {
+        for (index, &value) in command.iter().enumerate() {
+            if !value.is_finite() {
+                return Err(CommandError { index, value });
+            }
+        }
+        self.command = command.map(|c| c.clamp(-1.0, 1.0));
+        Ok(())
+    }
+
+    /// The motor commands in effect, each in [-1, 1].
+    pub fn command(&self) -> [f64; 2] {
+        self.command
+    }
+
+    /// Sets the wind force added from outside, N. Each must be finite.
+    pub fn set_external_wind_force(&mut self, force: [f64; 2]) -> Result<(), CommandError> {
+        for (index, &value) in force.iter().enumerate() {
+            if !value.is_finite() {
+                return Err(CommandError { index, value });
+            }
+        }
+        self.external_wind_force = force;
+        Ok(())
+    }
+
+    /// Advances by one control period (`params.dt`): draws the period's thrust noise, drains
+    /// the battery, then runs `physics_substeps` physics steps, classifying contacts after each.
+    pub fn step(&mut self) {
+        self.thrust = self.draw_thrust();
+        if self.battery > 0.0 {
+            let drain = (self.thrust[0] + self.thrust[1])
+                * self.params.battery_consumption_rate
+                * self.params.dt;
+            self.battery = (self.battery - drain).max(0.0);
+        }
+        let v0 = self.drone_body().linvel();
+        self.contact.begin_period();
+        for _ in 0..self.params.physics_substeps {
+            self.apply_forces();
+            let before = self.drone();
+            let platform_vx = self.platform_vx();
+            self.world.step();
+            self.steer_platform();
+            let on_platform = self
+                .handles
+                .drone_touches(&self.world, self.handles.platform_collider);
+            let on_ground = self
+                .handles
+                .drone_touches(&self.world, self.handles.ground_collider);
+            self.contact
+                .update(&self.params, &before, platform_vx, on_platform, on_ground);
+        }
+        let v1 = self.drone_body().linvel();
+        self.acceleration = [
+            (v1.x - v0.x) / self.params.dt,
+            (v1.y - v0.y) / self.params.dt,
+        ];
+        self.steps += 1;
+    }
+
+    /// Thrust of each motor for the coming period: commanded level plus Gaussian noise,
+    /// clipped to [0, max_thrust]; zero once the battery is empty. The two normal draws happen
+    /// every period, so the stream does not depend on the battery.
+    fn draw_thrust(&mut self) -> [f64; 2] {
+        let p = &self.params;
+        let noise = [self.rng.normal(), self.rng.normal()];
+        if self.battery <= 0.0 {
+            return [0.0; 2];
+        }
+        [0, 1].map(|i| {
+            let level = (self.command[i] + 1.0) / 2.0 * p.max_thrust;
+            (level + p.thrust_noise_std * noise[i]).clamp(0.0, p.max_thrust)
+        })
+    }
+
+    /// Replaces last step's user forces (rapier keeps them until reset) with the thrust at
+    /// the motors along the body's +y, in the current pose, and the wind at the centre of mass.
+    fn apply_forces(&mut self) {
+        let motor_x = DroneGeometry::of(&self.params).motor_x;
+        let wind = Vector::new(
+            self.wind_force[0] + self.external_wind_force[0],
+            self.wind_force[1] + self.external_wind_force[1],
+        );
+        let thrust = self.thrust;
+        let body = self.drone_body_mut();
+        body.reset_forces(false);
+        body.reset_torques(false);
+        let pose = *body.position();
+        let up = pose.rotation.transform_vector(Vector::Y);
+        for (t, x) in thrust.into_iter().zip([-motor_x, motor_x]) {
+            body.add_force_at_point(up * t, pose.transform_point(Vector::new(x, 0.0)), true);
+        }
+        body.add_force(wind, true);
+    }
+
+    /// Turns a moving platform around once its centre reaches either end of its travel.
+    fn steer_platform(&mut self) {
+        if !self.params.moving_platform {
+            return;
+        }
+        let (lo, hi) = self.params.platform_travel();
+        let x = self.platform_x();
+        if x <= lo && self.platform_direction < 0.0 {
+            self.platform_direction = 1.0;
+        } else if x >= hi && self.platform_direction > 0.0 {
+            self.platform_direction = -1.0;
+        }
+        let v = Vector::new(self.platform_direction * self.params.platform_speed, 0.0);
+        self.world.bodies[self.handles.platform].set_linvel(v, true);
+    }
+
+    // The handles were checked against the world when it was built or restored, and the
+    // world is private: indexing cannot miss.
+    fn drone_body(&self) -> &RigidBody {
+        &self.world.bodies[self.handles.drone]
+    }
+
+    fn drone_body_mut(&mut self) -> &mut RigidBody {
+        &mut self.world.bodies[self.handles.drone]
+    }
+
+    /// The drone's position, angle and velocities now.
+    pub fn drone(&self) -> DroneState {
+        world::drone_state(self.drone_body())
+    }
+
+    /// Platform centre x, m.
+    pub fn platform_x(&self) -> f64 {
+        self.world.bodies[self.handles.platform].translation().x
+    }
+
+    /// Platform velocity along x, m/s (0 for a fixed platform).
+    pub fn platform_vx(&self) -> f64 {
+        self.world.bodies[self.handles.platform].linvel().x
+    }
+
+    /// The platform's top centre, the landing target, m.
+    pub fn platform_target(&self) -> (f64, f64) {
+        (self.platform_x(), self.params.platform_top())
+    }
+
+    /// Total wind force on the drone (episode wind + external), N.
+    pub fn wind_force(&self) -> [f64; 2] {
+        [
+            self.wind_force[0] + self.external_wind_force[0],
+            self.wind_force[1] + self.external_wind_force[1],
+        ]
+    }
+
+    /// The wind force added from outside, N.
+    pub fn external_wind_force(&self) -> [f64; 2] {
+        self.external_wind_force
+    }
+
+    /// Thrust of each motor (left, right) during the last period, N.
+    pub fn thrust(&self) -> [f64; 2] {
+        self.thrust
+    }
+
+    /// Remaining battery charge.
+    pub fn battery(&self) -> f64 {
+        self.battery
+    }
+
+    /// Mean acceleration over the last control period, m/s².
+    pub fn acceleration(&self) -> [f64; 2] {
+        self.acceleration
+    }
+
+    /// Contact flags and the touch-down outcome.
+    pub fn contact(&self) -> &ContactState {
+        &self.contact
+    }
+
+    /// Landed safely on the platform (latched).
+    pub fn landed(&self) -> bool {
+        self.contact.landed
+    }
+
+    /// Crashed: onto the ground, or onto the platform too fast or tilted (latched).
+    pub fn crashed(&self) -> bool {
+        self.contact.crashed
+    }
+
+    /// Control periods since the start.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// Simulated time since the start, s (n · dt, never accumulated).
+    pub fn time(&self) -> f64 {
+        self.steps as f64 * self.params.dt
+    }
+
+    /// The parameters in force.
+    pub fn params(&self) -> &Lander2dParams {
+        &self.params
+    }
+
+    /// Composite moment of inertia of the drone, from its colliders' mass properties, kg·m².
+    pub fn inertia(&self) -> f64 {
+        self.drone_body()
+            .mass_properties()
+            .local_mprops
+            .principal_inertia()
+    }
+
+    /// Sets parameter `name` and rebuilds the scene; on error nothing changes. Before the
+    /// first step the start follows the new parameters (platform start, battery charge, from
+    /// the same random draws); after it, the scene keeps its state (drone pose and velocities,
+    /// platform position and heading, battery, RNG).
+    pub fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), ParamError> {
+        let mut params = self.params.clone();
+        params.set(name, value)?;
+        let drone = self.drone();
+        check_start(&drone)?;
+        let fresh = self.steps == 0;
+        let platform_x = if fresh {
+            self.platform_direction = self.draws.platform_heading;
+            self.battery = params.initial_battery;
+            self.draws.platform_start_x(&params)
+        } else {
+            self.platform_x()
+        };
+        let platform_vx = self.platform_direction * params.platform_speed;
+        let (world, handles) = world::build(&params, &drone, platform_x, platform_vx);
+        self.world = world;
+        self.handles = handles;
+        self.wind_force = self.draws.wind_force(&params);
+        self.params = params;
+        Ok(())
+    }
+}
+
+/// The random draws that shape an episode, kept so that a parameter change before the first
+/// step re-derives the start from the same numbers.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+struct EpisodeDraws {
+    /// Wind direction if random, rad in [0, 2π).
+    wind_angle: f64,
+    /// Start heading of a moving platform, +1 or −1.
+    platform_heading: f64,
+    /// Uniform in [0, 1): the platform's start within its travel, if random.
+    platform_start: f64,
+}
+
+impl EpisodeDraws {
+    fn wind_force(&self, p: &Lander2dParams) -> [f64; 2] {
+        let angle = if p.wind_direction_random {
+            self.wind_angle
+        } else {
+            p.wind_direction
+        };
+        let magnitude = p.wind_force_magnitude();
+        [magnitude * angle.cos(), magnitude * angle.sin()]
+    }
+
+    fn platform_start_x(&self, p: &Lander2dParams) -> f64 {
+        if p.platform_random_start_x {
+            let (lo, hi) = p.platform_travel();
+            lo + (hi - lo) * self.platform_start
+        } else {
+            p.platform_start_x
+        }
+    }
+}
+
+/// Format tag of a Lander2d snapshot (name and version).
+const SNAPSHOT_TAG: &[u8; 8] = b"FLYL2D01";
+
+impl Lander2d {
+    /// The whole state as bytes: the rapier world (bodies, colliders, islands, broad and
+    /// narrow phase with their warm-start impulses), RNG, battery, counters and contact flags.
+    pub fn save(&self) -> Result<Vec<u8>, SnapshotError> {
+        snapshot::encode(SNAPSHOT_TAG, self)
+    }
+
+    /// An instance from [`Lander2d::save`] bytes; it continues exactly as the saved one would.
+    /// Foreign or damaged bytes are an error, never a panic.
+    pub fn restore(bytes: &[u8]) -> Result<Self, SnapshotError> {
+        let lander: Lander2d = snapshot::decode(SNAPSHOT_TAG, "Lander2D", bytes)?;
+        lander.check_restored()?;
+        Ok(lander)
+    }
+
+    /// Checks a decoded instance before anything indexes its world.
+    pub(crate) fn check_restored(&self) -> Result<(), SnapshotError> {
+        let lander = self;
+        lander
+            .params
+            .validate()
+            .map_err(|e| SnapshotError::Invalid(e.to_string()))?;
+        if !lander.handles.are_valid_in(&lander.world) {
+            return Err(SnapshotError::Invalid(
+                "body or collider handles do not match the world".into(),
+            ));
+        }
+        let d = lander.draws;
+        let numbers = [
+            lander.battery,
+            lander.platform_direction,
+            d.wind_angle,
+            d.platform_start,
+        ]
+        .into_iter()
+        .chain(lander.command)
+        .chain(lander.external_wind_force)
+        .chain(lander.wind_force)
+        .chain(lander.thrust);
+        if numbers.into_iter().any(|v| !v.is_finite()) {
+            return Err(SnapshotError::Invalid(
+                "a command, force or the battery is not finite".into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The drone's start must be finite numbers (rapier would quarantine the body).
+fn check_start(drone: &DroneState) -> Result<(), ParamError> {
+    let values = [
+        ("initial_x", drone.x),
+        ("initial_y", drone.y),
+        ("initial_angle", drone.angle),
+        ("initial_vx", drone.vx),
+        ("initial_vy", drone.vy),
+        ("initial_angular_velocity", drone.angular_velocity),
+    ];
+    for (name, value) in values {
+        if !value.is_finite() {
+            return Err(ParamError::Relation {
+                name,
+                requirement: format!("the drone's start must be finite, got {value}"),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// A motor command or wind input that is not a finite number.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CommandError {
+    pub index: usize,
+    pub value: f64,
+}
+
+impl std::fmt::Display for CommandError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "input {} is {}, not a finite number",
+            self.index, self.value
+        )
+    }
+}
+
+impl std::error::Error for CommandError {}

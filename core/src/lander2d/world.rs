@@ -1,0 +1,262 @@
+//! The rapier2d scene of one lander: ground, landing platform and the drone as ONE rigid body
+//! with three colliders. The reference joined three bodies with pivot joints and stayed rigid
+//! only because the parts collided with each other; a single body is rigid by construction.
+
+use super::params::Lander2dParams;
+use rapier2d_f64::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Kinematic state of the drone's body (its origin is the centre of mass).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct DroneState {
+    /// Centre x, m.
+    pub x: f64,
+    /// Centre y, m.
+    pub y: f64,
+    /// Angle, counter-clockwise from level, rad.
+    pub angle: f64,
+    /// Velocity along x, m/s.
+    pub vx: f64,
+    /// Velocity along y, m/s.
+    pub vy: f64,
+    /// Angular velocity, counter-clockwise, rad/s.
+    pub angular_velocity: f64,
+}
+
+/// Handles of the scene's bodies and colliders inside its [`PhysicsWorld`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub(crate) struct Handles {
+    pub drone: RigidBodyHandle,
+    /// Frame, left motor, right motor.
+    pub drone_parts: [ColliderHandle; 3],
+    pub platform: RigidBodyHandle,
+    pub platform_collider: ColliderHandle,
+    pub ground_collider: ColliderHandle,
+}
+
+/// Shapes and masses of the drone's three parts, in body coordinates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DroneGeometry {
+    /// Half extents of the frame box, m.
+    pub frame_half: (f64, f64),
+    /// Half side of each square motor box, m.
+    pub motor_half: f64,
+    /// x of the motor centres (left at −x, right at +x), m.
+    pub motor_x: f64,
+    /// Masses of frame and of each motor, kg.
+    pub frame_mass: f64,
+    pub motor_mass: f64,
+}
+
+impl DroneGeometry {
+    pub fn of(p: &Lander2dParams) -> Self {
+        let motor_x = (p.drone_width - p.drone_height) / 2.0;
+        DroneGeometry {
+            frame_half: (motor_x, p.drone_height / 4.0),
+            motor_half: p.drone_height / 2.0,
+            motor_x,
+            frame_mass: 0.2 * p.drone_mass,
+            motor_mass: 0.4 * p.drone_mass,
+        }
+    }
+}
+
+/// Builds the scene with the drone in `drone` state and the platform centred at `platform_x`
+/// moving at `platform_vx` (ignored unless the platform moves).
+pub(crate) fn build(
+    p: &Lander2dParams,
+    drone: &DroneState,
+    platform_x: f64,
+    platform_vx: f64,
+) -> (PhysicsWorld, Handles) {
+    let mut world = PhysicsWorld::new();
+    world.gravity = Vector::new(0.0, -p.gravity);
+    world.integration_parameters.dt = p.dt / f64::from(p.physics_substeps);
+    // Recycled contacts may be up to 5 cm stale; touch-down classification needs fresh ones,
+    // and with six candidate pairs the full update costs next to nothing.
+    world.integration_parameters.contact_recycling = false;
+
+    // Product combination, as in Chipmunk: the pad's 1.0 and the ground's 0.8 apply unchanged
+    // against the drone's default 1.0.
+    let material = |b: ColliderBuilder, friction: f64| {
+        b.friction(friction)
+            .friction_combine_rule(CoefficientCombineRule::Multiply)
+            .restitution(0.0)
+    };
+
+    // A thick box rather than the reference's line: nothing tunnels through it.
+    let ground = material(
+        ColliderBuilder::cuboid(p.world_width, 0.5)
+            .translation(Vector::new(p.world_width / 2.0, p.ground_height - 0.5)),
+        p.ground_friction,
+    );
+    let ground_collider = world.insert_collider(ground, None);
+
+    let platform_body = if p.moving_platform {
+        RigidBodyBuilder::kinematic_velocity_based().linvel(Vector::new(platform_vx, 0.0))
+    } else {
+        RigidBodyBuilder::fixed()
+    };
+    let platform_body = platform_body.translation(Vector::new(
+        platform_x,
+        p.ground_height + p.platform_height / 2.0,
+    ));
+    let platform_shape = material(
+        ColliderBuilder::cuboid(p.platform_width / 2.0, p.platform_height / 2.0),
+        p.platform_friction,
+    );
+    let (platform, platform_collider) = world.insert(platform_body, platform_shape);
+
+    let g = DroneGeometry::of(p);
+    let body = RigidBodyBuilder::dynamic()
+        .translation(Vector::new(drone.x, drone.y))
+        .rotation(drone.angle)
+        .linvel(Vector::new(drone.vx, drone.vy))
+        .angvel(drone.angular_velocity)
+        // A hovering drone is nearly at rest; asleep it would ignore its next command.
+        .can_sleep(false)
+        .ccd_enabled(true);
+    let drone_body = world.insert_body(body);
+    let part = |hx: f64, hy: f64, x: f64, mass: f64| {
+        material(
+            ColliderBuilder::cuboid(hx, hy)
+                .translation(Vector::new(x, 0.0))
+                .mass(mass),
+            p.drone_friction,
+        )
+    };
+    let frame = world.insert_collider(
+        part(g.frame_half.0, g.frame_half.1, 0.0, g.frame_mass),
+        Some(drone_body),
+    );
+    let left = world.insert_collider(
+        part(g.motor_half, g.motor_half, -g.motor_x, g.motor_mass),
+        Some(drone_body),
+    );
+    let right = world.insert_collider(
+        part(g.motor_half, g.motor_half, g.motor_x, g.motor_mass),
+        Some(drone_body),
+    );
+
+    let handles = Handles {
+        drone: drone_body,
+        drone_parts: [frame, left, right],
+        platform,
+        platform_collider,
+        ground_collider,
+    };
+    (world, handles)
+}
+
+impl Handles {
+    /// Whether every handle names an object of the right kind in `world` (a restored world
+    /// must, before anything indexes it).
+    pub fn are_valid_in(&self, world: &PhysicsWorld) -> bool {
+        let drone_ok = world.bodies.get(self.drone).is_some_and(|b| b.is_dynamic());
+        let platform_ok = world.bodies.get(self.platform).is_some();
+        let parts_ok = self.drone_parts.iter().all(|&c| {
+            world
+                .colliders
+                .get(c)
+                .is_some_and(|c| c.parent() == Some(self.drone))
+        });
+        let platform_collider_ok = world
+            .colliders
+            .get(self.platform_collider)
+            .is_some_and(|c| c.parent() == Some(self.platform));
+        let ground_ok = world.colliders.get(self.ground_collider).is_some();
+        drone_ok && platform_ok && parts_ok && platform_collider_ok && ground_ok
+    }
+
+    /// Whether any drone part has an active contact with `other` (speculative contacts within
+    /// rapier's 2 cm prediction distance included: they are what stops the drone).
+    pub fn drone_touches(&self, world: &PhysicsWorld, other: ColliderHandle) -> bool {
+        self.drone_parts.iter().any(|&part| {
+            world
+                .narrow_phase
+                .contact_pair(part, other)
+                .is_some_and(|pair| pair.has_any_active_contact())
+        })
+    }
+}
+
+/// Reads the drone's kinematic state.
+pub(crate) fn drone_state(body: &RigidBody) -> DroneState {
+    let t = body.translation();
+    let v = body.linvel();
+    DroneState {
+        x: t.x,
+        y: t.y,
+        angle: body.rotation().angle(),
+        vx: v.x,
+        vy: v.y,
+        angular_velocity: body.angvel(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn composite_inertia_comes_from_the_collider_mass_properties() {
+        let p = Lander2dParams::default();
+        let start = DroneState {
+            x: 25.0,
+            y: 40.0,
+            ..Default::default()
+        };
+        let (world, h) = build(&p, &start, 25.0, 0.0);
+        let body = &world.bodies[h.drone];
+        let mprops = body.mass_properties().local_mprops;
+        // Frame 0.3·(0.8² + 0.1²)/12 = 0.01625; each motor 0.6·(0.2² + 0.2²)/12 + 0.6·0.4² = 0.1.
+        assert!(
+            (mprops.principal_inertia() - 0.21625).abs() < 1e-12,
+            "{}",
+            mprops.principal_inertia()
+        );
+        assert!((body.mass() - 1.5).abs() < 1e-12);
+        assert!(
+            mprops.local_com.length() < 1e-12,
+            "centre of mass {:?}",
+            mprops.local_com
+        );
+        let masses: Vec<f64> = h
+            .drone_parts
+            .iter()
+            .map(|&c| world.colliders[c].mass())
+            .collect();
+        for (got, want) in masses.iter().zip([0.3, 0.6, 0.6]) {
+            assert!((got - want).abs() < 1e-12, "{masses:?}");
+        }
+        assert!(h.are_valid_in(&world));
+    }
+
+    #[test]
+    fn default_parts_are_the_reference_shapes() {
+        let g = DroneGeometry::of(&Lander2dParams::default());
+        assert_eq!(g.motor_x, 0.4);
+        assert_eq!(g.frame_half, (0.4, 0.05));
+        assert_eq!(g.motor_half, 0.1);
+    }
+
+    #[test]
+    fn drone_is_one_rigid_body_not_a_joint_assembly() {
+        // The reference's three jointed bodies stayed rigid only through self-collision.
+        let p = Lander2dParams::default();
+        let start = DroneState {
+            x: 25.0,
+            y: 40.0,
+            angle: 0.3,
+            ..Default::default()
+        };
+        let (world, h) = build(&p, &start, 25.0, 0.0);
+        assert_eq!(world.impulse_joints.len(), 0);
+        assert_eq!(world.multibody_joints.multibodies().count(), 0);
+        assert_eq!(
+            world.bodies.iter().filter(|(_, b)| b.is_dynamic()).count(),
+            1
+        );
+        assert_eq!(world.bodies[h.drone].colliders(), &h.drone_parts);
+    }
+}

@@ -1,0 +1,422 @@
+//! Landing: bring the Lander2D down onto its platform (seed 000), without the reference's bugs.
+//!
+//! Observation (11 × f32, 12 with a moving platform), each value clipped to [−1, 1] (battery
+//! and distance to [0, 1]), with W, H the world's width and height (50 m by default):
+//!
+//! | index | value |
+//! |---|---|
+//! | 0, 1 | x/(W/2) − 1, y/(H/2) − 1 |
+//! | 2, 3 | vx/15, vy/15 (m/s) |
+//! | 4, 5 | wrap(angle)/π, ω/10 (rad/s) |
+//! | 6 | battery / initial_battery |
+//! | 7, 8 | err_x/(W/2), err_y/(H/2): drone → platform top centre |
+//! | 9 | wrap(atan2(err_y, err_x) − angle)/π: bearing of the platform from the body |
+//! | 10 | ‖err‖/W |
+//! | 11 | platform vx / platform_speed (moving platform only) |
+//!
+//! Reward on the normalised values n: 2·e^(−0.1·n10) − 0.1·(n2² + n3²) − 0.2·|n4| − 0.1·|n5|,
+//! +5 on a step with platform contact; then the first terminal condition in this order adds
+//! its reward and ends the episode: landed (+100 if ‖(n2, n3)‖ < 0.1 and |n5| < 0.1, else
+//! +20), crashed (−50), lost control (|wrapped angle| > max_allowed_tilt_angle_rad, −50),
+//! battery empty (−50), out of bounds (−50). Otherwise the episode is truncated with −10 at
+//! exactly step == max_steps (the reference fired one step late).
+
+use super::{ActionError, Info, InfoValue, StepOutcome, Task, check_action, clip_f32};
+use crate::error::ParamError;
+use crate::lander2d::snapshot::{self, SnapshotError};
+use crate::lander2d::{DroneState, Lander2d, Lander2dParams, wrap_angle};
+use crate::param;
+use crate::params::{ParamSpec, Parameters};
+use crate::rng::SimRng;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// Parameters of the Landing task (the reference's constructor arguments that are not the
+/// model's own: `moving_platform` and `platform_speed` live in [`Lander2dParams`], as the FMU
+/// needs them too).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct LandingParams {
+    /// Episode length in steps; truncation at step == max_steps. Default 1000.
+    pub max_steps: u32,
+    /// Half side of the square spawn zone around (spawn_x, spawn_y), m. Default 5; 0 = fixed.
+    pub initial_pos_random_range_m: f64,
+    /// Centre of the spawn zone, x, m. Default 25.
+    pub spawn_x: f64,
+    /// Centre of the spawn zone, y, m. Default 40.
+    pub spawn_y: f64,
+    /// Half range of the uniform spawn angle, rad. Default 0.1.
+    pub initial_angle_random_range_rad: f64,
+    /// |wrapped angle| beyond which control is lost, rad. Default π/2.
+    pub max_allowed_tilt_angle_rad: f64,
+}
+
+impl Default for LandingParams {
+    fn default() -> Self {
+        LandingParams {
+            max_steps: 1000,
+            initial_pos_random_range_m: 5.0,
+            spawn_x: 25.0,
+            spawn_y: 40.0,
+            initial_angle_random_range_rad: 0.1,
+            max_allowed_tilt_angle_rad: PI / 2.0,
+        }
+    }
+}
+
+static LANDING_SPECS: [ParamSpec<LandingParams>; 6] = [
+    param!(integer max_steps, "", 1, i32::MAX, "Episode length in steps (truncation at step == max_steps)"),
+    param!(real initial_pos_random_range_m, "m", 0.0, 1e4, "Half side of the square spawn zone"),
+    param!(real spawn_x, "m", 0.0, 1e4, "Centre of the spawn zone, x"),
+    param!(real spawn_y, "m", 0.0, 1e4, "Centre of the spawn zone, y"),
+    param!(real initial_angle_random_range_rad, "rad", 0.0, PI, "Half range of the uniform spawn angle"),
+    param!(real max_allowed_tilt_angle_rad, "rad", 0.0, PI, "|wrapped angle| beyond which control is lost"),
+];
+
+impl Parameters for LandingParams {
+    fn specs() -> &'static [ParamSpec<Self>] {
+        &LANDING_SPECS
+    }
+}
+
+/// Where a spawn may lie: one drone width inside the world's sides and top, and one drone
+/// width above the platform's top, so no episode starts touching or outside.
+fn spawn_box(model: &Lander2dParams) -> ((f64, f64), (f64, f64)) {
+    let margin = model.drone_width;
+    (
+        (margin, model.world_width - margin),
+        (model.platform_top() + margin, model.world_height - margin),
+    )
+}
+
+/// Velocity and angular-velocity scales of the observation.
+const VELOCITY_SCALE: f64 = 15.0;
+const ANGULAR_VELOCITY_SCALE: f64 = 10.0;
+
+/// Outcome flags and counters of the current episode.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct LandingStatus {
+    /// Steps taken in this episode.
+    pub step: u32,
+    pub lost_control: bool,
+    pub out_of_bounds: bool,
+    pub battery_empty: bool,
+    pub time_limit: bool,
+    pub terminated: bool,
+    pub truncated: bool,
+}
+
+/// The Landing task over one [`Lander2d`].
+#[derive(Debug, Serialize, Deserialize)]
+pub struct Landing {
+    params: LandingParams,
+    lander: Lander2d,
+    status: LandingStatus,
+}
+
+impl Landing {
+    /// A Landing task, reset with seed 0. Both parameter sets are validated, and the spawn
+    /// zone must fit the world.
+    pub fn new(model: Lander2dParams, params: LandingParams) -> Result<Self, ParamError> {
+        params.validate()?;
+        model.validate()?;
+        let ((xlo, xhi), (ylo, yhi)) = spawn_box(&model);
+        if xlo > xhi || ylo > yhi {
+            return Err(ParamError::Relation {
+                name: "world_height",
+                requirement: format!(
+                    "the world leaves no room to spawn the drone: x in [{xlo}, {xhi}], y in [{ylo}, {yhi}]"
+                ),
+            });
+        }
+        let lander = Lander2d::new(model, DroneState::default(), SimRng::new(0))?;
+        let mut landing = Landing {
+            params,
+            lander,
+            status: LandingStatus::default(),
+        };
+        landing.reset(0);
+        Ok(landing)
+    }
+
+    pub fn params(&self) -> &LandingParams {
+        &self.params
+    }
+
+    pub fn lander(&self) -> &Lander2d {
+        &self.lander
+    }
+
+    /// Mutable access for tests and front ends that place the drone by hand.
+    pub fn lander_mut(&mut self) -> &mut Lander2d {
+        &mut self.lander
+    }
+
+    pub fn status(&self) -> &LandingStatus {
+        &self.status
+    }
+
+    /// Starts an episode with the drone in `drone` state instead of a sampled one; the
+    /// episode's wind and platform are still drawn from `seed`. A non-finite state is refused.
+    pub fn reset_to(&mut self, seed: u64, drone: DroneState) -> Result<(), ParamError> {
+        let model = self.lander.params().clone();
+        self.lander = Lander2d::new(model, drone, SimRng::new(seed))?;
+        self.status = LandingStatus::default();
+        Ok(())
+    }
+
+    /// The observation before narrowing to f32: each value normalised and clipped.
+    pub fn normalised_observation(&self) -> ([f64; 12], usize) {
+        let l = &self.lander;
+        let p = l.params();
+        let d = l.drone();
+        let (tx, ty) = l.platform_target();
+        let (half_w, half_h) = (p.world_width / 2.0, p.world_height / 2.0);
+        let (ex, ey) = (tx - d.x, ty - d.y);
+        let angle = wrap_angle(d.angle);
+        let signed = |v: f64| v.clamp(-1.0, 1.0);
+        let unsigned = |v: f64| v.clamp(0.0, 1.0);
+        let battery = if p.initial_battery > 0.0 {
+            l.battery() / p.initial_battery
+        } else {
+            0.0
+        };
+        let platform = if p.platform_speed > 0.0 {
+            l.platform_vx() / p.platform_speed
+        } else {
+            0.0
+        };
+        let values = [
+            signed(d.x / half_w - 1.0),
+            signed(d.y / half_h - 1.0),
+            signed(d.vx / VELOCITY_SCALE),
+            signed(d.vy / VELOCITY_SCALE),
+            signed(angle / PI),
+            signed(d.angular_velocity / ANGULAR_VELOCITY_SCALE),
+            unsigned(battery),
+            signed(ex / half_w),
+            signed(ey / half_h),
+            signed(wrap_angle(ey.atan2(ex) - angle) / PI),
+            unsigned(ex.hypot(ey) / p.world_width),
+            signed(platform),
+        ];
+        (values, self.observation_size())
+    }
+
+    /// The whole episode as bytes (see [`Lander2d::save`]).
+    pub fn save(&self) -> Result<Vec<u8>, SnapshotError> {
+        snapshot::encode(SNAPSHOT_TAG, self)
+    }
+
+    /// A task from [`Landing::save`] bytes; foreign or damaged bytes are an error.
+    pub fn restore(bytes: &[u8]) -> Result<Self, SnapshotError> {
+        let landing: Landing = snapshot::decode(SNAPSHOT_TAG, "Landing", bytes)?;
+        landing
+            .params
+            .validate()
+            .map_err(|e| SnapshotError::Invalid(e.to_string()))?;
+        landing.lander.check_restored()?;
+        Ok(landing)
+    }
+}
+
+const SNAPSHOT_TAG: &[u8; 8] = b"FLYLND01";
+
+/// The per-step reward on normalised observation values (module docs).
+pub fn shaping_reward(n: &[f64; 12], touched_platform: bool) -> f64 {
+    let r = 2.0 * (-0.1 * n[10]).exp()
+        - 0.1 * (n[2] * n[2] + n[3] * n[3])
+        - 0.2 * n[4].abs()
+        - 0.1 * n[5].abs();
+    if touched_platform { r + 5.0 } else { r }
+}
+
+impl Task for Landing {
+    fn action_size(&self) -> usize {
+        2
+    }
+
+    fn action_bounds(&self) -> (Vec<f64>, Vec<f64>) {
+        (vec![-1.0; 2], vec![1.0; 2])
+    }
+
+    fn observation_size(&self) -> usize {
+        if self.lander.params().moving_platform {
+            12
+        } else {
+            11
+        }
+    }
+
+    fn observation_bounds(&self) -> (Vec<f32>, Vec<f32>) {
+        let n = self.observation_size();
+        let mut low = vec![-1.0f32; n];
+        low[6] = 0.0;
+        low[10] = 0.0;
+        (low, vec![1.0; n])
+    }
+
+    fn reset(&mut self, seed: u64) {
+        let mut rng = SimRng::new(seed);
+        let model = self.lander.params().clone();
+        let p = &self.params;
+        let r = p.initial_pos_random_range_m;
+        let a = p.initial_angle_random_range_rad;
+        let x = p.spawn_x + rng.uniform(-r, r);
+        let y = p.spawn_y + rng.uniform(-r, r);
+        let angle = rng.uniform(-a, a);
+        let ((xlo, xhi), (ylo, yhi)) = spawn_box(&model);
+        let drone = DroneState {
+            x: x.clamp(xlo, xhi),
+            y: y.clamp(ylo, yhi),
+            angle,
+            ..Default::default()
+        };
+        self.lander = Lander2d::new_unchecked(model, drone, rng);
+        self.status = LandingStatus::default();
+    }
+
+    fn step(&mut self, action: &[f64]) -> Result<StepOutcome, ActionError> {
+        check_action(action, 2)?;
+        let command = [action[0].clamp(-1.0, 1.0), action[1].clamp(-1.0, 1.0)];
+        self.lander
+            .set_command(command)
+            .map_err(|e| ActionError::NotFinite {
+                index: e.index,
+                value: e.value,
+            })?;
+        self.lander.step();
+        self.status.step = self.status.step.saturating_add(1);
+
+        let (n, _) = self.normalised_observation();
+        let l = &self.lander;
+        let mut reward = shaping_reward(&n, l.contact().touched_platform);
+
+        let d = l.drone();
+        let p = l.params();
+        let s = &mut self.status;
+        s.lost_control = wrap_angle(d.angle).abs() > self.params.max_allowed_tilt_angle_rad;
+        s.battery_empty = l.battery() <= 0.0;
+        let inside = d.x > 0.0 && d.x < p.world_width && d.y > 0.0 && d.y < p.world_height;
+        s.out_of_bounds = !inside;
+        let calm = n[2].hypot(n[3]) < 0.1 && n[5].abs() < 0.1;
+        let terminal = if l.landed() {
+            Some(if calm { 100.0 } else { 20.0 })
+        } else if l.crashed() || s.lost_control || s.battery_empty || s.out_of_bounds {
+            Some(-50.0)
+        } else {
+            None
+        };
+        s.terminated = terminal.is_some();
+        s.time_limit = !s.terminated && s.step >= self.params.max_steps;
+        s.truncated = s.time_limit;
+        reward += terminal.unwrap_or(if s.time_limit { -10.0 } else { 0.0 });
+        Ok(StepOutcome {
+            reward,
+            terminated: s.terminated,
+            truncated: s.truncated,
+        })
+    }
+
+    fn write_observation(&self, out: &mut [f32]) {
+        let (values, n) = self.normalised_observation();
+        for (i, slot) in out.iter_mut().enumerate().take(n) {
+            let low = if i == 6 || i == 10 { 0.0 } else { -1.0 };
+            *slot = clip_f32(values[i], low, 1.0);
+        }
+    }
+
+    fn info(&self) -> Info {
+        let l = &self.lander;
+        let d = l.drone();
+        let (tx, ty) = l.platform_target();
+        let s = &self.status;
+        vec![
+            ("position", InfoValue::Vector(vec![d.x, d.y])),
+            ("velocity", InfoValue::Vector(vec![d.vx, d.vy])),
+            ("angle", InfoValue::Real(wrap_angle(d.angle))),
+            ("angular_velocity", InfoValue::Real(d.angular_velocity)),
+            ("battery", InfoValue::Real(l.battery())),
+            ("thrust", InfoValue::Vector(l.thrust().to_vec())),
+            ("wind_force", InfoValue::Vector(l.wind_force().to_vec())),
+            ("platform_position", InfoValue::Vector(vec![tx, ty])),
+            ("distance", InfoValue::Real((tx - d.x).hypot(ty - d.y))),
+            ("landed", InfoValue::Flag(l.landed())),
+            ("crashed", InfoValue::Flag(l.crashed())),
+            ("lost_control", InfoValue::Flag(s.lost_control)),
+            ("out_of_bounds", InfoValue::Flag(s.out_of_bounds)),
+            ("battery_empty", InfoValue::Flag(s.battery_empty)),
+            ("time_limit", InfoValue::Flag(s.time_limit)),
+            (
+                "platform_contact",
+                InfoValue::Flag(l.contact().touched_platform),
+            ),
+            (
+                "touchdown_speed",
+                InfoValue::Real(l.contact().touchdown_speed),
+            ),
+            ("step", InfoValue::Integer(i64::from(s.step))),
+        ]
+    }
+
+    fn dt(&self) -> f64 {
+        self.lander.params().dt
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::{assert_every_bound_is_enforced, assert_table_is_consistent};
+
+    #[test]
+    fn table_is_consistent_and_every_bound_is_enforced() {
+        assert_table_is_consistent::<LandingParams>();
+        assert_every_bound_is_enforced::<LandingParams>();
+    }
+
+    #[test]
+    fn named_errors_for_the_classic_mistakes() {
+        let cases = [
+            (
+                "max_steps",
+                0.0,
+                "parameter `max_steps` = 0 is out of range",
+            ),
+            ("max_steps", 10.5, "`max_steps` = 10.5 is not an integer"),
+            (
+                "initial_pos_random_range_m",
+                -1.0,
+                "`initial_pos_random_range_m` = -1 m",
+            ),
+            (
+                "max_allowed_tilt_angle_rad",
+                f64::NAN,
+                "`max_allowed_tilt_angle_rad` = NaN",
+            ),
+        ];
+        for (name, value, expected) in cases {
+            let mut p = LandingParams::default();
+            let err = p.set(name, value).unwrap_err().to_string();
+            assert!(err.contains(expected), "{err}");
+            assert_eq!(p, LandingParams::default());
+        }
+        let p = LandingParams::from_toml_str("max_steps = 1500\ninitial_pos_random_range_m = 10.0")
+            .unwrap();
+        assert_eq!((p.max_steps, p.initial_pos_random_range_m), (1500, 10.0));
+    }
+
+    #[test]
+    fn shaping_reward_is_the_reference_formula() {
+        let mut n = [0.0; 12];
+        assert_eq!(shaping_reward(&n, false), 2.0);
+        assert_eq!(shaping_reward(&n, true), 7.0);
+        n[10] = 0.5;
+        n[2] = 0.3;
+        n[3] = -0.4;
+        n[4] = -0.25;
+        n[5] = 0.5;
+        let want = 2.0 * (-0.05f64).exp() - 0.1 * 0.25 - 0.2 * 0.25 - 0.1 * 0.5;
+        assert!((shaping_reward(&n, false) - want).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,281 @@
+//! Waypoints: fly through a sequence of waypoints as fast as possible (seed 001's
+//! SequentialWaypointEnv), paying the checkpoint bonus the reference never paid.
+//!
+//! Observation (37 × f32): the 33 Hover values with the current waypoint as target, then
+//! [33:36] next waypoint − position (m) and [36] seconds since the last checkpoint.
+//!
+//! Reward on the step that comes within `waypoint_reach_threshold` of the current waypoint:
+//! max(checkpoint_bonus − bonus_decay_rate · t_since_checkpoint, 1); otherwise
+//! tanh(v·d̂ / velocity_scale). A positive reward gets + ½ · mean(motor states).
+//! Terminated on a crash or beyond 2·√3·side from the current waypoint; truncated at
+//! max_steps or when every waypoint is reached.
+
+use super::flight::{
+    BASE_OBSERVATION_SIZE, FlightParams, FlightStatus, apply_action, base_bounds,
+    distance_and_direction, episode_vehicle, flight_info, is_crashed, sample_start, sample_target,
+    velocity_reward, write_base_observation,
+};
+use super::{ActionError, Info, InfoValue, StepOutcome, Task, clip_f32};
+use crate::error::ParamError;
+use crate::param;
+use crate::params::{ParamSpec, Parameters};
+use crate::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
+use crate::rng::SimRng;
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+/// Arguments specific to the waypoint task (the flight arguments come in [`FlightParams`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct WaypointParams {
+    /// Waypoints per episode. Default 15.
+    pub max_num_waypoints: u32,
+    /// A waypoint is reached within this distance, m. Default 0.1.
+    pub waypoint_reach_threshold_m: f64,
+    /// Reward for reaching a waypoint at once. Default 10.
+    pub checkpoint_bonus: f64,
+    /// Bonus lost per second since the last checkpoint, 1/s. Default 2.
+    pub bonus_decay_rate_per_sec: f64,
+}
+
+impl Default for WaypointParams {
+    fn default() -> Self {
+        WaypointParams {
+            max_num_waypoints: 15,
+            waypoint_reach_threshold_m: 0.1,
+            checkpoint_bonus: 10.0,
+            bonus_decay_rate_per_sec: 2.0,
+        }
+    }
+}
+
+static WAYPOINT_SPECS: [ParamSpec<WaypointParams>; 4] = [
+    param!(integer max_num_waypoints, "", 1, 10_000, "Waypoints per episode"),
+    param!(real waypoint_reach_threshold_m, "m", 1e-3, 1e3, "Distance at which a waypoint counts as reached"),
+    param!(real checkpoint_bonus, "", 0.0, 1e6, "Reward for reaching a waypoint at once"),
+    param!(real bonus_decay_rate_per_sec, "1/s", 0.0, 1e6, "Bonus lost per second since the last checkpoint"),
+];
+
+impl Parameters for WaypointParams {
+    fn specs() -> &'static [ParamSpec<Self>] {
+        &WAYPOINT_SPECS
+    }
+}
+
+/// Number of observation values.
+pub const WAYPOINT_OBSERVATION_SIZE: usize = BASE_OBSERVATION_SIZE + 4;
+
+/// The Waypoints task. Plain data: clone it to snapshot an episode.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Waypoints {
+    flight: FlightParams,
+    params: WaypointParams,
+    quad: Quadrotor,
+    waypoints: Vec<Vector3<f64>>,
+    current: usize,
+    reached: u32,
+    /// Steps since the last checkpoint (time = steps · dt, never summed).
+    steps_since_checkpoint: u32,
+    status: FlightStatus,
+    obs_low: Vec<f32>,
+    obs_high: Vec<f32>,
+}
+
+/// Out-of-bounds radius around the current waypoint: 2·√3·side.
+pub fn waypoint_out_of_bounds_distance(flight: &FlightParams) -> f64 {
+    2.0 * 3f64.sqrt() * flight.space_side_length
+}
+
+impl Waypoints {
+    /// A Waypoints task, reset with seed 0. All parameter sets are validated.
+    pub fn new(
+        model: QuadrotorParams,
+        flight: FlightParams,
+        params: WaypointParams,
+    ) -> Result<Self, ParamError> {
+        flight.validate()?;
+        params.validate()?;
+        model.validate()?;
+        let bound = waypoint_out_of_bounds_distance(&flight);
+        let (base_lo, base_hi) = base_bounds(&model, bound);
+        let max_time = f64::from(flight.max_steps) * flight.dt;
+        let mut obs_low = base_lo.to_vec();
+        let mut obs_high = base_hi.to_vec();
+        obs_low.extend([-bound as f32; 3]);
+        obs_high.extend([bound as f32; 3]);
+        obs_low.push(0.0);
+        obs_high.push(max_time as f32);
+        let body = BodyState::at_rest(Vector3::zeros(), 0.0, 0.0, 0.0, 0.0);
+        let quad = Quadrotor::new(model, body, SimRng::new(0))?;
+        let mut task = Waypoints {
+            flight,
+            params,
+            quad,
+            waypoints: Vec::new(),
+            current: 0,
+            reached: 0,
+            steps_since_checkpoint: 0,
+            status: FlightStatus::default(),
+            obs_low,
+            obs_high,
+        };
+        task.reset(0);
+        Ok(task)
+    }
+
+    pub fn quadrotor(&self) -> &Quadrotor {
+        &self.quad
+    }
+
+    pub fn quadrotor_mut(&mut self) -> &mut Quadrotor {
+        &mut self.quad
+    }
+
+    /// The episode's waypoints, in order.
+    pub fn waypoints(&self) -> &[Vector3<f64>] {
+        &self.waypoints
+    }
+
+    pub fn waypoints_reached(&self) -> u32 {
+        self.reached
+    }
+
+    /// The waypoint being flown to (the last one once all are reached).
+    pub fn current_waypoint(&self) -> Vector3<f64> {
+        self.waypoints[self.current.min(self.waypoints.len() - 1)]
+    }
+
+    /// The waypoint after the current one (the current one if it is the last).
+    pub fn next_waypoint(&self) -> Vector3<f64> {
+        self.waypoints[(self.current + 1).min(self.waypoints.len() - 1)]
+    }
+
+    /// Seconds since the last checkpoint (or the start).
+    pub fn time_since_checkpoint(&self) -> f64 {
+        f64::from(self.steps_since_checkpoint) * self.flight.dt
+    }
+}
+
+impl Task for Waypoints {
+    fn action_size(&self) -> usize {
+        4
+    }
+
+    fn action_bounds(&self) -> (Vec<f64>, Vec<f64>) {
+        (vec![0.0; 4], vec![1.0; 4])
+    }
+
+    fn observation_size(&self) -> usize {
+        WAYPOINT_OBSERVATION_SIZE
+    }
+
+    fn observation_bounds(&self) -> (Vec<f32>, Vec<f32>) {
+        (self.obs_low.clone(), self.obs_high.clone())
+    }
+
+    fn reset(&mut self, seed: u64) {
+        let mut rng = SimRng::new(seed);
+        let model = self.quad.params.clone();
+        let body = sample_start(&self.flight, &model, &mut rng);
+        let mut from = body.position;
+        self.waypoints.clear();
+        for _ in 0..self.params.max_num_waypoints {
+            from = sample_target(&self.flight, &from, &mut rng);
+            self.waypoints.push(from);
+        }
+        if let Ok(quad) = episode_vehicle(model, body, rng) {
+            self.quad = quad;
+        }
+        self.current = 0;
+        self.reached = 0;
+        self.steps_since_checkpoint = 0;
+        self.status = FlightStatus {
+            initial_distance: (self.current_waypoint() - self.quad.body.position).norm(),
+            ..FlightStatus::default()
+        };
+    }
+
+    fn step(&mut self, action: &[f64]) -> Result<StepOutcome, ActionError> {
+        apply_action(&mut self.quad, action, self.flight.dt)?;
+        self.status.step_count += 1;
+        self.steps_since_checkpoint += 1;
+
+        let waypoint = self.current_waypoint();
+        let (d, _) = distance_and_direction(&self.quad.body, &waypoint);
+        let all_reached = self.reached >= self.params.max_num_waypoints;
+        let mut reward = if d < self.params.waypoint_reach_threshold_m && !all_reached {
+            let bonus = self.params.checkpoint_bonus
+                - self.params.bonus_decay_rate_per_sec * self.time_since_checkpoint();
+            self.reached += 1;
+            self.current += 1;
+            self.steps_since_checkpoint = 0;
+            self.status.initial_distance =
+                (self.current_waypoint() - self.quad.body.position).norm();
+            bonus.max(1.0)
+        } else {
+            velocity_reward(&self.flight, &self.quad.body, &waypoint)
+        };
+        if reward > 0.0 {
+            let mean_motor = self.quad.body.motors.iter().sum::<f64>() / 4.0;
+            reward += 0.5 * mean_motor;
+        }
+
+        let d_now = (self.current_waypoint() - self.quad.body.position).norm();
+        let status = &mut self.status;
+        status.crashed =
+            self.flight.enable_crash_detection && is_crashed(&self.flight, &self.quad.body);
+        status.out_of_bounds = self.flight.enable_out_of_bounds_detection
+            && d_now > waypoint_out_of_bounds_distance(&self.flight);
+        let truncated = status.step_count >= self.flight.max_steps
+            || self.reached >= self.params.max_num_waypoints;
+        Ok(StepOutcome {
+            reward,
+            terminated: status.crashed || status.out_of_bounds,
+            truncated,
+        })
+    }
+
+    fn write_observation(&self, out: &mut [f32]) {
+        let current = self.current_waypoint();
+        write_base_observation(&self.quad, &current, &self.obs_low, &self.obs_high, out);
+        let next = self.next_waypoint() - self.quad.body.position;
+        for i in 0..3 {
+            let k = BASE_OBSERVATION_SIZE + i;
+            out[k] = clip_f32(next[i], self.obs_low[k], self.obs_high[k]);
+        }
+        let k = BASE_OBSERVATION_SIZE + 3;
+        out[k] = clip_f32(
+            self.time_since_checkpoint(),
+            self.obs_low[k],
+            self.obs_high[k],
+        );
+    }
+
+    fn info(&self) -> Info {
+        let current = self.current_waypoint();
+        let mut info = flight_info(&self.quad, &current, &self.status, self.flight.dt);
+        info.extend([
+            (
+                "waypoints_reached",
+                InfoValue::Integer(i64::from(self.reached)),
+            ),
+            (
+                "current_waypoint_pos",
+                InfoValue::Vector(current.as_slice().to_vec()),
+            ),
+            (
+                "next_waypoint_pos",
+                InfoValue::Vector(self.next_waypoint().as_slice().to_vec()),
+            ),
+            (
+                "steps_since_checkpoint",
+                InfoValue::Real(self.time_since_checkpoint()),
+            ),
+        ]);
+        info
+    }
+
+    fn dt(&self) -> f64 {
+        self.flight.dt
+    }
+}
