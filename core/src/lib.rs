@@ -13,9 +13,11 @@ pub mod lander2d;
 pub mod params;
 pub mod quadrotor;
 pub mod rng;
+pub mod snapshot;
 pub mod tasks;
 pub mod variables;
 
 pub use error::ParamError;
 pub use params::{ParamSpec, Parameters, ValueKind};
 pub use rng::SimRng;
+pub use snapshot::SnapshotError;

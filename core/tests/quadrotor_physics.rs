@@ -346,6 +346,22 @@ fn a_snapshot_continues_bit_identically() {
 }
 
 #[test]
+fn saved_bytes_restore_an_instance_that_continues_bit_identically() {
+    let body = BodyState::at_rest(Vector3::new(0.0, 0.0, 3.0), 0.05, 0.0, 0.0, 0.5);
+    let mut quad = Quadrotor::new(QuadrotorParams::default(), body, SimRng::new(4)).unwrap();
+    fly(&mut quad, [0.5, 0.49, 0.51, 0.5], 0.5);
+    let bytes = quad.save().unwrap();
+    fly(&mut quad, [0.52, 0.49, 0.51, 0.5], 1.0);
+    let mut restored = Quadrotor::restore(&bytes).unwrap();
+    fly(&mut restored, [0.52, 0.49, 0.51, 0.5], 1.0);
+    assert_eq!(quad.save().unwrap(), restored.save().unwrap());
+    assert!(Quadrotor::restore(b"not a snapshot at all").is_err());
+    let mut damaged = bytes.clone();
+    damaged[20] ^= 0x10;
+    assert!(Quadrotor::restore(&damaged).is_err());
+}
+
+#[test]
 fn non_finite_commands_are_refused_and_out_of_range_ones_clamped() {
     let mut quad = vehicle(
         still_air(),

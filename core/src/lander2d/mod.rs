@@ -3,17 +3,16 @@
 //!
 //! [`world`] builds the rapier scene, [`model`] steps it (thrust, noise, battery, wind,
 //! moving platform), [`contact`] judges touch-downs, [`params`] holds the parameter tables,
-//! [`variables`] the table the FMU and the SITL read, [`snapshot`] the save format.
+//! [`variables`] the table the FMU and the SITL read.
 
 pub mod contact;
 pub mod model;
 pub mod params;
-pub mod snapshot;
 pub mod variables;
 pub mod world;
 
+pub use crate::snapshot::SnapshotError;
 pub use contact::{ContactState, wrap_angle};
 pub use model::{CommandError, Lander2d};
 pub use params::{Lander2dInitial, Lander2dParams};
-pub use snapshot::SnapshotError;
 pub use world::{DroneGeometry, DroneState};

@@ -3,11 +3,11 @@
 
 use super::contact::ContactState;
 use super::params::{Lander2dInitial, Lander2dParams};
-use super::snapshot::{self, SnapshotError};
 use super::world::{self, DroneGeometry, DroneState, Handles};
 use crate::error::ParamError;
 use crate::params::Parameters;
 use crate::rng::SimRng;
+use crate::snapshot::{self, SnapshotError};
 use rapier2d_f64::prelude::*;
 use serde::{Deserialize, Serialize};
 

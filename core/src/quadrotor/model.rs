@@ -8,6 +8,7 @@ use super::wind::{advance_wind, reset_wind};
 use crate::error::ParamError;
 use crate::params::Parameters;
 use crate::rng::SimRng;
+use crate::snapshot::{self, SnapshotError};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -125,7 +126,38 @@ impl Quadrotor {
     pub fn rng_mut(&mut self) -> &mut SimRng {
         &mut self.rng
     }
+
+    /// The whole state as bytes (parameters, body, wind, command, RNG); every f64 is kept
+    /// bit for bit, so a restored instance continues exactly as this one would.
+    pub fn save(&self) -> Result<Vec<u8>, SnapshotError> {
+        snapshot::encode(SNAPSHOT_TAG, self)
+    }
+
+    /// An instance from [`Quadrotor::save`] bytes. Foreign or damaged bytes, or bytes that
+    /// decode into invalid parameters or a non-finite state, are an error, never a panic.
+    pub fn restore(bytes: &[u8]) -> Result<Self, SnapshotError> {
+        let quad: Quadrotor = snapshot::decode(SNAPSHOT_TAG, "Quadrotor", bytes)?;
+        quad.params
+            .validate()
+            .map_err(|e| SnapshotError::Invalid(e.to_string()))?;
+        let b = &quad.body;
+        let finite = b.position.iter().all(|v| v.is_finite())
+            && b.velocity.iter().all(|v| v.is_finite())
+            && b.body_rates.iter().all(|v| v.is_finite())
+            && b.attitude.coords.iter().all(|v| v.is_finite())
+            && b.attitude.norm() > 0.0
+            && b.motors.iter().chain(&quad.command).all(|v| v.is_finite());
+        if !finite {
+            return Err(SnapshotError::Invalid(
+                "state holds a non-finite value or a zero quaternion".into(),
+            ));
+        }
+        Ok(quad)
+    }
 }
+
+/// Format tag of a Quadrotor snapshot (name and version).
+const SNAPSHOT_TAG: &[u8; 8] = b"FLYQUA01";
 
 /// A motor command that is not a finite number.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -23,11 +23,11 @@
 
 use super::{ActionError, Info, InfoValue, StepOutcome, Task, check_action, clip_f32};
 use crate::error::ParamError;
-use crate::lander2d::snapshot::{self, SnapshotError};
 use crate::lander2d::{DroneState, Lander2d, Lander2dParams, wrap_angle};
 use crate::param;
 use crate::params::{ParamSpec, Parameters};
 use crate::rng::SimRng;
+use crate::snapshot::{self, SnapshotError};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 

@@ -1,4 +1,5 @@
-//! Byte snapshots of a whole state (rapier world, RNG, battery, counters, contact flags).
+//! Byte snapshots of a whole model or task state (for the Lander2D: rapier world, RNG,
+//! battery, counters and contact flags).
 //!
 //! Layout: an 8-byte tag naming the format and its version, the payload length (u64 LE), the
 //! postcard payload, and an FNV-1a 64 checksum of the payload (u64 LE). postcard stores every
