@@ -7,11 +7,25 @@
 //!
 //! Frames: the quadrotor's world is ENU (x east, y north, z up) and its body FLU (x forward,
 //! y left, z up); quaternions are `[w, x, y, z]` (Hamilton, body → world).
+//!
+//! ```
+//! use flyloop_core::quadrotor::QuadrotorParams;
+//! use flyloop_core::tasks::{Task, flight::FlightParams, hover::Hover};
+//!
+//! let mut task = Hover::new(QuadrotorParams::default(), FlightParams::default())?;
+//! task.reset(42); // same seed → bit-identical episode
+//! let outcome = task.step(&[0.495, 0.495, 0.495, 0.495])?;
+//! let mut obs = [0f32; 33];
+//! task.write_observation(&mut obs);
+//! assert!(!outcome.terminated && obs.iter().all(|v| v.is_finite()));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 pub mod error;
 pub mod lander2d;
 pub mod params;
 pub mod quadrotor;
+pub mod reference;
 pub mod rng;
 pub mod snapshot;
 pub mod tasks;

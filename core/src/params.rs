@@ -198,7 +198,8 @@ pub trait Parameters: Sized + Clone + Default + Serialize + DeserializeOwned + '
                 s.unit,
                 (s.get)(&defaults),
                 range,
-                s.description
+                // A bare | would end the table cell.
+                s.description.replace('|', "\\|")
             ));
         }
         out

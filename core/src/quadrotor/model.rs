@@ -4,7 +4,7 @@
 use super::dynamics::{accelerations, integrate};
 use super::params::{QuadrotorInitial, QuadrotorParams};
 use super::state::{BodyState, WindState};
-use super::wind::{advance_wind, reset_wind};
+use super::wind::{OuCache, apply_transition, reset_wind};
 use crate::error::ParamError;
 use crate::params::Parameters;
 use crate::rng::SimRng;
@@ -24,6 +24,8 @@ pub struct Quadrotor {
     command: [f64; 4],
     grounded: bool,
     rng: SimRng,
+    #[serde(skip)]
+    ou_cache: OuCache,
 }
 
 impl Quadrotor {
@@ -43,6 +45,7 @@ impl Quadrotor {
             command: [0.0; 4],
             grounded: false,
             rng,
+            ou_cache: OuCache::default(),
         })
     }
 
@@ -88,7 +91,10 @@ impl Quadrotor {
     pub fn step(&mut self, dt: f64) {
         let wind = self.wind_velocity();
         self.grounded = integrate(&self.params, &mut self.body, &self.command, &wind, dt);
-        advance_wind(&self.params, &mut self.wind, dt, &mut self.rng);
+        if self.params.wind_enabled {
+            let transition = self.ou_cache.get(&self.params, dt);
+            apply_transition(&transition, &mut self.wind, &mut self.rng);
+        }
     }
 
     /// Total wind at the vehicle (episode wind + external), world ENU, m/s.

@@ -19,26 +19,85 @@ pub fn reset_wind(params: &QuadrotorParams, rng: &mut SimRng) -> WindState {
     }
 }
 
-/// Advances the turbulence by `dt` with the exact OU transition
-/// x ← x e^(−θ dt) + σ √((1 − e^(−2θ dt)) / 2θ) ξ (for θ → 0, Brownian motion σ √dt ξ),
-/// σ on x and y, σ · turbulence_vertical_ratio on z.
-pub fn advance_wind(params: &QuadrotorParams, wind: &mut WindState, dt: f64, rng: &mut SimRng) {
-    if !params.wind_enabled {
-        return;
+/// One OU transition of length `dt`: x ← x·decay + sigma·ξ (sigma_z on z).
+#[derive(Debug, Clone, Copy)]
+pub struct OuTransition {
+    /// Bits of (dt, θ, σ, vertical ratio) the coefficients were computed for.
+    key: [u64; 4],
+    decay: f64,
+    sigma: f64,
+    sigma_z: f64,
+}
+
+impl OuTransition {
+    /// The exact transition x ← x e^(−θ dt) + σ √((1 − e^(−2θ dt)) / 2θ) ξ (for θ → 0,
+    /// Brownian motion σ √dt ξ), σ on x and y, σ · turbulence_vertical_ratio on z.
+    pub fn new(params: &QuadrotorParams, dt: f64) -> Self {
+        let theta = params.turbulence_theta;
+        let decay = (-theta * dt).exp();
+        let spread = if theta * dt > 1e-12 {
+            ((1.0 - decay * decay) / (2.0 * theta)).sqrt()
+        } else {
+            dt.sqrt()
+        };
+        let sigma = params.turbulence_sigma * spread;
+        OuTransition {
+            key: Self::key(params, dt),
+            decay,
+            sigma,
+            sigma_z: sigma * params.turbulence_vertical_ratio,
+        }
     }
-    let theta = params.turbulence_theta;
-    let decay = (-theta * dt).exp();
-    let spread = if theta * dt > 1e-12 {
-        ((1.0 - decay * decay) / (2.0 * theta)).sqrt()
-    } else {
-        dt.sqrt()
-    };
-    let sigma = params.turbulence_sigma * spread;
-    let sigma_z = sigma * params.turbulence_vertical_ratio;
-    let t = &mut wind.turbulence;
-    t.x = t.x * decay + sigma * rng.normal();
-    t.y = t.y * decay + sigma * rng.normal();
-    t.z = t.z * decay + sigma_z * rng.normal();
+
+    fn key(params: &QuadrotorParams, dt: f64) -> [u64; 4] {
+        [
+            dt.to_bits(),
+            params.turbulence_theta.to_bits(),
+            params.turbulence_sigma.to_bits(),
+            params.turbulence_vertical_ratio.to_bits(),
+        ]
+    }
+
+    /// Whether these coefficients are the ones [`OuTransition::new`] gives for `params`, `dt`.
+    pub fn is_for(&self, params: &QuadrotorParams, dt: f64) -> bool {
+        self.key == Self::key(params, dt)
+    }
+}
+
+/// The last [`OuTransition`] used, so a run at a fixed step pays for exp and sqrt once.
+/// A cache, not state: not stored in snapshots and equal to every other cache.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct OuCache(Option<OuTransition>);
+
+impl PartialEq for OuCache {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl OuCache {
+    /// The transition for `params` and `dt`, recomputed only when one of them changed.
+    pub fn get(&mut self, params: &QuadrotorParams, dt: f64) -> OuTransition {
+        match self.0 {
+            Some(t) if t.is_for(params, dt) => t,
+            _ => *self.0.insert(OuTransition::new(params, dt)),
+        }
+    }
+}
+
+/// Advances the turbulence by `dt` with the exact OU transition (see [`OuTransition::new`]).
+pub fn advance_wind(params: &QuadrotorParams, wind: &mut WindState, dt: f64, rng: &mut SimRng) {
+    if params.wind_enabled {
+        apply_transition(&OuTransition::new(params, dt), wind, rng);
+    }
+}
+
+/// Advances the turbulence by one precomputed transition.
+pub fn apply_transition(t: &OuTransition, wind: &mut WindState, rng: &mut SimRng) {
+    let w = &mut wind.turbulence;
+    w.x = w.x * t.decay + t.sigma * rng.normal();
+    w.y = w.y * t.decay + t.sigma * rng.normal();
+    w.z = w.z * t.decay + t.sigma_z * rng.normal();
 }
 
 #[cfg(test)]

@@ -1,0 +1,64 @@
+//! The parameter reference (docs/parameters.md), generated from the parameter tables so the
+//! documentation cannot drift from the code: a test compares the checked-in file with
+//! [`parameter_reference`], and `cargo run -p flyloop-core --example parameter_reference`
+//! prints it.
+
+use crate::lander2d::{Lander2dInitial, Lander2dParams};
+use crate::params::Parameters;
+use crate::quadrotor::{QuadrotorInitial, QuadrotorParams};
+use crate::tasks::flight::FlightParams;
+use crate::tasks::landing::LandingParams;
+use crate::tasks::waypoints::WaypointParams;
+
+/// The whole reference as markdown.
+pub fn parameter_reference() -> String {
+    let sections = [
+        (
+            "Quadrotor model (`QuadrotorParams`)",
+            "Physical parameters of the 3D quadrotor (world ENU, body FLU, PX4 quad-X).",
+            QuadrotorParams::markdown_table(),
+        ),
+        (
+            "Quadrotor start values (`QuadrotorInitial`, FMU only)",
+            "Seed and initial state of an FMU instance.",
+            QuadrotorInitial::markdown_table(),
+        ),
+        (
+            "Hover and Waypoints tasks (`FlightParams`)",
+            "Episode settings shared by QuadHover and QuadWaypoints (seed 001's DroneEnv arguments).",
+            FlightParams::markdown_table(),
+        ),
+        (
+            "Waypoints task (`WaypointParams`)",
+            "Extra settings of QuadWaypoints (seed 001's SequentialWaypointEnv arguments).",
+            WaypointParams::markdown_table(),
+        ),
+        (
+            "Lander2D model (`Lander2dParams`)",
+            "Physical parameters of the 2D lander on rapier2d (world x right, y up, metres).",
+            Lander2dParams::markdown_table(),
+        ),
+        (
+            "Lander2D start values (`Lander2dInitial`, FMU only)",
+            "Seed and initial state of an FMU instance.",
+            Lander2dInitial::markdown_table(),
+        ),
+        (
+            "Landing task (`LandingParams`)",
+            "Episode settings of Lander2D (seed 000's arguments).",
+            LandingParams::markdown_table(),
+        ),
+    ];
+    let mut out = String::from(
+        "# Parameter reference\n\n\
+         Generated from the parameter tables in `core/` by\n\
+         `cargo run -p flyloop-core --example parameter_reference > docs/parameters.md`;\n\
+         a test fails when this file and the code disagree. Every value is checked against\n\
+         its range when set (from TOML/JSON, over MAVLink, through the FMU), and the error\n\
+         names the parameter and the bound it broke.\n",
+    );
+    for (title, text, table) in sections {
+        out.push_str(&format!("\n## {title}\n\n{text}\n\n{table}"));
+    }
+    out
+}

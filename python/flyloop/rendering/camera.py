@@ -1,0 +1,144 @@
+"""Perspective orbit camera for the quadrotor view: pure numpy, no pygame.
+
+The camera orbits a look-at point. ``azimuth_deg`` is the compass direction the camera looks
+toward (0 = north/+y, 90 = east/+x); ``elevation_deg`` is how far it looks down from the
+horizon. Camera space: x right, y up, z (depth) forward. Screen: pixels, origin top-left,
+v downward; ``fov_deg`` is the vertical field of view.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+MAX_ELEVATION_DEG = 89.0
+
+
+@dataclass(eq=False)
+class OrbitCamera:
+    look_at: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+    distance: float = 6.5
+    azimuth_deg: float = 35.0
+    elevation_deg: float = 28.0
+    fov_deg: float = 55.0
+    near: float = 0.05
+
+    def __post_init__(self) -> None:
+        self.look_at = np.asarray(self.look_at, dtype=float).reshape(3)
+        if not (self.distance > 0 and 0 < self.fov_deg < 180 and self.near > 0):
+            raise ValueError(
+                f"camera needs distance > 0, 0 < fov_deg < 180 and near > 0, got "
+                f"distance={self.distance}, fov_deg={self.fov_deg}, near={self.near}"
+            )
+        self.elevation_deg = _clamp_elevation(self.elevation_deg)
+        self._home = (self.look_at.copy(), self.distance, self.azimuth_deg, self.elevation_deg)
+        self._cache_key: tuple | None = None
+        self._cache: tuple[np.ndarray, np.ndarray] = (np.eye(3), np.zeros(3))
+
+    def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Unit vectors (right, up, forward) of the camera in world coordinates."""
+        rows = self._view()[0]
+        return rows[0].copy(), rows[1].copy(), rows[2].copy()
+
+    def position(self) -> np.ndarray:
+        """Where the camera sits in the world, metres."""
+        return self._view()[1].copy()
+
+    def to_camera(self, points: np.ndarray) -> np.ndarray:
+        """World points (..., 3) to camera coordinates (..., 3): right, up, depth."""
+        rows, position = self._view()
+        return (np.asarray(points, dtype=float) - position) @ rows.T
+
+    def _view(self) -> tuple[np.ndarray, np.ndarray]:
+        """(3x3 rows right/up/forward, position), recomputed only when the pose changed: a
+        frame projects thousands of points through the same pose."""
+        key = (self.azimuth_deg, self.elevation_deg, self.distance, *self.look_at.tolist())
+        if self._cache_key != key:
+            az = math.radians(self.azimuth_deg)
+            el = math.radians(self.elevation_deg)
+            sa, ca, se, ce = math.sin(az), math.cos(az), math.sin(el), math.cos(el)
+            forward = (sa * ce, ca * ce, -se)
+            right = (ca, -sa, 0.0)
+            up = (sa * se, ca * se, ce)  # right x forward
+            rows = np.array([right, up, forward])
+            self._cache = (rows, self.look_at - rows[2] * self.distance)
+            self._cache_key = key
+        return self._cache
+
+    def focal_px(self, height: int) -> float:
+        """Pixels per unit of (lateral offset / depth)."""
+        return (height / 2.0) / math.tan(math.radians(self.fov_deg) / 2.0)
+
+    def project_camera(self, cam: np.ndarray, width: int, height: int) -> np.ndarray:
+        """Camera points (..., 3) with depth >= near to screen pixels (..., 2), float."""
+        cam = np.asarray(cam, dtype=float)
+        f = self.focal_px(height)
+        depth = np.maximum(cam[..., 2], self.near)
+        u = width / 2.0 + f * cam[..., 0] / depth
+        v = height / 2.0 - f * cam[..., 1] / depth
+        return np.stack([u, v], axis=-1)
+
+    def project(self, points: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+        """World points (..., 3) to (pixels (..., 2), visible (...)): visible = in front of near."""
+        cam = self.to_camera(points)
+        return self.project_camera(cam, width, height), cam[..., 2] >= self.near
+
+    def clip_segment(self, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """The part of world segment a-b in front of the near plane, in camera coordinates."""
+        ca, cb = self.to_camera(np.stack([a, b]))
+        da, db = ca[2] - self.near, cb[2] - self.near
+        if da < 0 and db < 0:
+            return None
+        if da < 0:
+            ca = ca + (cb - ca) * (da / (da - db))
+        elif db < 0:
+            cb = cb + (ca - cb) * (db / (db - da))
+        return ca, cb
+
+    def pixel_radius(self, radius_m: float, depth: float, height: int) -> float:
+        """On-screen radius in pixels of a sphere of radius_m at this depth."""
+        return self.focal_px(height) * radius_m / max(depth, self.near)
+
+    # Interactive controls ------------------------------------------------------------------
+
+    def orbit(self, d_azimuth_deg: float, d_elevation_deg: float) -> None:
+        """Turn around the look-at point; elevation stays short of straight up/down."""
+        self.azimuth_deg = (self.azimuth_deg + d_azimuth_deg) % 360.0
+        self.elevation_deg = _clamp_elevation(self.elevation_deg + d_elevation_deg)
+
+    def move(self, forward: float, right: float, up: float) -> None:
+        """Shift the look-at point: forward/right along the ground as seen, up along +z."""
+        az = math.radians(self.azimuth_deg)
+        ground_forward = np.array([math.sin(az), math.cos(az), 0.0])
+        ground_right = np.array([math.cos(az), -math.sin(az), 0.0])
+        self.look_at = (
+            self.look_at + forward * ground_forward + right * ground_right + np.array([0, 0, up])
+        )
+
+    def reset(self) -> None:
+        """Back to the pose the camera was created with."""
+        look_at, self.distance, self.azimuth_deg, self.elevation_deg = self._home
+        self.look_at = look_at.copy()
+
+
+def _clamp_elevation(value: float) -> float:
+    return max(-MAX_ELEVATION_DEG, min(MAX_ELEVATION_DEG, float(value)))
+
+
+def clip_polygon_near(cam_points: np.ndarray, near: float) -> np.ndarray:
+    """The part of a convex camera-space polygon (N, 3) with depth >= near (Sutherland-Hodgman
+    against one plane); (0, 3) when it lies wholly behind."""
+    out: list[np.ndarray] = []
+    pts = np.asarray(cam_points, dtype=float)
+    for i in range(len(pts)):
+        a, b = pts[i - 1], pts[i]
+        da, db = a[2] - near, b[2] - near
+        if db >= 0:
+            if da < 0:
+                out.append(a + (b - a) * (da / (da - db)))
+            out.append(b)
+        elif da >= 0:
+            out.append(a + (b - a) * (da / (da - db)))
+    return np.array(out) if out else np.zeros((0, 3))

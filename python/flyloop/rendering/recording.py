@@ -1,0 +1,159 @@
+"""Save rgb_array frames as a GIF (Pillow) or a video (ffmpeg from imageio-ffmpeg).
+
+gymnasium's own `gymnasium.wrappers.RecordVideo` also works with flyloop's envs in
+render_mode="rgb_array" (it needs moviepy); these helpers need neither gymnasium's wrapper
+nor moviepy.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+VIDEO_SUFFIXES = (".mp4", ".mkv", ".mov", ".avi", ".webm")
+
+
+def _checked(frames: Iterable[np.ndarray]) -> list[np.ndarray]:
+    out = [np.asarray(f) for f in frames]
+    if not out:
+        raise ValueError("no frames to save")
+    shape = out[0].shape
+    for i, f in enumerate(out):
+        if f.ndim != 3 or f.shape[2] != 3 or f.dtype != np.uint8:
+            raise ValueError(f"frame {i} must be (H, W, 3) uint8, got {f.shape} {f.dtype}")
+        if f.shape != shape:
+            raise ValueError(f"frame {i} is {f.shape}, the first frame is {shape}")
+    return out
+
+
+def save_video(frames: Iterable[np.ndarray], path: str | Path, fps: float = 30.0) -> Path:
+    """Write frames ((H, W, 3) uint8, all one size) to path; the suffix picks the format:
+    .gif (Pillow) or .mp4/.mkv/.mov/.avi/.webm (imageio-ffmpeg's bundled ffmpeg)."""
+    if not fps > 0:
+        raise ValueError(f"fps must be > 0, got {fps}")
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix != ".gif" and suffix not in VIDEO_SUFFIXES:
+        raise ValueError(f"unsupported file type {suffix!r}: use .gif or one of {VIDEO_SUFFIXES}")
+    checked = _checked(frames)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if suffix == ".gif":
+        _save_gif(checked, path, fps)
+    else:
+        _save_ffmpeg(checked, path, fps)
+    return path
+
+
+def _save_gif(frames: list[np.ndarray], path: Path, fps: float) -> None:
+    try:
+        from PIL import Image
+    except ImportError as exc:
+        raise ImportError("saving a GIF needs Pillow: pip install pillow") from exc
+    images = [Image.fromarray(f) for f in frames]
+    # GIF delays are in 1/100 s, so rates above 50 fps cannot be shown faithfully.
+    duration_ms = max(20, round(1000.0 / fps))
+    images[0].save(
+        path, save_all=True, append_images=images[1:], duration=duration_ms, loop=0, optimize=False
+    )
+
+
+def _save_ffmpeg(frames: list[np.ndarray], path: Path, fps: float) -> None:
+    try:
+        import imageio_ffmpeg
+    except ImportError as exc:
+        raise ImportError(
+            f"saving {path.suffix} needs imageio-ffmpeg (it bundles ffmpeg): "
+            "pip install imageio-ffmpeg, or save a .gif"
+        ) from exc
+    height, width = frames[0].shape[:2]
+    # H.264 in yuv420p needs even sides: pad by one edge pixel rather than rescale.
+    pad_h, pad_w = height % 2, width % 2
+    writer = imageio_ffmpeg.write_frames(
+        str(path),
+        (width + pad_w, height + pad_h),
+        fps=fps,
+        macro_block_size=1,
+        ffmpeg_log_level="error",
+    )
+    writer.send(None)
+    try:
+        for f in frames:
+            if pad_h or pad_w:
+                f = np.pad(f, ((0, pad_h), (0, pad_w), (0, 0)), mode="edge")
+            writer.send(np.ascontiguousarray(f))
+    finally:
+        writer.close()
+
+
+class FrameRecorder:
+    """Collects frames (e.g. each env.render() in rgb_array mode) and saves them at the end."""
+
+    def __init__(self, max_frames: int | None = None) -> None:
+        if max_frames is not None and max_frames < 1:
+            raise ValueError(f"max_frames must be >= 1, got {max_frames}")
+        self.max_frames = max_frames
+        self.frames: list[np.ndarray] = []
+
+    def add(self, frame: np.ndarray | None) -> None:
+        """Keep a copy of frame; None (a human-mode render) is refused with a clear error."""
+        if frame is None:
+            raise ValueError("got no frame: record with render_mode='rgb_array'")
+        if self.max_frames is not None and len(self.frames) >= self.max_frames:
+            return
+        self.frames.append(np.array(frame, dtype=np.uint8, copy=True))
+
+    def __len__(self) -> int:
+        return len(self.frames)
+
+    def save(self, path: str | Path, fps: float = 30.0) -> Path:
+        return save_video(self.frames, path, fps)
+
+    def clear(self) -> None:
+        self.frames.clear()
+
+
+@dataclass(frozen=True)
+class Recording:
+    path: Path
+    frames: int
+    steps: int
+    total_reward: float
+
+
+def record_episode(
+    env: Any,
+    path: str | Path,
+    policy: Callable[[Any], Any] | None = None,
+    *,
+    seed: int | None = None,
+    max_steps: int | None = None,
+    fps: float | None = None,
+) -> Recording:
+    """Run one episode of a gymnasium env made with render_mode="rgb_array" and save it.
+
+    policy(observation) -> action; random actions when None. fps defaults to the env's
+    metadata["render_fps"] (30 if absent). One frame after reset and one per step.
+    """
+    if getattr(env, "render_mode", None) != "rgb_array":
+        raise ValueError(
+            f"record_episode needs an env made with render_mode='rgb_array', "
+            f"got {getattr(env, 'render_mode', None)!r}"
+        )
+    rate = fps if fps is not None else float(env.metadata.get("render_fps") or 30)
+    recorder = FrameRecorder()
+    observation, _ = env.reset(seed=seed)
+    recorder.add(env.render())
+    steps, total = 0, 0.0
+    while max_steps is None or steps < max_steps:
+        action = policy(observation) if policy is not None else env.action_space.sample()
+        observation, reward, terminated, truncated, _ = env.step(action)
+        recorder.add(env.render())
+        steps += 1
+        total += float(reward)
+        if terminated or truncated:
+            break
+    return Recording(recorder.save(path, rate), len(recorder), steps, total)

@@ -1,0 +1,170 @@
+"""Camera, frame-convention and 2D-plane math of flyloop.rendering (pure numpy, no pygame)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from flyloop.rendering.camera import OrbitCamera, clip_polygon_near
+from flyloop.rendering.geometry import (
+    ROTOR_SPIN,
+    euler_rpy,
+    quaternion_from_euler,
+    rotation_matrix,
+    rotor_positions_body,
+)
+from flyloop.rendering.plane import PlaneView
+
+W, H = 800, 600
+
+
+def test_look_at_point_lands_in_the_frame_centre():
+    cam = OrbitCamera(look_at=np.array([1.0, -2.0, 0.5]), distance=5.0, azimuth_deg=70)
+    uv, visible = cam.project(np.array([1.0, -2.0, 0.5]), W, H)
+    assert visible
+    np.testing.assert_allclose(uv, [W / 2, H / 2], atol=1e-9)
+    assert cam.to_camera(cam.look_at)[2] == pytest.approx(5.0)
+
+
+def test_looking_north_east_is_right_and_up_is_up():
+    # Looking north (azimuth 0) from the horizon: east is screen-right, +z is screen-up.
+    cam = OrbitCamera(look_at=np.zeros(3), distance=10.0, azimuth_deg=0.0, elevation_deg=0.0)
+    (u_east, v_east), _ = cam.project(np.array([1.0, 0.0, 0.0]), W, H)
+    (u_up, v_up), _ = cam.project(np.array([0.0, 0.0, 1.0]), W, H)
+    focal = (H / 2) / math.tan(math.radians(cam.fov_deg) / 2)
+    assert u_east == pytest.approx(W / 2 + focal * 1.0 / 10.0)
+    assert v_east == pytest.approx(H / 2)
+    assert v_up == pytest.approx(H / 2 - focal * 1.0 / 10.0)
+    assert u_up == pytest.approx(W / 2)
+
+
+def test_azimuth_90_looks_east_so_north_is_screen_left():
+    cam = OrbitCamera(look_at=np.zeros(3), distance=10.0, azimuth_deg=90.0, elevation_deg=0.0)
+    right, up, forward = cam.basis()
+    np.testing.assert_allclose(forward, [1, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(right, [0, -1, 0], atol=1e-12)
+    np.testing.assert_allclose(up, [0, 0, 1], atol=1e-12)
+    (u_north, _), _ = cam.project(np.array([0.0, 1.0, 0.0]), W, H)
+    assert u_north < W / 2 - 10
+
+
+def test_basis_is_orthonormal_and_right_handed_at_any_pose():
+    for az, el in [(0, 0), (35, 28), (200, -40), (359, 89)]:
+        right, up, forward = OrbitCamera(azimuth_deg=az, elevation_deg=el).basis()
+        m = np.array([right, up, forward])
+        np.testing.assert_allclose(m @ m.T, np.eye(3), atol=1e-12)
+        np.testing.assert_allclose(np.cross(right, up), -forward, atol=1e-12)
+
+
+def test_perspective_shrinks_with_depth():
+    cam = OrbitCamera(look_at=np.zeros(3), distance=4.0, azimuth_deg=0, elevation_deg=0)
+    near_r = cam.pixel_radius(0.1, 2.0, H)
+    far_r = cam.pixel_radius(0.1, 8.0, H)
+    assert near_r == pytest.approx(4 * far_r)
+    # A 1 m offset at depth 4 spans the projected distance that pixel_radius predicts.
+    (u0, _), _ = cam.project(np.zeros(3), W, H)
+    (u1, _), _ = cam.project(np.array([1.0, 0, 0]), W, H)
+    assert u1 - u0 == pytest.approx(cam.pixel_radius(1.0, 4.0, H))
+
+
+def test_points_behind_the_camera_are_not_visible_and_segments_are_clipped():
+    cam = OrbitCamera(look_at=np.zeros(3), distance=5.0, azimuth_deg=0, elevation_deg=0)
+    behind = cam.position() - np.array([0.0, 1.0, 0.0])
+    _, visible = cam.project(behind, W, H)
+    assert not visible
+    assert cam.clip_segment(behind, behind - [0, 1, 0]) is None
+    a, b = cam.clip_segment(behind, np.zeros(3))
+    assert a[2] == pytest.approx(cam.near)
+    assert b[2] == pytest.approx(5.0)
+
+
+def test_near_plane_polygon_clipping():
+    square = np.array([[-1, -1, -1.0], [1, -1, -1.0], [1, 1, 3.0], [-1, 1, 3.0]])
+    out = clip_polygon_near(square, 1.0)
+    assert len(out) == 4
+    assert np.all(out[:, 2] >= 1.0 - 1e-12)
+    assert sorted(np.round(out[:, 2], 9)) == [1.0, 1.0, 3.0, 3.0]
+    assert len(clip_polygon_near(square - [0, 0, 10], 1.0)) == 0
+
+
+def test_orbit_move_and_reset():
+    cam = OrbitCamera(look_at=np.array([0.0, 0.0, 1.0]), azimuth_deg=10, elevation_deg=20)
+    cam.orbit(355, 500)
+    assert cam.azimuth_deg == pytest.approx(5.0)
+    assert cam.elevation_deg == 89.0  # clamped short of straight down
+    cam.orbit(0, -400)
+    assert cam.elevation_deg == -89.0
+    cam.azimuth_deg = 90.0
+    cam.move(forward=2.0, right=1.0, up=0.5)
+    np.testing.assert_allclose(cam.look_at, [2.0, -1.0, 1.5], atol=1e-12)
+    cam.distance = 20.0
+    cam.reset()
+    np.testing.assert_allclose(cam.look_at, [0.0, 0.0, 1.0])
+    assert (cam.azimuth_deg, cam.elevation_deg, cam.distance) == (10, 20, 6.5)
+
+
+def test_bad_camera_is_refused_by_name():
+    with pytest.raises(ValueError, match="distance"):
+        OrbitCamera(distance=0.0)
+    with pytest.raises(ValueError, match="fov_deg"):
+        OrbitCamera(fov_deg=180.0)
+
+
+def test_rotor_layout_is_px4_quad_x():
+    r = rotor_positions_body(0.1)
+    lever = 0.1 / math.sqrt(2)
+    # 0 front-right, 1 rear-left, 2 front-left, 3 rear-right (body FLU: +x front, +y left).
+    np.testing.assert_allclose(r[0], [lever, -lever, 0])
+    np.testing.assert_allclose(r[1], [-lever, lever, 0])
+    np.testing.assert_allclose(r[2], [lever, lever, 0])
+    np.testing.assert_allclose(r[3], [-lever, -lever, 0])
+    assert ROTOR_SPIN == (-1, -1, 1, 1)  # CCW, CCW, CW, CW as core/src/quadrotor/dynamics.rs
+
+
+def test_quaternion_rotation_and_euler_round_trip():
+    yaw90 = quaternion_from_euler(0.0, 0.0, math.pi / 2)
+    # Yaw +90 deg (ENU, counter-clockwise from above): the nose points north.
+    np.testing.assert_allclose(rotation_matrix(yaw90) @ [1, 0, 0], [0, 1, 0], atol=1e-12)
+    roll = quaternion_from_euler(0.3, 0.0, 0.0)
+    # Positive roll about the forward axis lifts the left (+y) side: body z tips toward -y.
+    assert (rotation_matrix(roll) @ [0, 0, 1])[1] < -0.25
+    for angles in [(0.1, -0.2, 0.3), (-1.0, 0.7, -2.5), (0.0, 1.2, 3.0)]:
+        q = quaternion_from_euler(*angles)
+        assert np.linalg.norm(q) == pytest.approx(1.0)
+        np.testing.assert_allclose(euler_rpy(q), angles, atol=1e-9)
+        m = rotation_matrix(q)
+        np.testing.assert_allclose(m @ m.T, np.eye(3), atol=1e-12)
+
+
+def test_plane_fits_the_world_and_round_trips():
+    plane = PlaneView.fit_world(50.0, 50.0, (800, 800), margin_px=12)
+    assert plane.scale == pytest.approx(776 / 50)
+    np.testing.assert_allclose(plane.to_screen((0.0, 0.0)), [12, 788])
+    np.testing.assert_allclose(plane.to_screen((50.0, 50.0)), [788, 12])
+    wide = PlaneView.fit_world(100.0, 20.0, (800, 400), margin_px=0)
+    np.testing.assert_allclose(wide.to_screen((50.0, 10.0)), [400, 200])
+    pts = np.array([[3.0, 4.0], [25.0, 40.0]])
+    np.testing.assert_allclose(plane.to_world(plane.to_screen(pts)), pts)
+    zoom = PlaneView.centred_on(np.array([25.0, 40.0]), 48.0, (250, 180))
+    np.testing.assert_allclose(zoom.to_screen((25.0, 40.0)), [125, 90])
+    np.testing.assert_allclose(zoom.to_screen((26.0, 41.0)) - [125, 90], [48, -48])
+    with pytest.raises(ValueError, match="cannot fit"):
+        PlaneView.fit_world(50.0, 50.0, (20, 20), margin_px=12)
+
+
+def test_batched_segments_match_one_by_one_clipping():
+    from flyloop.rendering.quad_world import Projector
+
+    cam = OrbitCamera(look_at=np.zeros(3), distance=3.0, azimuth_deg=20, elevation_deg=10)
+    pr = Projector(cam, (W, H))
+    rng = np.random.default_rng(7)
+    a = rng.uniform(-8, 8, (200, 3))
+    b = rng.uniform(-8, 8, (200, 3))
+    batched = pr.segments(a, b)
+    single = [pr.segment(x, y) for x, y in zip(a, b, strict=True)]
+    single = [s for s in single if s is not None]
+    assert 20 < len(single) < 200  # some segments lie wholly behind the camera
+    assert len(batched) == len(single)
+    for (pa, pb), (qa, qb) in zip(batched, single, strict=True):
+        np.testing.assert_allclose(pa, qa, atol=1e-6)
+        np.testing.assert_allclose(pb, qb, atol=1e-6)

@@ -1,0 +1,226 @@
+"""Human mode in a real X window: Xvfb on a free display, its framebuffer read back (-fbdir
+writes the screen as an XWD file) and compared with what rgb_array mode draws; camera input
+through real pygame events; clean close. Needs the Debian package xvfb."""
+
+import os
+import select
+import shutil
+import struct
+import subprocess
+import time
+
+import numpy as np
+import pytest
+
+from flyloop.rendering import LanderScene, LanderView, QuadrotorView, QuadScene
+from flyloop.rendering.screen import import_pygame
+
+pygame = import_pygame("human")  # a hard dependency: its absence must fail, not skip
+
+QUAD = QuadScene(
+    time_s=1.0,
+    step=10,
+    position=(0.3, -0.2, 1.4),
+    velocity=(0.5, 0.2, 0.0),
+    quaternion=(0.98, 0.1, -0.05, 0.15),
+    motors=(0.6, 0.5, 0.4, 0.55),
+    wind=(2.0, 1.0, 0.0),
+    target=(1.0, 1.0, 2.0),
+    reward=0.5,
+)
+LANDER = LanderScene(
+    time_s=1.0,
+    step=10,
+    position=(24.0, 30.0),
+    velocity=(0.5, -1.0),
+    angle=0.1,
+    angular_velocity=0.2,
+    thrust=(6.0, 8.0),
+    battery=90.0,
+    platform_x=25.0,
+    wind_force=(2.5, 0.0),
+    wind_speed=5.0,
+)
+
+
+@pytest.fixture(scope="module")
+def xvfb(tmp_path_factory):
+    exe = shutil.which("Xvfb")
+    if exe is None:
+        pytest.skip("Xvfb is not installed (apt-get install xvfb): no display for human mode")
+    fbdir = tmp_path_factory.mktemp("xvfb")
+    read_fd, write_fd = os.pipe()
+    proc = subprocess.Popen(
+        [exe, "-displayfd", str(write_fd), "-screen", "0", "1024x900x24", "-br"]
+        + ["-nolisten", "tcp", "-fbdir", str(fbdir)],
+        pass_fds=(write_fd,),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    os.close(write_fd)
+    try:
+        ready, _, _ = select.select([read_fd], [], [], 15.0)
+        number = os.read(read_fd, 16).decode().strip() if ready else ""
+        if not number:
+            pytest.fail("Xvfb did not report a display within 15 s")
+        yield f":{number}", fbdir / "Xvfb_screen0"
+    finally:
+        os.close(read_fd)
+        proc.terminate()
+        proc.wait(timeout=10)
+
+
+@pytest.fixture
+def display(xvfb, monkeypatch):
+    name, framebuffer = xvfb
+    monkeypatch.setenv("DISPLAY", name)
+    monkeypatch.delenv("SDL_VIDEODRIVER", raising=False)  # rgb_array tests may have set dummy
+    monkeypatch.setenv("SDL_VIDEO_WINDOW_POS", "0,0")
+    return framebuffer
+
+
+@pytest.fixture
+def views(display):
+    """Views a test opens; closed even when it fails, before Xvfb goes away."""
+    opened = []
+    yield opened
+    for view in opened:
+        view.close()
+
+
+def read_xwd(path) -> np.ndarray:
+    """The (H, W, 3) RGB pixels of an XWD screen dump (32 bits per pixel, TrueColor)."""
+    data = path.read_bytes()
+    fields = struct.unpack(">25I", data[:100])
+    header_size, width, height = fields[0], fields[4], fields[5]
+    byte_order, bits_per_pixel, bytes_per_line = fields[7], fields[11], fields[12]
+    masks, ncolors = fields[14:17], fields[19]
+    assert bits_per_pixel == 32, bits_per_pixel
+    offset = header_size + ncolors * 12
+    raw = np.frombuffer(data, np.uint8, count=height * bytes_per_line, offset=offset)
+    rows = raw.reshape(height, bytes_per_line)[:, : width * 4].copy()
+    value = rows.view("<u4" if byte_order == 0 else ">u4")
+    shift = [int(m & -m).bit_length() - 1 for m in masks]
+    return np.stack([(value & m) >> s for m, s in zip(masks, shift, strict=True)], -1).astype(
+        np.uint8
+    )
+
+
+def wait_for_window(framebuffer, expected: np.ndarray, rows: int) -> float:
+    """Largest fraction of the window's first `rows` rows equal to `expected`, polled ~3 s."""
+    best = 0.0
+    deadline = time.monotonic() + 3.0
+    while time.monotonic() < deadline:
+        pygame.event.pump()
+        screen = read_xwd(framebuffer)
+        h, w = expected.shape[:2]
+        same = np.all(screen[:rows, :w] == expected[:rows], axis=-1).mean()
+        best = max(best, float(same))
+        if best > 0.995:
+            break
+        time.sleep(0.05)
+    return best
+
+
+def test_quadrotor_window_shows_the_frame_and_closes_cleanly(display, views):
+    offscreen = QuadrotorView("rgb_array", width=640, height=480)
+    expected = offscreen.render(QUAD)
+    offscreen.close()
+    view = QuadrotorView("human", width=640, height=480, fps=0)
+    views.append(view)
+    for _ in range(3):
+        assert view.render(QUAD) is None
+    assert pygame.display.get_driver() == "x11"
+    assert pygame.display.get_surface().get_size() == (640, 480)
+    # The window differs from rgb_array only in the controls hint along its bottom.
+    assert wait_for_window(display, expected, rows=450) > 0.995
+    view.close()
+    view.close()
+    assert not pygame.display.get_init()
+    assert not view.is_open
+
+
+def test_lander_window_shows_the_frame(display, views):
+    offscreen = LanderView("rgb_array", width=600, height=600)
+    expected = offscreen.render(LANDER)
+    offscreen.close()
+    view = LanderView("human", width=600, height=600, fps=0)
+    views.append(view)
+    for _ in range(3):
+        view.render(LANDER)
+    assert wait_for_window(display, expected, rows=600) > 0.995
+    view.close()
+    assert not pygame.display.get_init()
+
+
+def post(kind, **attrs):
+    pygame.event.post(pygame.event.Event(kind, **attrs))
+
+
+def test_mouse_drag_keys_and_reset_move_the_camera(display, views):
+    view = QuadrotorView("human", width=480, height=360, fps=0)
+    views.append(view)
+    view.render(QUAD)
+    view.render(QUAD)  # let the window's own start-up events pass
+    cam = view.camera
+    az, el, look_at, distance = cam.azimuth_deg, cam.elevation_deg, cam.look_at.copy(), cam.distance
+
+    post(pygame.MOUSEBUTTONDOWN, button=1, pos=(200, 200))
+    post(pygame.MOUSEMOTION, pos=(250, 210), rel=(50, 10), buttons=(1, 0, 0))
+    post(pygame.MOUSEBUTTONUP, button=1, pos=(250, 210))
+    post(pygame.MOUSEMOTION, pos=(300, 210), rel=(50, 0), buttons=(0, 0, 0))  # not dragging
+    view.render(QUAD)
+    assert cam.azimuth_deg == pytest.approx((az - 15.0) % 360)
+    assert cam.elevation_deg == pytest.approx(el + 3.0)
+
+    post(pygame.KEYDOWN, key=pygame.K_w, mod=0, unicode="w", scancode=26)
+    for _ in range(4):
+        view.render(QUAD)
+    post(pygame.KEYUP, key=pygame.K_w, mod=0, unicode="w", scancode=26)
+    post(pygame.KEYDOWN, key=pygame.K_e, mod=0, unicode="e", scancode=8)
+    post(pygame.KEYUP, key=pygame.K_e, mod=0, unicode="e", scancode=8)
+    view.render(QUAD)
+    view.render(QUAD)  # nothing held any more: no further movement
+    step = 0.012 * distance
+    moved = cam.look_at - look_at
+    forward = np.array([np.sin(np.radians(cam.azimuth_deg)), np.cos(np.radians(cam.azimuth_deg))])
+    assert moved[:2] @ forward == pytest.approx(4 * step, rel=1e-6)  # W held for 4 frames
+    assert moved[2] == pytest.approx(step, rel=1e-6)  # a tap within one frame: one step
+
+    post(pygame.MOUSEWHEEL, x=0, y=2, flipped=False)
+    view.render(QUAD)
+    assert cam.distance == pytest.approx(distance * 0.81)
+
+    post(pygame.KEYDOWN, key=pygame.K_r, mod=0, unicode="r", scancode=21)
+    view.render(QUAD)
+    assert (cam.azimuth_deg, cam.elevation_deg, cam.distance) == (az, el, distance)
+    np.testing.assert_array_equal(cam.look_at, look_at)
+    view.close()
+
+
+def test_closing_the_window_stops_rendering_and_frees_it(display, views):
+    view = LanderView("human", width=300, height=300, fps=0)
+    views.append(view)
+    view.render(LANDER)
+    with pytest.raises(RuntimeError, match="already owns the pygame window"):
+        QuadrotorView("human", width=300, height=300)
+    post(pygame.QUIT)
+    assert view.render(LANDER) is None
+    assert not view.is_open
+    assert not pygame.display.get_init()
+    view.close()  # after the user closed it: still fine
+    again = QuadrotorView("human", width=300, height=300, fps=0)  # the window is free again
+    views.append(again)
+    again.render(QUAD)
+    post(pygame.KEYDOWN, key=pygame.K_ESCAPE, mod=0, unicode="\x1b", scancode=41)
+    assert again.render(QUAD) is None
+    assert not again.is_open
+    again.close()
+
+
+def test_human_mode_without_a_display_is_a_clear_error(monkeypatch):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.setenv("SDL_VIDEODRIVER", "x11")
+    with pytest.raises(RuntimeError, match="needs a display"):
+        QuadrotorView("human", width=200, height=200)

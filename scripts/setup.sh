@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Sets up everything on a fresh machine (Debian packages, a Python venv in .venv, the Rust
+# build) and runs the main demo. Usage: bash scripts/setup.sh [--no-demo]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+demo=1
+[[ "${1:-}" == "--no-demo" ]] && demo=0
+
+say() { printf '\n==> %s\n' "$*"; }
+
+packages=$(grep -v '^#' scripts/apt-packages.txt | xargs)
+missing=$(for p in $packages; do dpkg -s "$p" >/dev/null 2>&1 || echo "$p"; done | xargs)
+if [[ -n "$missing" ]]; then
+    say "Debian packages: $missing"
+    if [[ $(id -u) -eq 0 ]]; then
+        apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $missing >/dev/null
+    else
+        sudo apt-get update -qq && sudo DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $missing >/dev/null
+    fi
+fi
+
+say "Python venv .venv (test peers: fmpy, libcosimpy, pymavlink, MAVProxy, pytest)"
+[[ -x .venv/bin/python ]] || python3 -m venv .venv
+.venv/bin/pip install -q --upgrade pip
+.venv/bin/pip install -q -r tests/requirements.txt
+.venv/bin/pip install -q -e python
+
+say "Rust build (release)"
+cargo build --release --workspace --all-targets
+
+if [[ $demo -eq 1 ]]; then
+    say "Demo: the Hover task flown by a PD controller in the Rust core"
+    cargo run --release -q -p flyloop-core --example hover
+fi

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Runs every check and test: formatting, lints, Rust tests, Python lint and system tests.
+# Needs scripts/setup.sh to have run once (it creates .venv).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+say() { printf '\n==> %s\n' "$*"; }
+
+say "cargo fmt --check"
+cargo fmt --all --check
+say "cargo clippy (all targets, warnings are errors)"
+cargo clippy --workspace --all-targets -- -D warnings
+say "Rust tests (cargo nextest)"
+cargo nextest run --workspace --release
+say "Rust doctests"
+cargo test --workspace --release --doc
+say "ruff"
+.venv/bin/ruff check python tests
+.venv/bin/ruff format --check python tests
+say "Python system tests (pytest)"
+.venv/bin/pytest -q
