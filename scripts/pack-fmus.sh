@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Builds the FMU library (release) and packs dist/fmu/Quadrotor.fmu and dist/fmu/Lander2D.fmu.
+# Builds the FMU library and tools (release) and packs dist/fmu/Quadrotor.fmu and dist/fmu/Lander2D.fmu.
 # Usage: bash scripts/pack-fmus.sh [out-dir]    (honours CARGO_TARGET_DIR)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -7,5 +7,5 @@ cd "$(dirname "$0")/.."
 out="${1:-dist/fmu}"
 target="${CARGO_TARGET_DIR:-target}"
 
-cargo build --release -q -p flyloop-fmu --lib --bin flyloop-fmu-pack
+cargo build --release -q -p flyloop-fmu --lib --bins
 "$target/release/flyloop-fmu-pack" fmus "$target/release/libflyloop_fmu.so" "$out"

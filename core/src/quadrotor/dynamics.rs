@@ -259,6 +259,17 @@ fn integrate_avx(
     integrate_portable(params, state, command, wind, dt)
 }
 
+/// ceil(dt / max_substep), at least 1. A ratio within 1e-9 (relative) above a whole number
+/// counts as that number: 0.07 / 0.01 is 7.000000000000001 in floating point, and 7
+/// substeps, not 8, is what the parameters say.
+pub fn substep_count(dt: f64, max_substep: f64) -> f64 {
+    if dt <= max_substep {
+        return 1.0;
+    }
+    let ratio = dt / max_substep;
+    (ratio - ratio * 1e-9).ceil().max(1.0)
+}
+
 #[inline(always)]
 fn integrate_portable(
     params: &QuadrotorParams,
@@ -268,11 +279,7 @@ fn integrate_portable(
     dt: f64,
 ) -> bool {
     let c = Coefficients::new(params);
-    let substeps = if dt <= params.max_substep {
-        1.0
-    } else {
-        (dt / params.max_substep).ceil()
-    };
+    let substeps = substep_count(dt, params.max_substep);
     let h = dt / substeps;
     let mut grounded = false;
     for _ in 0..substeps as u64 {
@@ -365,5 +372,16 @@ mod tests {
         let bits = |s: &BodyState| flatten(s).map(f64::to_bits);
         assert_eq!(bits(&a), bits(&b));
         assert_ne!(bits(&a), bits(&start));
+    }
+
+    /// Regression: 0.07 s at 0.01 s substeps took 8 substeps (0.07 / 0.01 = 7.000000000000001).
+    #[test]
+    fn substep_count_ignores_rounding_noise_in_the_ratio() {
+        assert_eq!(substep_count(0.07, 0.01), 7.0);
+        assert_eq!(substep_count(0.03, 0.01), 3.0);
+        assert_eq!(substep_count(0.01, 0.01), 1.0);
+        assert_eq!(substep_count(0.005, 0.01), 1.0);
+        assert_eq!(substep_count(0.0701, 0.01), 8.0);
+        assert_eq!(substep_count(1.0, 0.3), 4.0);
     }
 }

@@ -1,0 +1,186 @@
+//! FMU states: get, set, free, serialize, deserialize. A state is a copy of everything the
+//! instance holds (model with its RNG and physics world, stage, experiment, time grid, start
+//! values), so setting it and stepping again repeats the same outputs bit for bit.
+//!
+//! The instance keeps every state it hands out; a pointer it does not know (freed already,
+//! foreign, garbage) is refused with fmi2Error instead of being dereferenced.
+
+use super::guard::{c_slice, c_slice_mut, with_instance, write_out};
+use crate::error::FmuError;
+use crate::fmi2_types::*;
+use crate::instance::{SavedState, Stage, masks};
+
+/// Copies the current state. `*FMUstate` NULL gets a new state; a state of this instance is
+/// overwritten in place.
+///
+/// # Safety
+/// `FMUstate` must be NULL or valid for reads and writes of one pointer.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetFMUstate(
+    c: fmi2Component,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    let function = "fmi2GetFMUstate";
+    with_instance(c, function, masks::FMU_STATE, |instance| {
+        if FMUstate.is_null() {
+            return Err(FmuError::NullArgument("FMUstate"));
+        }
+        // SAFETY: non-NULL and readable per the contract.
+        let existing = unsafe { FMUstate.read() };
+        let bytes = instance.sim.save(instance.stage.code())?;
+        if existing.is_null() {
+            let address = instance.adopt_state(SavedState { bytes });
+            // SAFETY: non-NULL and writable per the contract.
+            unsafe { FMUstate.write(address.cast()) };
+        } else {
+            instance.state_mut(existing as usize)?.bytes = bytes;
+        }
+        instance.event(&format!(
+            "{function}: state saved at t = {}",
+            instance.sim.time()
+        ));
+        Ok(fmi2Status::fmi2OK)
+    })
+}
+
+/// Restores a state of this instance (stage, time and everything else included).
+///
+/// # Safety
+/// `c` must be NULL or a live instance; `FMUstate` may be anything (it is looked up, not
+/// dereferenced).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
+    let function = "fmi2SetFMUstate";
+    with_instance(c, function, masks::FMU_STATE, |instance| {
+        if FMUstate.is_null() {
+            return Err(FmuError::NullArgument("FMUstate"));
+        }
+        // A copy: the lookup borrows the instance that restore changes. Every state in the
+        // registry was made by fmi2GetFMUstate or checked by fmi2DeSerializeFMUstate, stage
+        // code included, and restore changes nothing when it fails.
+        let bytes = instance.state(FMUstate as usize)?.bytes.clone();
+        let code = instance.sim.restore(&bytes)?;
+        instance.stage = stage_of(code)?;
+        instance.event(&format!(
+            "{function}: state restored, t = {}, stage {:?}",
+            instance.sim.time(),
+            instance.stage
+        ));
+        Ok(fmi2Status::fmi2OK)
+    })
+}
+
+fn stage_of(code: u8) -> Result<Stage, FmuError> {
+    Stage::from_code(code).ok_or_else(|| {
+        FmuError::InvalidArgument(format!("the FMU state holds an unknown stage code {code}"))
+    })
+}
+
+/// Frees a state and sets `*FMUstate` to NULL. `*FMUstate` NULL is ignored; a pointer this
+/// instance does not hold (a second free) is an error.
+///
+/// # Safety
+/// `FMUstate` must be NULL or valid for reads and writes of one pointer.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2FreeFMUstate(
+    c: fmi2Component,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    with_instance(c, "fmi2FreeFMUstate", masks::FMU_STATE, |instance| {
+        if FMUstate.is_null() {
+            return Err(FmuError::NullArgument("FMUstate"));
+        }
+        // SAFETY: non-NULL and readable per the contract.
+        let state = unsafe { FMUstate.read() };
+        if state.is_null() {
+            return Ok(fmi2Status::fmi2OK);
+        }
+        instance.release_state(state as usize)?;
+        // SAFETY: non-NULL and writable per the contract.
+        unsafe { FMUstate.write(std::ptr::null_mut()) };
+        Ok(fmi2Status::fmi2OK)
+    })
+}
+
+/// # Safety
+/// `size` must be NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
+    c: fmi2Component,
+    FMUstate: fmi2FMUstate,
+    size: *mut usize,
+) -> fmi2Status {
+    with_instance(
+        c,
+        "fmi2SerializedFMUstateSize",
+        masks::FMU_STATE,
+        |instance| {
+            let length = instance.state(FMUstate as usize)?.bytes.len();
+            // SAFETY: per the contract.
+            unsafe { write_out(size, length, "size") }?;
+            Ok(fmi2Status::fmi2OK)
+        },
+    )
+}
+
+/// Copies a state's bytes; `size` must be what fmi2SerializedFMUstateSize said.
+///
+/// # Safety
+/// `serializedState` must be NULL or writable for `size` bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SerializeFMUstate(
+    c: fmi2Component,
+    FMUstate: fmi2FMUstate,
+    serializedState: *mut fmi2Byte,
+    size: usize,
+) -> fmi2Status {
+    with_instance(c, "fmi2SerializeFMUstate", masks::FMU_STATE, |instance| {
+        let bytes = &instance.state(FMUstate as usize)?.bytes;
+        if size != bytes.len() {
+            return Err(FmuError::InvalidArgument(format!(
+                "size is {size}, but the serialized state has {} bytes \
+                 (ask fmi2SerializedFMUstateSize)",
+                bytes.len()
+            )));
+        }
+        // SAFETY: per the contract.
+        let out = unsafe { c_slice_mut(serializedState.cast::<u8>(), size, "serializedState") }?;
+        out.copy_from_slice(bytes);
+        Ok(fmi2Status::fmi2OK)
+    })
+}
+
+/// Makes a state from serialized bytes after checking them completely (format, checksum,
+/// model, a restorable model snapshot). Bytes that fail give fmi2Error and change nothing.
+///
+/// # Safety
+/// `serializedState` must be NULL or readable for `size` bytes; `FMUstate` must be NULL or
+/// valid for reads and writes of one pointer.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
+    c: fmi2Component,
+    serializedState: *const fmi2Byte,
+    size: usize,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    with_instance(c, "fmi2DeSerializeFMUstate", masks::FMU_STATE, |instance| {
+        if FMUstate.is_null() {
+            return Err(FmuError::NullArgument("FMUstate"));
+        }
+        // SAFETY: per the contract.
+        let bytes = unsafe { c_slice(serializedState.cast::<u8>(), size, "serializedState") }?;
+        stage_of(instance.sim.check_saved(bytes)?)?;
+        // SAFETY: non-NULL and readable per the contract.
+        let existing = unsafe { FMUstate.read() };
+        if existing.is_null() {
+            let address = instance.adopt_state(SavedState {
+                bytes: bytes.to_vec(),
+            });
+            // SAFETY: non-NULL and writable per the contract.
+            unsafe { FMUstate.write(address.cast()) };
+        } else {
+            instance.state_mut(existing as usize)?.bytes = bytes.to_vec();
+        }
+        Ok(fmi2Status::fmi2OK)
+    })
+}

@@ -1,0 +1,241 @@
+//! What every export does around its body: the NULL check of the instance, the stage check,
+//! the mapping of errors to a status plus a log message, and `catch_unwind`, so that a panic
+//! becomes fmi2Fatal with a message instead of unwinding into (and aborting) the importer.
+
+use crate::error::FmuError;
+use crate::fmi2_types::{fmi2Component, fmi2Status};
+use crate::instance::{Instance, Mask, Stage};
+use std::any::Any;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
+/// Runs `body` for the instance behind `c` if `mask` allows its stage.
+///
+/// A NULL `c` gives fmi2Error (there is no logger to tell). An `Err` from the body is logged
+/// as "`function`: reason" and gives its status. A panic puts the instance in the Fatal
+/// stage and gives fmi2Fatal.
+pub(crate) fn with_instance(
+    c: fmi2Component,
+    function: &'static str,
+    mask: Mask,
+    body: impl FnOnce(&mut Instance) -> Result<fmi2Status, FmuError>,
+) -> fmi2Status {
+    let outcome = catch_unwind(AssertUnwindSafe(|| {
+        // SAFETY: a non-NULL fmi2Component is a pointer fmi2Instantiate returned and
+        // fmi2FreeInstance has not freed (the importer's side of the contract).
+        let Some(instance) = (unsafe { c.cast::<Instance>().as_mut() }) else {
+            return fmi2Status::fmi2Error;
+        };
+        let result = instance.check_stage(mask).and_then(|()| body(instance));
+        match result {
+            Ok(status) => status,
+            Err(error) => instance.report(function, &error),
+        }
+    }));
+    outcome.unwrap_or_else(|payload| {
+        let message = panic_message(payload);
+        // SAFETY: as above; the borrow inside the closure ended with the unwind.
+        if let Some(instance) = unsafe { c.cast::<Instance>().as_mut() } {
+            instance.stage = Stage::Fatal;
+            let _ = catch_unwind(AssertUnwindSafe(|| {
+                instance.log(
+                    fmi2Status::fmi2Fatal,
+                    &format!(
+                        "{function}: internal error (panic: {message}); the instance is \
+                         unusable, call fmi2FreeInstance"
+                    ),
+                );
+            }));
+        }
+        fmi2Status::fmi2Fatal
+    })
+}
+
+/// Runs `body` (an export without an instance) and returns `fallback` if it panics.
+pub(crate) fn guarded<R>(fallback: R, body: impl FnOnce() -> R) -> R {
+    catch_unwind(AssertUnwindSafe(body)).unwrap_or_else(|payload| {
+        let _ = panic_message(payload);
+        fallback
+    })
+}
+
+/// The text of a panic payload. The payload is leaked, not dropped: a payload whose drop
+/// panicked again would abort the importing process.
+fn panic_message(payload: Box<dyn Any + Send>) -> String {
+    let message = if let Some(s) = payload.downcast_ref::<&str>() {
+        (*s).to_string()
+    } else if let Some(s) = payload.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "unknown panic payload".to_string()
+    };
+    std::mem::forget(payload);
+    message
+}
+
+/// The slice behind a C array argument; NULL is allowed only for an empty array.
+///
+/// # Safety
+/// If `ptr` is not NULL it must point to `n` readable `T`s that stay valid for `'a`.
+pub(crate) unsafe fn c_slice<'a, T>(
+    ptr: *const T,
+    n: usize,
+    name: &'static str,
+) -> Result<&'a [T], FmuError> {
+    if n == 0 {
+        return Ok(&[]);
+    }
+    if ptr.is_null() {
+        return Err(FmuError::NullArgument(name));
+    }
+    check_length::<T>(n, name)?;
+    // SAFETY: non-NULL, length checked against isize::MAX bytes, validity per the contract.
+    Ok(unsafe { std::slice::from_raw_parts(ptr, n) })
+}
+
+/// The mutable slice behind a C output array; NULL is allowed only for an empty array.
+///
+/// # Safety
+/// If `ptr` is not NULL it must point to `n` writable `T`s that stay valid for `'a`.
+pub(crate) unsafe fn c_slice_mut<'a, T>(
+    ptr: *mut T,
+    n: usize,
+    name: &'static str,
+) -> Result<&'a mut [T], FmuError> {
+    if n == 0 {
+        return Ok(&mut []);
+    }
+    if ptr.is_null() {
+        return Err(FmuError::NullArgument(name));
+    }
+    check_length::<T>(n, name)?;
+    // SAFETY: as in c_slice, and the importer does not alias its output arrays.
+    Ok(unsafe { std::slice::from_raw_parts_mut(ptr, n) })
+}
+
+fn check_length<T>(n: usize, name: &'static str) -> Result<(), FmuError> {
+    if n > isize::MAX as usize / std::mem::size_of::<T>().max(1) {
+        return Err(FmuError::InvalidArgument(format!(
+            "array `{name}` claims {n} elements, more than memory can hold"
+        )));
+    }
+    Ok(())
+}
+
+/// `*ptr = value` for an output pointer argument.
+///
+/// # Safety
+/// If `ptr` is not NULL it must be valid for writes of `T`.
+pub(crate) unsafe fn write_out<T>(
+    ptr: *mut T,
+    value: T,
+    name: &'static str,
+) -> Result<(), FmuError> {
+    if ptr.is_null() {
+        return Err(FmuError::NullArgument(name));
+    }
+    // SAFETY: non-NULL and writable per the contract.
+    unsafe { ptr.write(value) };
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exports::{fmi2DoStep, fmi2FreeInstance, fmi2GetReal, fmi2Instantiate};
+    use crate::fmi2_types::*;
+    use crate::instance::masks;
+    use std::ffi::{CStr, c_char};
+    use std::sync::Mutex;
+
+    static LOG: Mutex<Vec<(fmi2Status, String, String)>> = Mutex::new(Vec::new());
+
+    fn text(p: *const c_char) -> String {
+        // SAFETY: the FMU passes NUL-terminated strings.
+        unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
+    }
+
+    /// Fixed-arity receiver of the FMU's one call shape (format, one string); see
+    /// tests/support/mod.rs.
+    unsafe extern "C" fn record(
+        _env: fmi2ComponentEnvironment,
+        _name: fmi2String,
+        status: fmi2Status,
+        category: fmi2String,
+        format: fmi2String,
+        message: fmi2String,
+    ) {
+        assert_eq!(text(format), "%s");
+        LOG.lock()
+            .unwrap()
+            .push((status, text(category), text(message)));
+    }
+
+    #[test]
+    fn a_panic_becomes_fatal_with_a_message_and_only_free_instance_remains() {
+        // SAFETY: same argument registers for the call shape the FMU uses.
+        let logger = unsafe {
+            std::mem::transmute::<
+                unsafe extern "C" fn(
+                    fmi2ComponentEnvironment,
+                    fmi2String,
+                    fmi2Status,
+                    fmi2String,
+                    fmi2String,
+                    fmi2String,
+                ),
+                fmi2CallbackLogger,
+            >(record)
+        };
+        let callbacks = fmi2CallbackFunctions {
+            logger: Some(logger),
+            allocateMemory: None,
+            freeMemory: None,
+            stepFinished: None,
+            componentEnvironment: std::ptr::null_mut(),
+        };
+        let guid = crate::models::tables()[0].guid_c.clone();
+        // SAFETY: valid strings and callbacks.
+        let c = unsafe {
+            fmi2Instantiate(
+                c"p".as_ptr(),
+                fmi2CoSimulation,
+                guid.as_ptr(),
+                std::ptr::null(),
+                &callbacks,
+                fmi2False,
+                fmi2False,
+            )
+        };
+        assert!(!c.is_null());
+        let status = with_instance(c, "fmi2Probe", masks::SET_REAL, |_| {
+            panic!("100% broken");
+        });
+        assert_eq!(status, fmi2Status::fmi2Fatal);
+        let (status, category, message) = LOG.lock().unwrap().last().cloned().unwrap();
+        assert_eq!(
+            (status, category.as_str()),
+            (fmi2Status::fmi2Fatal, "logStatusFatal")
+        );
+        assert!(
+            message.starts_with("fmi2Probe: internal error (panic: 100% broken)"),
+            "{message}"
+        );
+        // SAFETY: live instance.
+        unsafe {
+            assert_eq!(fmi2DoStep(c, 0.0, 0.1, 0), fmi2Status::fmi2Error);
+            assert_eq!(
+                fmi2GetReal(c, [100u32].as_ptr(), 1, [0.0].as_mut_ptr()),
+                fmi2Status::fmi2Error
+            );
+            fmi2FreeInstance(c);
+        }
+        let log = LOG.lock().unwrap();
+        assert!(log[log.len() - 1].2.contains("stage Fatal"), "{log:?}");
+    }
+
+    #[test]
+    fn panics_without_an_instance_give_the_fallback() {
+        assert_eq!(guarded(7, || panic!("no instance")), 7);
+        assert_eq!(guarded(7, || 3), 3);
+    }
+}

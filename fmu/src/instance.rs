@@ -1,0 +1,263 @@
+//! An FMU instance (what an `fmi2Component` points to) and the FMI 2.0 Co-Simulation state
+//! machine: the stage it is in and, per function, the stages it may be called in (the
+//! pattern of modelica/Reference-FMUs).
+
+use crate::error::FmuError;
+use crate::fmi2_types::fmi2Status;
+use crate::log::{Category, LogFilter, Logger, category_of};
+use crate::simulation::Simulation;
+use std::collections::HashMap;
+
+/// The stages of a Co-Simulation instance. `Fatal` is entered after a caught panic: only
+/// fmi2FreeInstance is allowed then.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u16)]
+pub enum Stage {
+    Instantiated = 1 << 1,
+    InitializationMode = 1 << 2,
+    StepComplete = 1 << 3,
+    StepInProgress = 1 << 4,
+    StepFailed = 1 << 5,
+    StepCanceled = 1 << 6,
+    Terminated = 1 << 7,
+    Error = 1 << 8,
+    Fatal = 1 << 9,
+}
+
+impl Stage {
+    const ALL: [Stage; 9] = [
+        Stage::Instantiated,
+        Stage::InitializationMode,
+        Stage::StepComplete,
+        Stage::StepInProgress,
+        Stage::StepFailed,
+        Stage::StepCanceled,
+        Stage::Terminated,
+        Stage::Error,
+        Stage::Fatal,
+    ];
+
+    /// A small code for FMU state bytes.
+    pub fn code(self) -> u8 {
+        (self as u16).trailing_zeros() as u8
+    }
+
+    pub fn from_code(code: u8) -> Option<Stage> {
+        Stage::ALL.into_iter().find(|s| s.code() == code)
+    }
+}
+
+/// The stages a function may be called in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Mask {
+    bits: u16,
+    /// For the "Illegal call sequence" message.
+    pub names: &'static str,
+}
+
+impl Mask {
+    pub fn allows(self, stage: Stage) -> bool {
+        self.bits & stage as u16 != 0
+    }
+}
+
+macro_rules! mask {
+    ($first:ident $(| $rest:ident)*) => {
+        Mask {
+            bits: Stage::$first as u16 $(| Stage::$rest as u16)*,
+            names: concat!(stringify!($first) $(, ", ", stringify!($rest))*),
+        }
+    };
+}
+
+/// Per-function masks, as in Reference-FMUs' fmi2Functions.c (Co-Simulation subset).
+pub mod masks {
+    use super::{Mask, Stage};
+
+    pub const SET_DEBUG_LOGGING: Mask = mask!(
+        Instantiated
+            | InitializationMode
+            | StepComplete
+            | StepInProgress
+            | StepFailed
+            | StepCanceled
+            | Terminated
+            | Error
+    );
+    pub const FREE_INSTANCE: Mask = mask!(
+        Instantiated
+            | InitializationMode
+            | StepComplete
+            | StepFailed
+            | StepCanceled
+            | Terminated
+            | Error
+            | Fatal
+    );
+    pub const SETUP_EXPERIMENT: Mask = mask!(Instantiated);
+    pub const ENTER_INITIALIZATION_MODE: Mask = mask!(Instantiated);
+    pub const EXIT_INITIALIZATION_MODE: Mask = mask!(InitializationMode);
+    pub const TERMINATE: Mask = mask!(StepComplete | StepFailed);
+    pub const RESET: Mask = mask!(
+        Instantiated
+            | InitializationMode
+            | StepComplete
+            | StepFailed
+            | StepCanceled
+            | Terminated
+            | Error
+    );
+    pub const GET_VALUE: Mask =
+        mask!(InitializationMode | StepComplete | StepFailed | StepCanceled | Terminated | Error);
+    pub const SET_REAL: Mask = mask!(Instantiated | InitializationMode | StepComplete);
+    pub const SET_OTHER: Mask = mask!(Instantiated | InitializationMode | StepComplete);
+    pub const FMU_STATE: Mask = RESET;
+    pub const DIRECTIONAL_DERIVATIVE: Mask = GET_VALUE;
+    pub const SET_REAL_INPUT_DERIVATIVES: Mask =
+        mask!(Instantiated | InitializationMode | StepComplete);
+    pub const GET_REAL_OUTPUT_DERIVATIVES: Mask =
+        mask!(StepComplete | StepFailed | StepCanceled | Terminated | Error);
+    pub const DO_STEP: Mask = mask!(StepComplete);
+    pub const CANCEL_STEP: Mask = mask!(StepInProgress);
+    pub const GET_STATUS: Mask = mask!(StepComplete | StepInProgress | StepFailed | Terminated);
+    /// Model Exchange functions: never, this FMU is Co-Simulation only.
+    pub const MODEL_EXCHANGE: Mask = Mask {
+        bits: 0,
+        names: "a Model Exchange instance (this FMU is Co-Simulation only)",
+    };
+}
+
+/// A saved FMU state: the bytes of [`Simulation::save`]. Boxed; the box's address is the
+/// `fmi2FMUstate` the importer holds.
+#[derive(Debug)]
+pub struct SavedState {
+    pub bytes: Vec<u8>,
+}
+
+/// One FMU instance.
+pub struct Instance {
+    pub logger: Logger,
+    pub filter: LogFilter,
+    pub stage: Stage,
+    pub sim: Box<dyn Simulation>,
+    /// FMU states handed out and not yet freed, by address. A pointer that is not here is
+    /// refused instead of dereferenced (double free, foreign pointer).
+    states: HashMap<usize, Box<SavedState>>,
+}
+
+impl std::fmt::Debug for Instance {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Instance")
+            .field("name", &self.logger.instance_name())
+            .field("model", &self.sim.table().info.identifier)
+            .field("stage", &self.stage)
+            .field("states", &self.states.len())
+            .finish_non_exhaustive()
+    }
+}
+
+impl Instance {
+    pub fn new(logger: Logger, logging_on: bool, sim: Box<dyn Simulation>) -> Self {
+        Instance {
+            logger,
+            filter: LogFilter::at_instantiation(logging_on),
+            stage: Stage::Instantiated,
+            sim,
+            states: HashMap::new(),
+        }
+    }
+
+    /// Logs `message` if its category is on.
+    pub fn log(&self, status: fmi2Status, message: &str) {
+        let category = category_of(status);
+        if self.filter.enabled(category) {
+            self.logger.log(status, category, message);
+        }
+    }
+
+    /// Logs a lifecycle event.
+    pub fn event(&self, message: &str) {
+        if self.filter.enabled(Category::Events) {
+            self.logger
+                .log(fmi2Status::fmi2OK, Category::Events, message);
+        }
+    }
+
+    /// Logs why `function` failed and moves to the Error stage when the error says so.
+    pub fn report(&mut self, function: &str, error: &FmuError) -> fmi2Status {
+        if error.enters_error_stage() {
+            self.stage = Stage::Error;
+        }
+        let status = error.status();
+        self.log(status, &format!("{function}: {error}"));
+        status
+    }
+
+    /// Fails with "Illegal call sequence" unless `mask` allows the current stage.
+    pub fn check_stage(&self, mask: Mask) -> Result<(), FmuError> {
+        if mask.allows(self.stage) {
+            Ok(())
+        } else {
+            Err(FmuError::IllegalCall {
+                stage: self.stage,
+                allowed: mask.names,
+            })
+        }
+    }
+
+    /// Keeps `state` and returns its address for the importer.
+    pub fn adopt_state(&mut self, state: SavedState) -> *mut SavedState {
+        let mut boxed = Box::new(state);
+        let address: *mut SavedState = &mut *boxed;
+        self.states.insert(address as usize, boxed);
+        address
+    }
+
+    /// The live state at `address`.
+    pub fn state(&self, address: usize) -> Result<&SavedState, FmuError> {
+        self.states
+            .get(&address)
+            .map(|b| &**b)
+            .ok_or(FmuError::UnknownState)
+    }
+
+    /// The live state at `address`, to overwrite.
+    pub fn state_mut(&mut self, address: usize) -> Result<&mut SavedState, FmuError> {
+        self.states
+            .get_mut(&address)
+            .map(|b| &mut **b)
+            .ok_or(FmuError::UnknownState)
+    }
+
+    /// Frees the live state at `address`.
+    pub fn release_state(&mut self, address: usize) -> Result<(), FmuError> {
+        self.states
+            .remove(&address)
+            .map(drop)
+            .ok_or(FmuError::UnknownState)
+    }
+
+    /// How many FMU states are live.
+    pub fn live_states(&self) -> usize {
+        self.states.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stage_codes_round_trip_and_masks_name_their_stages() {
+        for stage in Stage::ALL {
+            assert_eq!(Stage::from_code(stage.code()), Some(stage));
+        }
+        assert_eq!(Stage::from_code(0), None);
+        assert_eq!(Stage::from_code(200), None);
+        assert!(masks::DO_STEP.allows(Stage::StepComplete));
+        assert!(!masks::DO_STEP.allows(Stage::Instantiated));
+        assert!(masks::FREE_INSTANCE.allows(Stage::Fatal));
+        assert!(!masks::RESET.allows(Stage::Fatal));
+        assert_eq!(masks::TERMINATE.names, "StepComplete, StepFailed");
+    }
+}

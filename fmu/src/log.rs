@@ -1,0 +1,165 @@
+//! Logging through the importer's variadic logger, by category.
+//!
+//! Categories (declared in the modelDescription's LogCategories): `logEvents` (lifecycle),
+//! `logStatusWarning`, `logStatusError` and `logStatusFatal`. fmi2Instantiate's loggingOn
+//! switches `logEvents` and `logStatusWarning`; errors and fatal errors are on from the start,
+//! because a status without its reason helps nobody. fmi2SetDebugLogging switches the
+//! categories it names (all of them when it names none), errors included.
+
+use crate::fmi2_types::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status};
+use std::ffi::{CStr, CString};
+
+/// A log category.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Category {
+    Events,
+    Warning,
+    Error,
+    Fatal,
+}
+
+/// Every category with its name and description, in modelDescription order.
+pub const CATEGORIES: [(Category, &CStr, &str); 4] = [
+    (
+        Category::Events,
+        c"logEvents",
+        "Lifecycle: instantiation, initialisation, reset, termination, FMU states",
+    ),
+    (
+        Category::Warning,
+        c"logStatusWarning",
+        "Calls that return fmi2Warning",
+    ),
+    (
+        Category::Error,
+        c"logStatusError",
+        "Calls that return fmi2Error, with the reason",
+    ),
+    (
+        Category::Fatal,
+        c"logStatusFatal",
+        "Calls that return fmi2Fatal (an internal failure caught at the C boundary)",
+    ),
+];
+
+impl Category {
+    fn index(self) -> usize {
+        self as usize
+    }
+
+    fn c_name(self) -> &'static CStr {
+        CATEGORIES[self.index()].1
+    }
+
+    /// The category called `name`.
+    pub fn from_name(name: &str) -> Option<Category> {
+        CATEGORIES
+            .iter()
+            .find(|(_, c, _)| c.to_str() == Ok(name))
+            .map(|(cat, _, _)| *cat)
+    }
+}
+
+/// Which categories reach the logger.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LogFilter([bool; 4]);
+
+impl LogFilter {
+    /// The filter after fmi2Instantiate(..., loggingOn).
+    pub fn at_instantiation(logging_on: bool) -> Self {
+        LogFilter([logging_on, logging_on, true, true])
+    }
+
+    pub fn set(&mut self, category: Category, on: bool) {
+        self.0[category.index()] = on;
+    }
+
+    pub fn set_all(&mut self, on: bool) {
+        self.0 = [on; 4];
+    }
+
+    pub fn enabled(&self, category: Category) -> bool {
+        self.0[category.index()]
+    }
+}
+
+/// The importer's logger with what it needs on every call.
+#[derive(Debug)]
+pub struct Logger {
+    callback: fmi2CallbackLogger,
+    environment: fmi2ComponentEnvironment,
+    instance_name: CString,
+}
+
+impl Logger {
+    pub fn new(
+        callback: fmi2CallbackLogger,
+        environment: fmi2ComponentEnvironment,
+        instance_name: CString,
+    ) -> Self {
+        Logger {
+            callback,
+            environment,
+            instance_name,
+        }
+    }
+
+    pub fn instance_name(&self) -> &CStr {
+        &self.instance_name
+    }
+
+    /// Sends `message`, always through a "%s" format so that a '%' in it is printed, never
+    /// interpreted.
+    pub fn log(&self, status: fmi2Status, category: Category, message: &str) {
+        // SAFETY: callback and environment came together from the importer's
+        // fmi2CallbackFunctions, which it keeps valid while the instance lives.
+        unsafe {
+            send(
+                self.callback,
+                self.environment,
+                &self.instance_name,
+                status,
+                category,
+                message,
+            );
+        }
+    }
+}
+
+/// Calls `callback` once with `message` (NUL bytes in it become U+FFFD).
+///
+/// # Safety
+/// `callback` must be the importer's logger and `environment` the componentEnvironment it
+/// gave with it.
+pub unsafe fn send(
+    callback: fmi2CallbackLogger,
+    environment: fmi2ComponentEnvironment,
+    instance_name: &CStr,
+    status: fmi2Status,
+    category: Category,
+    message: &str,
+) {
+    let text = CString::new(message.replace('\0', "\u{fffd}")).unwrap_or_default();
+    // SAFETY: the caller's contract for callback and environment; every string is
+    // NUL-terminated and outlives the call; the format consumes exactly one string argument.
+    unsafe {
+        callback(
+            environment,
+            instance_name.as_ptr(),
+            status,
+            category.c_name().as_ptr(),
+            c"%s".as_ptr(),
+            text.as_ptr(),
+        );
+    }
+}
+
+/// The category a status is logged under.
+pub fn category_of(status: fmi2Status) -> Category {
+    match status {
+        fmi2Status::fmi2OK | fmi2Status::fmi2Pending => Category::Events,
+        fmi2Status::fmi2Warning | fmi2Status::fmi2Discard => Category::Warning,
+        fmi2Status::fmi2Error => Category::Error,
+        fmi2Status::fmi2Fatal => Category::Fatal,
+    }
+}

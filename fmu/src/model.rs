@@ -1,0 +1,149 @@
+//! What the FMI layer needs from a model, and nothing about physics: the [`FmuModel`] trait,
+//! implemented for the quadrotor and the lander in [`crate::models`], and the [`ModelTable`]
+//! each model derives from its core variable table (lookup by value reference, GUID).
+
+use crate::guid;
+use flyloop_core::params::ValueKind;
+use flyloop_core::variables::{Causality, Variability, Variable};
+use flyloop_core::{ParamError, SnapshotError};
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+use std::ffi::CString;
+
+/// One communication step as the model sees it. Times are on the FMU's grid
+/// (`t0 + n·h`, never summed), so a model with its own fixed step can count whole steps.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepRequest {
+    /// Start time of the experiment (fmi2SetupExperiment), s.
+    pub start_time: f64,
+    /// Communication point at the end of this step, s.
+    pub end_time: f64,
+    /// Communication step size h, s.
+    pub step_size: f64,
+}
+
+/// Facts about a model that its variable table does not hold.
+#[derive(Debug)]
+pub struct ModelInfo {
+    /// modelIdentifier and modelName: the FMU is `<identifier>.fmu`, its binary
+    /// `binaries/linux64/<identifier>.so`.
+    pub identifier: &'static str,
+    pub description: &'static str,
+    /// DefaultExperiment: start, stop, step size (s).
+    pub default_experiment: (f64, f64, f64),
+    /// Inputs (by name) each output depends on directly, without a step in between
+    /// (ModelStructure/Outputs/Unknown/@dependencies). Outputs not listed depend on none.
+    pub direct_feedthrough: &'static [(&'static str, &'static [&'static str])],
+}
+
+/// A model behind the FMU: built from start values, read and written by value reference,
+/// advanced by communication steps, saved to and restored from bytes.
+pub trait FmuModel: Sized + 'static {
+    /// The start values that are not physical parameters (seed, initial pose...).
+    type Initial: Clone + Default + Serialize + DeserializeOwned;
+
+    /// The model's table, built once.
+    fn table() -> &'static ModelTable;
+
+    /// A fresh model from `initial`, with the physical parameters of `previous` (or the
+    /// defaults when there is none).
+    fn build(previous: Option<&Self>, initial: &Self::Initial) -> Result<Self, ParamError>;
+
+    /// Reads variable `vr` (value as `f64`; integers and booleans are exact).
+    fn get(&self, initial: &Self::Initial, vr: u32) -> Result<f64, ParamError>;
+
+    /// Writes variable `vr`, range-checked; nothing changes when it is refused.
+    fn set(&mut self, initial: &mut Self::Initial, vr: u32, value: f64) -> Result<(), ParamError>;
+
+    /// How many internal steps `step` would take (to refuse steps that would run for hours).
+    fn internal_steps(&self, step: &StepRequest) -> f64;
+
+    /// Advances to `step.end_time`.
+    fn advance(&mut self, step: &StepRequest);
+
+    /// Whether the state holds only finite numbers (false once the dynamics diverged).
+    fn is_finite(&self) -> bool;
+
+    /// The whole state as bytes (RNG and physics world included).
+    fn save(&self) -> Result<Vec<u8>, SnapshotError>;
+
+    /// A model from [`FmuModel::save`] bytes; foreign or damaged bytes are an error.
+    fn restore(bytes: &[u8]) -> Result<Self, SnapshotError>;
+}
+
+/// The variable table of a model with what the FMI layer looks up on every call.
+#[derive(Debug)]
+pub struct ModelTable {
+    pub info: &'static ModelInfo,
+    /// Every variable in value-reference order (the modelDescription's order).
+    pub variables: Vec<Variable>,
+    pub guid: String,
+    pub guid_c: CString,
+    /// Value reference → position in `variables`, sorted for binary search.
+    by_vr: Vec<(u32, usize)>,
+}
+
+impl ModelTable {
+    /// The table of `info` over the core's `variables`.
+    pub fn new(info: &'static ModelInfo, variables: Vec<Variable>) -> Self {
+        let guid = guid::of_interface(info.identifier, &variables);
+        let mut by_vr: Vec<(u32, usize)> = variables
+            .iter()
+            .enumerate()
+            .map(|(i, v)| (v.value_reference, i))
+            .collect();
+        by_vr.sort_unstable();
+        // A GUID is hex digits, dashes and braces: it never holds a NUL.
+        let guid_c = CString::new(guid.clone()).unwrap_or_default();
+        ModelTable {
+            info,
+            variables,
+            guid,
+            guid_c,
+            by_vr,
+        }
+    }
+
+    /// The variable with value reference `vr`.
+    pub fn variable(&self, vr: u32) -> Option<&Variable> {
+        let at = self.by_vr.binary_search_by_key(&vr, |&(v, _)| v).ok()?;
+        self.variables.get(self.by_vr[at].1)
+    }
+
+    /// The variable named `name`.
+    pub fn by_name(&self, name: &str) -> Option<&Variable> {
+        self.variables.iter().find(|v| v.name == name)
+    }
+
+    /// The inputs output `output` depends on directly (see [`ModelInfo::direct_feedthrough`]).
+    pub fn direct_feedthrough(&self, output: &str) -> &'static [&'static str] {
+        self.info
+            .direct_feedthrough
+            .iter()
+            .find(|(name, _)| *name == output)
+            .map_or(&[], |(_, inputs)| inputs)
+    }
+
+    /// Input value references, in order.
+    pub fn inputs(&self) -> impl Iterator<Item = u32> + '_ {
+        self.variables
+            .iter()
+            .filter(|v| v.causality == Causality::Input)
+            .map(|v| v.value_reference)
+    }
+}
+
+/// The FMI type name of a value kind (for messages and the modelDescription).
+pub fn type_name(kind: ValueKind) -> &'static str {
+    match kind {
+        ValueKind::Real => "Real",
+        ValueKind::Integer => "Integer",
+        ValueKind::Boolean => "Boolean",
+    }
+}
+
+/// Whether a variable of `variability` and `causality` may be set once initialised.
+pub fn settable_after_initialisation(causality: Causality, variability: Variability) -> bool {
+    causality == Causality::Input
+        || (causality == Causality::Parameter && variability == Variability::Tunable)
+}

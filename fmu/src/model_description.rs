@@ -1,0 +1,313 @@
+//! Writes a model's modelDescription.xml (FMI 2.0 Co-Simulation) from its table: every
+//! variable with unit, description, start and range; unit definitions for every unit used;
+//! log categories; the default experiment; the model structure. Deterministic output (no
+//! date), so the checked-in copies under modelDescription/ can be compared byte for byte.
+
+use crate::log::CATEGORIES;
+use crate::model::{ModelTable, type_name};
+use crate::units::{self, BASE_UNITS};
+use flyloop_core::params::ValueKind;
+use flyloop_core::variables::{Causality, Variability, Variable};
+use std::collections::BTreeSet;
+use std::fmt::Write;
+
+/// A unit string the generator has no base-unit entry for (add it to `units.rs`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UnknownUnit {
+    pub unit: String,
+    pub variable: String,
+}
+
+impl std::fmt::Display for UnknownUnit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "unit `{}` of variable `{}` has no entry in fmu/src/units.rs",
+            self.unit, self.variable
+        )
+    }
+}
+
+impl std::error::Error for UnknownUnit {}
+
+/// Escapes text for an XML attribute value.
+fn escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for ch in text.chars() {
+        match ch {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// An xs:double: the shortest text that reads back to the same f64.
+fn real(value: f64) -> String {
+    if value.is_nan() {
+        "NaN".to_string()
+    } else if value.is_infinite() {
+        if value > 0.0 { "INF" } else { "-INF" }.to_string()
+    } else {
+        format!("{value:?}")
+    }
+}
+
+/// A value of `kind` as its XML attribute text.
+fn value_text(kind: ValueKind, value: f64) -> String {
+    match kind {
+        ValueKind::Real => real(value),
+        ValueKind::Integer => format!("{}", value as i64),
+        ValueKind::Boolean => (value != 0.0).to_string(),
+    }
+}
+
+fn causality(c: Causality) -> &'static str {
+    match c {
+        Causality::Parameter => "parameter",
+        Causality::Input => "input",
+        Causality::Output => "output",
+    }
+}
+
+fn variability(v: Variability) -> &'static str {
+    match v {
+        Variability::Fixed => "fixed",
+        Variability::Tunable => "tunable",
+        Variability::Continuous => "continuous",
+        Variability::Discrete => "discrete",
+    }
+}
+
+/// The units of Real variables, sorted.
+fn units_used(variables: &[Variable]) -> BTreeSet<&'static str> {
+    variables
+        .iter()
+        .filter(|v| v.kind == ValueKind::Real && !v.unit.is_empty())
+        .map(|v| v.unit)
+        .collect()
+}
+
+fn unit_definitions(out: &mut String, variables: &[Variable]) -> Result<(), UnknownUnit> {
+    out.push_str("  <UnitDefinitions>\n");
+    for unit in units_used(variables) {
+        let exponents = units::exponents(unit).ok_or_else(|| UnknownUnit {
+            unit: unit.to_string(),
+            variable: variables
+                .iter()
+                .find(|v| v.unit == unit)
+                .map_or_else(String::new, |v| v.name.to_string()),
+        })?;
+        match exponents {
+            Some(exponents) => {
+                let _ = write!(out, "    <Unit name=\"{}\">\n      <BaseUnit", escape(unit));
+                for (name, e) in BASE_UNITS.iter().zip(exponents) {
+                    if e != 0 {
+                        let _ = write!(out, " {name}=\"{e}\"");
+                    }
+                }
+                out.push_str("/>\n    </Unit>\n");
+            }
+            None => {
+                let _ = writeln!(out, "    <Unit name=\"{}\"/>", escape(unit));
+            }
+        }
+    }
+    out.push_str("  </UnitDefinitions>\n");
+    Ok(())
+}
+
+fn scalar_variable(out: &mut String, v: &Variable) {
+    let _ = writeln!(
+        out,
+        "    <ScalarVariable name=\"{}\" valueReference=\"{}\" description=\"{}\" \
+         causality=\"{}\" variability=\"{}\">",
+        escape(v.name),
+        v.value_reference,
+        escape(v.description),
+        causality(v.causality),
+        variability(v.variability)
+    );
+    let _ = write!(out, "      <{}", type_name(v.kind));
+    // FMI 2.0 gives units to Real variables only.
+    if v.kind == ValueKind::Real && !v.unit.is_empty() {
+        let _ = write!(out, " unit=\"{}\"", escape(v.unit));
+    }
+    if v.kind != ValueKind::Boolean {
+        for (name, bound) in [("min", v.min), ("max", v.max)] {
+            if let Some(b) = bound {
+                let _ = write!(out, " {name}=\"{}\"", value_text(v.kind, b));
+            }
+        }
+    }
+    if let Some(start) = v.start {
+        let _ = write!(out, " start=\"{}\"", value_text(v.kind, start));
+    }
+    out.push_str("/>\n    </ScalarVariable>\n");
+}
+
+/// 1-based positions (ModelVariables order) of `names`.
+fn indices(table: &ModelTable, names: &[&str]) -> String {
+    names
+        .iter()
+        .filter_map(|n| table.variables.iter().position(|v| v.name == *n))
+        .map(|i| (i + 1).to_string())
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+fn model_structure(out: &mut String, table: &ModelTable) {
+    let outputs: Vec<(usize, &Variable)> = table
+        .variables
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.causality == Causality::Output)
+        .collect();
+    out.push_str("  <ModelStructure>\n    <Outputs>\n");
+    for &(i, v) in &outputs {
+        let dependencies = indices(table, table.direct_feedthrough(v.name));
+        let _ = writeln!(
+            out,
+            "      <Unknown index=\"{}\" dependencies=\"{dependencies}\"/>",
+            i + 1
+        );
+    }
+    // Every output is calculated during initialisation, from any of the start values.
+    out.push_str("    </Outputs>\n    <InitialUnknowns>\n");
+    for &(i, _) in &outputs {
+        let _ = writeln!(out, "      <Unknown index=\"{}\"/>", i + 1);
+    }
+    out.push_str("    </InitialUnknowns>\n  </ModelStructure>\n");
+}
+
+/// The modelDescription.xml of `table`'s model.
+pub fn generate(table: &ModelTable) -> Result<String, UnknownUnit> {
+    let info = table.info;
+    let mut out = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    let _ = writeln!(
+        out,
+        "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{}\" guid=\"{}\" \
+         description=\"{}\" version=\"{}\" generationTool=\"flyloop\" \
+         variableNamingConvention=\"flat\" numberOfEventIndicators=\"0\">",
+        info.identifier,
+        table.guid,
+        escape(info.description),
+        env!("CARGO_PKG_VERSION")
+    );
+    let _ = writeln!(
+        out,
+        "  <CoSimulation modelIdentifier=\"{}\" needsExecutionTool=\"false\" \
+         canHandleVariableCommunicationStepSize=\"true\" canInterpolateInputs=\"false\" \
+         maxOutputDerivativeOrder=\"0\" canRunAsynchronuously=\"false\" \
+         canBeInstantiatedOnlyOncePerProcess=\"false\" \
+         canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" \
+         canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"/>",
+        info.identifier
+    );
+    unit_definitions(&mut out, &table.variables)?;
+    out.push_str("  <LogCategories>\n");
+    for (_, name, description) in CATEGORIES {
+        let _ = writeln!(
+            out,
+            "    <Category name=\"{}\" description=\"{}\"/>",
+            name.to_string_lossy(),
+            escape(description)
+        );
+    }
+    out.push_str("  </LogCategories>\n");
+    let (start, stop, step) = info.default_experiment;
+    let _ = writeln!(
+        out,
+        "  <DefaultExperiment startTime=\"{}\" stopTime=\"{}\" stepSize=\"{}\"/>",
+        real(start),
+        real(stop),
+        real(step)
+    );
+    out.push_str("  <ModelVariables>\n");
+    for (i, v) in table.variables.iter().enumerate() {
+        let _ = writeln!(out, "    <!-- Index {} -->", i + 1);
+        scalar_variable(&mut out, v);
+    }
+    out.push_str("  </ModelVariables>\n");
+    model_structure(&mut out, table);
+    out.push_str("</fmiModelDescription>\n");
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::tables;
+
+    #[test]
+    fn every_unit_is_known_and_every_feedthrough_name_is_an_input_of_an_output() {
+        for table in tables() {
+            for unit in units_used(&table.variables) {
+                assert!(units::exponents(unit).is_some(), "unit {unit} missing");
+            }
+            for (output, inputs) in table.info.direct_feedthrough {
+                let o = table.by_name(output).unwrap();
+                assert_eq!(o.causality, Causality::Output, "{output}");
+                for input in *inputs {
+                    let i = table.by_name(input).unwrap();
+                    assert_eq!(i.causality, Causality::Input, "{input}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn numbers_read_back_exactly_and_text_is_escaped() {
+        for x in [
+            0.1,
+            1e-7,
+            1e16,
+            -2.5,
+            0.0,
+            2147483647.0,
+            std::f64::consts::PI,
+        ] {
+            assert_eq!(real(x).parse::<f64>().unwrap(), x);
+        }
+        assert_eq!(real(f64::INFINITY), "INF");
+        assert_eq!(value_text(ValueKind::Integer, 7.0), "7");
+        assert_eq!(value_text(ValueKind::Boolean, 1.0), "true");
+        assert_eq!(escape("a<b & \"c\""), "a&lt;b &amp; &quot;c&quot;");
+    }
+
+    #[test]
+    fn structure_lists_every_output_with_its_direct_inputs() {
+        let table = crate::models::tables()[0];
+        let xml = generate(table).unwrap();
+        let outputs = table
+            .variables
+            .iter()
+            .filter(|v| v.causality == Causality::Output)
+            .count();
+        let structure = &xml[xml.find("<ModelStructure>").unwrap()..];
+        assert_eq!(structure.matches("<Unknown ").count(), 2 * outputs);
+        // wind_x (index after the 7 inputs and 23 outputs before it) depends on wind_input_x.
+        let wind_x = table
+            .variables
+            .iter()
+            .position(|v| v.name == "wind_x")
+            .unwrap()
+            + 1;
+        let wind_input_x = table
+            .variables
+            .iter()
+            .position(|v| v.name == "wind_input_x")
+            .unwrap()
+            + 1;
+        assert!(
+            structure.contains(&format!(
+                "<Unknown index=\"{wind_x}\" dependencies=\"{wind_input_x}\"/>"
+            )),
+            "{structure}"
+        );
+    }
+}

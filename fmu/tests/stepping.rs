@@ -1,0 +1,286 @@
+//! fmi2DoStep: the communication-point check, h <= 0, the stop time, the time grid
+//! t0 + n·h, divergence; and that the FMU's outputs are exactly the core's state after the
+//! same steps (bit for bit), for any communication step size.
+// Test code: a failed unwrap is a failed test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+mod support;
+
+use flyloop_core::lander2d::{Lander2d, Lander2dInitial, Lander2dParams};
+use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial, QuadrotorParams};
+use flyloop_core::variables::Causality;
+use flyloop_fmu::fmi2_types::fmi2Status::{fmi2Error, fmi2OK};
+use support::{Fmu, Model};
+
+fn output_vrs(model: Model) -> Vec<u32> {
+    model
+        .table()
+        .variables
+        .iter()
+        .filter(|v| v.causality == Causality::Output)
+        .map(|v| v.value_reference)
+        .collect()
+}
+
+#[test]
+fn a_mismatched_communication_point_is_refused_and_changes_nothing() {
+    let fmu = Fmu::started(Model::Quadrotor, 0.0, &[("initial_motor", 0.6)]);
+    assert_eq!(fmu.do_step(0.0, 0.1), fmi2OK);
+    let before = fmu.output_bits();
+    assert_eq!(fmu.do_step(0.2, 0.1), fmi2Error);
+    let message = fmu.last_message();
+    assert!(
+        message.contains("currentCommunicationPoint 0.2 does not match the instance's time 0.1"),
+        "{message}"
+    );
+    assert_eq!(
+        fmu.do_step(0.0, 0.1),
+        fmi2Error,
+        "no going back without an FMU state"
+    );
+    assert_eq!(fmu.output_bits(), before);
+    assert_eq!(fmu.time(), 0.1);
+    // Within the tolerance (an importer that sums its steps) is accepted.
+    assert_eq!(fmu.do_step(0.1 + 1e-12, 0.1), fmi2OK);
+}
+
+#[test]
+fn step_sizes_that_are_not_positive_finite_numbers_are_refused() {
+    let fmu = Fmu::started(Model::Lander2D, 0.0, &[]);
+    for h in [0.0, -0.01, f64::NAN, f64::INFINITY, -0.0] {
+        assert_eq!(fmu.do_step(0.0, h), fmi2Error, "h = {h}");
+        assert!(
+            fmu.last_message()
+                .contains("communicationStepSize must be a positive finite number")
+        );
+    }
+    assert_eq!(fmu.do_step(f64::NAN, 0.1), fmi2Error);
+    assert_eq!(fmu.time(), 0.0);
+}
+
+#[test]
+fn steps_may_reach_the_stop_time_but_not_pass_it() {
+    let fmu = Fmu::new(Model::Quadrotor);
+    assert_eq!(fmu.setup(1.0, Some(1.3)), fmi2OK);
+    assert_eq!(fmu.enter_init(), fmi2OK);
+    assert_eq!(fmu.exit_init(), fmi2OK);
+    assert_eq!(fmu.do_step(1.0, 0.25), fmi2OK);
+    assert_eq!(fmu.do_step(1.25, 0.1), fmi2Error);
+    assert!(
+        fmu.last_message().contains("after the stop time 1.3"),
+        "{}",
+        fmu.last_message()
+    );
+    for n in 0..5 {
+        assert_eq!(fmu.do_step(1.25 + f64::from(n) * 0.01, 0.01), fmi2OK);
+    }
+    assert_eq!(fmu.do_step(1.3, 0.01), fmi2Error);
+    let bad = Fmu::new(Model::Quadrotor);
+    assert_eq!(bad.setup(2.0, Some(1.0)), fmi2Error);
+    assert!(
+        bad.last_message()
+            .contains("stopTime 1 must not be before startTime 2")
+    );
+}
+
+#[test]
+fn time_is_t0_plus_n_h_never_a_running_sum() {
+    let fmu = Fmu::started(Model::Quadrotor, 0.5, &[]);
+    let mut summed = 0.5;
+    for n in 0..1000u32 {
+        // The importer's own time, computed the same way.
+        assert_eq!(fmu.do_step(0.5 + f64::from(n) * 0.001, 0.001), fmi2OK);
+        summed += 0.001;
+    }
+    assert_eq!(fmu.time(), 0.5 + 1000.0 * 0.001);
+    assert_ne!(summed, fmu.time(), "a running sum would have drifted");
+    // An importer that sums is still within the tolerance.
+    assert_eq!(fmu.do_step(summed, 0.001), fmi2OK);
+}
+
+#[test]
+fn step_sizes_computed_as_differences_of_grid_times_give_the_clean_grids_outputs() {
+    // fmpy and most importers pass h = t(n+1) - t(n), which jitters by ulps around 0.01;
+    // jitter above 0.01 would double the RK4 substeps and change the trajectory.
+    let clean = Fmu::started(
+        Model::Quadrotor,
+        0.0,
+        &[("seed", 2.0), ("initial_motor", 0.5)],
+    );
+    let jittered = Fmu::started(
+        Model::Quadrotor,
+        0.0,
+        &[("seed", 2.0), ("initial_motor", 0.5)],
+    );
+    let mut jitter_seen = false;
+    for n in 0..300u32 {
+        let (t, next) = (f64::from(n) * 0.01, f64::from(n + 1) * 0.01);
+        jitter_seen |= next - t > 0.01;
+        assert_eq!(clean.do_step(t, 0.01), fmi2OK);
+        assert_eq!(jittered.do_step(t, next - t), fmi2OK);
+    }
+    assert!(
+        jitter_seen,
+        "the test needs steps longer than 0.01 by an ulp"
+    );
+    assert_eq!(jittered.output_bits(), clean.output_bits());
+    assert_eq!(jittered.time(), 300.0 * 0.01);
+}
+
+#[test]
+fn quadrotor_outputs_are_the_cores_after_the_same_steps_bit_for_bit() {
+    let seed = 5;
+    let fmu = Fmu::started(
+        Model::Quadrotor,
+        0.0,
+        &[("seed", f64::from(seed)), ("initial_motor", 0.5)],
+    );
+    let initial = QuadrotorInitial {
+        seed,
+        initial_motor: 0.5,
+        ..Default::default()
+    };
+    let mut core = Quadrotor::from_initial(QuadrotorParams::default(), &initial).unwrap();
+    let vrs = output_vrs(Model::Quadrotor);
+    let inputs = [
+        "motor_command_0",
+        "motor_command_1",
+        "motor_command_2",
+        "motor_command_3",
+    ];
+    let schedule = [
+        (0.01, 0.5),
+        (0.013, 0.52),
+        (0.25, 0.55),
+        (0.01, 0.4),
+        (0.001, 0.6),
+        (0.5, 0.49),
+    ];
+    let mut t = 0.0;
+    for (round, &(h, command)) in schedule.iter().cycle().take(60).enumerate() {
+        let skew = if round % 3 == 0 { 0.01 } else { 0.0 };
+        let commands = [command + skew, command, command - skew, command];
+        for (name, c) in inputs.iter().zip(commands) {
+            assert_eq!(fmu.set(name, c), fmi2OK);
+        }
+        core.set_command(commands).unwrap();
+        assert_eq!(fmu.do_step(t, h), fmi2OK);
+        core.step(h);
+        t = fmu.time();
+        let (status, values) = fmu.get_reals(&vrs);
+        assert_eq!(status, fmi2OK);
+        for (&vr, value) in vrs.iter().zip(values) {
+            let expected = flyloop_core::quadrotor::variables::get(&core, &initial, vr).unwrap();
+            assert_eq!(value.to_bits(), expected.to_bits(), "vr {vr} at t = {t}");
+        }
+    }
+    assert!(fmu.get("z") != 1.5, "the vehicle moved");
+}
+
+#[test]
+fn lander_steps_every_whole_period_on_its_grid_and_matches_the_core() {
+    let seed = 11;
+    // Start at 1.0: the grid is 1.0 + k·dt. Communication steps of 0.03 with dt = 0.02
+    // reach periods 1, 3, 4, 6, 7, 9, ...
+    let fmu = Fmu::started(Model::Lander2D, 1.0, &[("seed", f64::from(seed))]);
+    let initial = Lander2dInitial {
+        seed,
+        ..Default::default()
+    };
+    let mut core = Lander2d::from_initial(Lander2dParams::default(), &initial).unwrap();
+    for n in 0..40u32 {
+        let command = [0.2 * f64::from(n % 5) - 0.4, 0.1];
+        assert_eq!(fmu.set("motor_command_left", command[0]), fmi2OK);
+        assert_eq!(fmu.set("motor_command_right", command[1]), fmi2OK);
+        core.set_command(command).unwrap();
+        assert_eq!(fmu.do_step(1.0 + f64::from(n) * 0.03, 0.03), fmi2OK);
+        let periods = ((f64::from(n + 1) * 0.03) / 0.02 + 1e-6).floor() as u64;
+        while core.steps() < periods {
+            core.step();
+        }
+        // Every output, Boolean flags included, through the function of its type.
+        for variable in Model::Lander2D.table().variables.iter() {
+            if variable.causality != Causality::Output {
+                continue;
+            }
+            let vr = variable.value_reference;
+            let expected = flyloop_core::lander2d::variables::get(&core, &initial, vr).unwrap();
+            let value = fmu.get(variable.name);
+            assert_eq!(
+                value.to_bits(),
+                expected.to_bits(),
+                "{} after step {n}",
+                variable.name
+            );
+        }
+    }
+    assert_eq!(core.steps(), 60);
+}
+
+#[test]
+fn a_lander_step_shorter_than_its_period_waits_for_the_grid() {
+    let fmu = Fmu::started(Model::Lander2D, 0.0, &[]);
+    let start = fmu.output_bits();
+    assert_eq!(fmu.do_step(0.0, 0.015), fmi2OK);
+    assert_eq!(fmu.output_bits(), start, "no whole period yet");
+    assert_eq!(fmu.do_step(0.015, 0.005), fmi2OK);
+    assert_ne!(
+        fmu.output_bits(),
+        start,
+        "t = 0.02 completes the first period"
+    );
+}
+
+#[test]
+fn a_step_that_would_run_for_hours_is_refused() {
+    let fmu = Fmu::started(Model::Quadrotor, 0.0, &[]);
+    assert_eq!(fmu.do_step(0.0, 1e7), fmi2Error);
+    assert!(
+        fmu.last_message().contains("internal steps (limit"),
+        "{}",
+        fmu.last_message()
+    );
+    assert_eq!(fmu.do_step(0.0, 1.0), fmi2OK);
+}
+
+#[test]
+fn a_diverging_model_stops_in_the_error_stage_and_a_saved_state_brings_it_back() {
+    // RK4 with a step 10^4 times the motor time constant is unstable: the motor states grow
+    // without bound until they are no longer finite.
+    let fmu = Fmu::new(Model::Quadrotor);
+    for (name, value) in [
+        ("motor_time_constant", 1e-4),
+        ("max_substep", 1.0),
+        ("wind_enabled", 0.0),
+    ] {
+        assert_eq!(fmu.set(name, value), fmi2OK);
+    }
+    assert_eq!(fmu.enter_init(), fmi2OK);
+    assert_eq!(fmu.exit_init(), fmi2OK);
+    assert_eq!(fmu.set("motor_command_0", 1.0), fmi2OK);
+    let state = fmu.get_state();
+    let mut n = 0;
+    while fmu.do_step(f64::from(n), 1.0) == fmi2OK {
+        n += 1;
+        assert!(n < 100, "never diverged");
+    }
+    let message = fmu.last_message();
+    assert!(
+        message.contains("became non-finite") && message.contains("Error stage"),
+        "{message}"
+    );
+    assert_eq!(fmu.do_step(f64::from(n + 1), 1.0), fmi2Error);
+    assert!(
+        fmu.last_message()
+            .contains("Illegal call sequence: the instance is in stage Error")
+    );
+    let (status, _) = fmu.get_reals(&[fmu.vr("motor_state_0")]);
+    assert_eq!(status, fmi2OK, "outputs stay readable for diagnosis");
+    assert_eq!(fmu.set_state(state), fmi2OK);
+    assert_eq!(fmu.time(), 0.0);
+    assert_eq!(
+        fmu.do_step(0.0, 1.0),
+        fmi2OK,
+        "stepping again from the saved state"
+    );
+}
