@@ -15,10 +15,12 @@ HOVER = (9.81 / 40) ** 0.5  # motor state that carries 1 kg with k = 10 N per mo
 
 
 def main() -> None:
-    motors = [f"motor_command_{i}" for i in range(4)]
+    # Motor commands, and no external wind (the model's own wind still blows).
+    names = [f"motor_command_{i}" for i in range(4)] + [f"wind_input_{a}" for a in "xyz"]
     rows = [(0, *[HOVER] * 4), (2, *[HOVER] * 4), (2, *[HOVER + 0.03] * 4)]
     rows.append((6, *[HOVER + 0.03] * 4))
-    u = np.array(rows, dtype=[("time", float)] + [(m, float) for m in motors])
+    rows = [(*row, 0.0, 0.0, 0.0) for row in rows]
+    u = np.array(rows, dtype=[("time", float)] + [(n, float) for n in names])
     result = simulate_fmu(
         str(ROOT / "dist" / "fmu" / "Quadrotor.fmu"),
         stop_time=6,

@@ -29,7 +29,12 @@ say "Python venv .venv (test peers: fmpy, libcosimpy, pymavlink, MAVProxy, pytes
 say "Rust build (release)"
 cargo build --release --workspace --all-targets
 
+say "FMUs → dist/fmu/"
+bash scripts/pack-fmus.sh
+
 if [[ $demo -eq 1 ]]; then
-    say "Demo: the Hover task flown by a PD controller in the Rust core"
+    say "Demo 1: the Hover task flown by a PD controller in the Rust core"
     cargo run --release -q -p flyloop-core --example hover
+    say "Demo 2: Quadrotor.fmu simulated with fmpy (plot)"
+    .venv/bin/python examples/fmu_fmpy_demo.py
 fi
