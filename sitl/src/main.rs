@@ -1,3 +1,170 @@
-//! MAVLink SITL front end of flyloop-core (work in progress, issue 5).
+//! The `flyloop-sitl` binary: options, sockets, then the server loop until SIGINT / SIGTERM.
 
-fn main() {}
+use clap::Parser;
+use flyloop_core::ParamError;
+use flyloop_sitl::cli::{Args, GcsTarget};
+use flyloop_sitl::config::{self, ConfigError};
+use flyloop_sitl::model::{TaskConfig, TaskInstance, TaskKind};
+use flyloop_sitl::server::{self, GcsLink};
+use flyloop_sitl::sim::{Sim, SimOptions};
+use flyloop_sitl::{param_table, task_frame};
+use std::io::IsTerminal;
+use std::net::SocketAddr;
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Why the SITL could not start (printed as one line, exit code 1).
+#[derive(Debug, thiserror::Error)]
+enum StartError {
+    #[error("{0}")]
+    Options(String),
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    #[error("{0}")]
+    Parameters(#[from] ParamError),
+    #[error("cannot bind the {link} socket to {addr}: {source}")]
+    Bind {
+        link: &'static str,
+        addr: SocketAddr,
+        source: std::io::Error,
+    },
+    #[error("cannot start the runtime: {0}")]
+    Runtime(#[from] std::io::Error),
+}
+
+fn bind(link: &'static str, addr: SocketAddr) -> Result<std::net::UdpSocket, StartError> {
+    let socket = std::net::UdpSocket::bind(addr).map_err(|source| StartError::Bind {
+        link,
+        addr,
+        source,
+    })?;
+    socket
+        .set_nonblocking(true)
+        .map_err(|source| StartError::Bind { link, addr, source })?;
+    Ok(socket)
+}
+
+fn describe_frame(task: TaskKind, config: &TaskConfig) -> Result<String, ParamError> {
+    let t = TaskInstance::build(task, config)?;
+    let n = t.observation_size();
+    let mut out = format!(
+        "task frame of `{}` (DEBUG_FLOAT_ARRAY name \"{}\", {} values over {} array(s) of {})\n",
+        task.frame_name(),
+        task.frame_name(),
+        task_frame::HEADER_LEN
+            + n
+            + task_frame::info_layout(&t)
+                .iter()
+                .map(|e| e.2)
+                .sum::<usize>(),
+        1 + (task_frame::HEADER_LEN
+            + n
+            + task_frame::info_layout(&t)
+                .iter()
+                .map(|e| e.2)
+                .sum::<usize>()
+            - 1)
+            / task_frame::ARRAY_LEN,
+        task_frame::ARRAY_LEN
+    );
+    out.push_str("0 reward\n1 terminated\n2 truncated\n3 step\n4 n_obs\n5 n_info\n");
+    out.push_str(&format!(
+        "{}..{} observation ({n} values)\n",
+        task_frame::HEADER_LEN,
+        task_frame::HEADER_LEN + n
+    ));
+    for (name, at, count) in task_frame::info_layout(&t) {
+        if count == 1 {
+            out.push_str(&format!("{at} info.{name}\n"));
+        } else {
+            out.push_str(&format!(
+                "{at}..{} info.{name} ({count} values)\n",
+                at + count
+            ));
+        }
+    }
+    Ok(out)
+}
+
+fn start(args: Args) -> Result<(), StartError> {
+    let task = args.task().map_err(StartError::Options)?;
+    let config = match &args.config {
+        Some(path) => config::load(task, path)?,
+        None => TaskConfig::default(),
+    };
+    if args.list_params {
+        print!("{}", param_table::listing(task, &config));
+        return Ok(());
+    }
+    if args.describe_frame {
+        print!("{}", describe_frame(task, &config)?);
+        return Ok(());
+    }
+    let mut options = SimOptions::new(task);
+    options.vehicles = args.vehicles;
+    options.seed = args.seed;
+    options.config = config;
+    options.mode = args.mode();
+    options.home = args.home;
+    options.state_in_reply = !args.no_state_reply;
+    options.failsafe_timeout = args.failsafe_timeout();
+    options.state_rate_hz = args.state_rate;
+    let sim = Sim::new(options, Instant::now())?;
+
+    let controller = bind("controller", args.listen)?;
+    let gcs = match args.gcs {
+        GcsTarget::Off => None,
+        GcsTarget::At(target) => Some((bind("ground-station", args.gcs_bind)?, target)),
+    };
+    let listen = controller.local_addr()?;
+    let gcs_text = match &gcs {
+        Some((socket, target)) => format!("{}->{}", socket.local_addr()?, target),
+        None => "off".to_string(),
+    };
+    let ready = format!(
+        "flyloop-sitl ready listen={listen} gcs={gcs_text} mode={} model={} task={} vehicles={} seed={}",
+        args.mode().name(),
+        args.model().name(),
+        task.frame_name(),
+        args.vehicles,
+        args.seed
+    );
+
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()?;
+    let stats = runtime.block_on(async move {
+        let shutdown = server::Shutdown::install()?;
+        let controller = tokio::net::UdpSocket::from_std(controller)?;
+        let gcs = match gcs {
+            Some((socket, target)) => Some(GcsLink {
+                socket: tokio::net::UdpSocket::from_std(socket)?,
+                target,
+            }),
+            None => None,
+        };
+        // Announced only once the sockets and the signal handlers are in place.
+        println!("{ready}");
+        tracing::info!(%listen, gcs = %gcs_text, "flyloop-sitl running");
+        server::run(sim, controller, gcs, shutdown).await
+    })?;
+    tracing::info!("stopped: {stats}");
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let args = Args::parse();
+    tracing_subscriber::fmt()
+        .with_writer(std::io::stderr)
+        .with_max_level(args.log_level)
+        .with_target(false)
+        .with_ansi(std::io::stderr().is_terminal())
+        .init();
+    match start(args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("flyloop-sitl: error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

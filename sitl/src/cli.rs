@@ -1,0 +1,236 @@
+//! Command-line options.
+
+use crate::kinematics::Home;
+use crate::model::{ModelKind, TaskKind};
+use crate::sim::Mode;
+use clap::Parser;
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::time::Duration;
+
+/// MAVLink 2 SITL of flyloop: flies the core's quadrotor or 2D lander for any MAVLink peer.
+///
+/// On start it prints one line on stdout:
+/// `flyloop-sitl ready listen=<addr> gcs=<local>-><target>|off mode=<mode> model=<model>
+/// task=<task> vehicles=<n> seed=<seed>`; logs go to stderr. The protocol is described in
+/// docs/protocol.md.
+#[derive(Debug, Parser)]
+#[command(name = "flyloop-sitl", version)]
+pub struct Args {
+    /// Vehicle model [default: the task's model, else quadrotor].
+    #[arg(long, value_enum)]
+    pub model: Option<ModelKind>,
+
+    /// Task flown on the model [default: hover for quadrotor, landing for lander2d].
+    #[arg(long, value_enum)]
+    pub task: Option<TaskKind>,
+
+    /// Controller link: UDP address to listen on (port 0 picks a free port; see the first
+    /// stdout line).
+    #[arg(long, default_value = "127.0.0.1:14560")]
+    pub listen: SocketAddr,
+
+    /// Ground-station link: UDP address telemetry is sent to, or `off`.
+    #[arg(long, default_value = "127.0.0.1:14550", value_parser = parse_gcs)]
+    pub gcs: GcsTarget,
+
+    /// Local address of the ground-station socket.
+    #[arg(long, default_value = "0.0.0.0:0")]
+    pub gcs_bind: SocketAddr,
+
+    /// Pacing: `lockstep` (one step per command, no wall clock) or `realtime`.
+    #[arg(long, value_enum, default_value = "lockstep")]
+    pub mode: Mode,
+
+    /// Shorthand for `--mode realtime`.
+    #[arg(long, conflicts_with_all = ["mode", "lockstep"])]
+    pub realtime: bool,
+
+    /// Shorthand for `--mode lockstep`.
+    #[arg(long, conflicts_with = "mode")]
+    pub lockstep: bool,
+
+    /// Number of vehicles, system ids 1..=N, each its own core instance.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=254))]
+    pub vehicles: u8,
+
+    /// Base seed: vehicle k starts with seed + k − 1.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+
+    /// Parameter file (flat TOML: the model's and the task's parameters by name).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+
+    /// Log level on stderr: error, warn, info, debug (every skipped input) or trace.
+    #[arg(long, default_value = "info")]
+    pub log_level: tracing::Level,
+
+    /// Home position `LAT,LON,ALT` (degrees, degrees, metres above MSL).
+    #[arg(long, value_parser = parse_home, default_value = "47.397742,8.545594,488")]
+    pub home: Home,
+
+    /// Leave HIL_STATE_QUATERNION out of lockstep replies (peers can still turn it on with
+    /// SET_MESSAGE_INTERVAL).
+    #[arg(long)]
+    pub no_state_reply: bool,
+
+    /// Real time: seconds without a command after which the motors go off.
+    #[arg(long, default_value_t = 0.5, value_parser = parse_seconds)]
+    pub failsafe_timeout: f64,
+
+    /// Real time: HIL_STATE_QUATERNION stream rate to controller peers, Hz.
+    #[arg(long, default_value_t = 50.0, value_parser = parse_rate)]
+    pub state_rate: f64,
+
+    /// Print the parameter table (MAVLink ids, names, ranges, defaults) and exit.
+    #[arg(long)]
+    pub list_params: bool,
+
+    /// Print the task frame layout (DEBUG_FLOAT_ARRAY indices) and exit.
+    #[arg(long)]
+    pub describe_frame: bool,
+}
+
+/// Where ground-station telemetry goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GcsTarget {
+    Off,
+    At(SocketAddr),
+}
+
+fn parse_gcs(s: &str) -> Result<GcsTarget, String> {
+    if s.eq_ignore_ascii_case("off") {
+        return Ok(GcsTarget::Off);
+    }
+    s.parse()
+        .map(GcsTarget::At)
+        .map_err(|e| format!("`{s}` is neither `off` nor an address like 127.0.0.1:14550 ({e})"))
+}
+
+fn parse_home(s: &str) -> Result<Home, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let numbers: Vec<f64> = parts.iter().filter_map(|p| p.parse().ok()).collect();
+    match numbers[..] {
+        [lat, lon, alt]
+            if parts.len() == 3
+                && (-90.0..=90.0).contains(&lat)
+                && (-180.0..=180.0).contains(&lon)
+                && alt.is_finite() =>
+        {
+            Ok(Home {
+                latitude_deg: lat,
+                longitude_deg: lon,
+                altitude_m: alt,
+            })
+        }
+        _ => Err(format!(
+            "`{s}` is not LAT,LON,ALT with latitude in [-90, 90] and longitude in [-180, 180]"
+        )),
+    }
+}
+
+fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v > 0.0 && v <= 3600.0 => Ok(v),
+        _ => Err(format!("`{s}` is not a number of seconds in (0, 3600]")),
+    }
+}
+
+fn parse_rate(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v > 0.0 && v <= 10_000.0 => Ok(v),
+        _ => Err(format!("`{s}` is not a rate in (0, 10000] Hz")),
+    }
+}
+
+impl Args {
+    /// The model, from `--model` or the task's model.
+    pub fn model(&self) -> ModelKind {
+        self.model
+            .or(self.task.map(TaskKind::model))
+            .unwrap_or(ModelKind::Quadrotor)
+    }
+
+    /// The task, from `--task` or the model's default.
+    pub fn task(&self) -> Result<TaskKind, String> {
+        let model = self.model();
+        let task = self.task.unwrap_or(TaskKind::default_for(model));
+        if task.model() != model {
+            return Err(format!(
+                "task `{}` does not run on model `{}`: quadrotor flies hover or waypoints, lander2d flies landing",
+                task.frame_name(),
+                model.name()
+            ));
+        }
+        Ok(task)
+    }
+
+    pub fn mode(&self) -> Mode {
+        if self.realtime {
+            Mode::Realtime
+        } else if self.lockstep {
+            Mode::Lockstep
+        } else {
+            self.mode
+        }
+    }
+
+    pub fn failsafe_timeout(&self) -> Duration {
+        Duration::from_secs_f64(self.failsafe_timeout)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(args: &[&str]) -> Result<Args, clap::Error> {
+        Args::try_parse_from(std::iter::once("flyloop-sitl").chain(args.iter().copied()))
+    }
+
+    #[test]
+    fn defaults_are_a_lockstep_quadrotor_hovering() {
+        let a = parse(&[]).unwrap();
+        assert_eq!(
+            (a.model(), a.task().unwrap(), a.mode()),
+            (ModelKind::Quadrotor, TaskKind::Hover, Mode::Lockstep)
+        );
+        assert_eq!(a.gcs, GcsTarget::At("127.0.0.1:14550".parse().unwrap()));
+        assert_eq!(a.listen.port(), 14560);
+        let a = parse(&[
+            "--model",
+            "lander2d",
+            "--realtime",
+            "--gcs",
+            "off",
+            "--vehicles",
+            "16",
+        ])
+        .unwrap();
+        assert_eq!(
+            (a.task().unwrap(), a.mode(), a.gcs, a.vehicles),
+            (TaskKind::Landing, Mode::Realtime, GcsTarget::Off, 16)
+        );
+    }
+
+    #[test]
+    fn bad_options_are_refused() {
+        assert!(parse(&["--vehicles", "0"]).is_err());
+        assert!(parse(&["--vehicles", "255"]).is_err());
+        assert!(parse(&["--home", "91,0,0"]).is_err());
+        assert!(parse(&["--failsafe-timeout", "-1"]).is_err());
+        assert!(parse(&["--realtime", "--lockstep"]).is_err());
+        let a = parse(&["--model", "lander2d", "--task", "hover"]).unwrap();
+        assert!(a.task().unwrap_err().contains("does not run on model"));
+        assert_eq!(
+            parse(&["--task", "landing"]).unwrap().model(),
+            ModelKind::Lander2d
+        );
+        let h = parse(&["--home", "10.5, -20.25, 3"]).unwrap().home;
+        assert_eq!(
+            (h.latitude_deg, h.longitude_deg, h.altitude_m),
+            (10.5, -20.25, 3.0)
+        );
+    }
+}

@@ -1,0 +1,143 @@
+//! The config file: a flat TOML table of the task's parameters (model and task sets), by the
+//! core's names or their MAVLink short ids. Missing keys keep the core's defaults; every error
+//! names the parameter and its bound (the core's [`ParamError`]).
+
+use crate::model::{TaskConfig, TaskInstance, TaskKind};
+use crate::param_table::{self, Group, ParamEntry};
+use flyloop_core::ParamError;
+use flyloop_core::params::Parameters;
+use std::path::{Path, PathBuf};
+
+/// Why a config file was refused.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    #[error("cannot read config file {path}: {source}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("config file {path}: {source}")]
+    Invalid { path: PathBuf, source: ParamError },
+}
+
+/// Parses `text` into the parameter sets of `task` (other sets keep their defaults) and
+/// checks that the task builds from them.
+pub fn parse(task: TaskKind, text: &str) -> Result<TaskConfig, ParamError> {
+    let table: toml::Table = toml::from_str(text)?;
+    let entries = param_table::entries(task);
+    let mut values: Vec<(&ParamEntry, f64)> = Vec::with_capacity(table.len());
+    for (key, value) in &table {
+        let entry = entries
+            .iter()
+            .find(|e| e.name == key || e.id == *key)
+            .ok_or_else(|| {
+                ParamError::UnknownName(format!("{key}` for task `{}", task.frame_name()))
+            })?;
+        let number = match value {
+            toml::Value::Integer(i) => *i as f64,
+            toml::Value::Float(x) => *x,
+            toml::Value::Boolean(b) => f64::from(u8::from(*b)),
+            _ => {
+                return Err(ParamError::Parse(format!(
+                    "parameter `{}` must be a number or a boolean",
+                    entry.name
+                )));
+            }
+        };
+        values.push((entry, number));
+    }
+    let pick = |group: Group| {
+        values
+            .iter()
+            .filter(move |(e, _)| e.group == group)
+            .map(|(e, v)| (e.name, *v))
+    };
+    let mut config = TaskConfig::default();
+    for &group in Group::for_task(task) {
+        match group {
+            Group::Quadrotor => config.quadrotor = Parameters::from_values(pick(group))?,
+            Group::Flight => config.flight = Parameters::from_values(pick(group))?,
+            Group::Waypoints => config.waypoints = Parameters::from_values(pick(group))?,
+            Group::Lander => config.lander = Parameters::from_values(pick(group))?,
+            Group::Landing => config.landing = Parameters::from_values(pick(group))?,
+        }
+    }
+    TaskInstance::build(task, &config)?;
+    Ok(config)
+}
+
+/// Reads and parses the config file at `path`.
+pub fn load(task: TaskKind, path: &Path) -> Result<TaskConfig, ConfigError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse(task, &text).map_err(|source| ConfigError::Invalid {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_and_short_ids_both_set_their_parameter() {
+        let c = parse(
+            TaskKind::Hover,
+            "mass = 1.5\nmax_steps = 200\nwind_enabled = false\ntgt_chg_intv = 50\n",
+        )
+        .unwrap();
+        assert_eq!(c.quadrotor.mass, 1.5);
+        assert_eq!(c.flight.max_steps, 200);
+        assert!(!c.quadrotor.wind_enabled);
+        assert_eq!(c.flight.target_change_interval, 50);
+        assert_eq!(
+            c.quadrotor.arm_length, 0.1,
+            "missing keys keep their defaults"
+        );
+    }
+
+    #[test]
+    fn a_bad_value_names_the_parameter_and_its_bound() {
+        let err = parse(TaskKind::Hover, "mass = -2.0")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("`mass` = -2 kg is out of range"), "{err}");
+        let err = parse(TaskKind::Landing, "max_steps = 0")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("`max_steps` = 0 is out of range"), "{err}");
+        let err = parse(TaskKind::Hover, "max_num_waypoints = 3")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("max_num_waypoints"), "{err}");
+        assert_eq!(
+            parse(TaskKind::Hover, "masss = 1").unwrap_err().to_string(),
+            "unknown parameter `masss` for task `hover`"
+        );
+        let err = parse(TaskKind::Hover, "mass = \"heavy\"")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("`mass` must be a number"), "{err}");
+        let err = parse(TaskKind::Hover, "mass = ").unwrap_err().to_string();
+        assert!(err.contains("invalid parameter file"), "{err}");
+    }
+
+    #[test]
+    fn relations_between_parameters_are_checked() {
+        let err = parse(
+            TaskKind::Hover,
+            "wind_speed_min = 9.0\nwind_speed_max = 3.0",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(err.contains("wind_speed_min"), "{err}");
+        parse(
+            TaskKind::Hover,
+            "wind_speed_min = 2.0\nwind_speed_max = 3.0",
+        )
+        .unwrap();
+    }
+}

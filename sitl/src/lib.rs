@@ -1,0 +1,26 @@
+//! flyloop's MAVLink 2 SITL: flies the core's models (flyloop-core) for any MAVLink peer over
+//! UDP. The core does all physics; this crate holds the vehicles, speaks MAVLink and keeps the
+//! clock. The protocol is documented in docs/protocol.md.
+//!
+//! - [`sim`]: the datagram handler and the real-time clock's steps (no sockets),
+//! - [`server`]: the tokio loop with the sockets and signals,
+//! - [`wire`]: frames in and out of datagrams,
+//! - [`kinematics`]: the one place where ENU/FLU becomes NED/FRD,
+//! - [`task_frame`]: the task frame layout (DEBUG_FLOAT_ARRAY),
+//! - [`param_table`], [`param_protocol`], [`config`]: parameters over MAVLink and from TOML.
+
+pub mod cli;
+pub mod commands;
+pub mod config;
+pub mod gcs_streams;
+pub mod kinematics;
+pub mod model;
+pub mod param_protocol;
+pub mod param_table;
+pub mod server;
+pub mod sim;
+pub mod stats;
+pub mod task_frame;
+pub mod telemetry;
+pub mod vehicle;
+pub mod wire;

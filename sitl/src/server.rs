@@ -1,0 +1,152 @@
+//! The sockets and the clock: one tokio task on one thread reads both links, paces real time,
+//! streams the ground-station telemetry and stops on SIGINT / SIGTERM.
+
+use crate::sim::{Link, Mode, Sim};
+use crate::stats::Stats;
+use crate::wire;
+use std::future::pending;
+use std::io;
+use std::net::SocketAddr;
+use std::time::Instant;
+use tokio::net::UdpSocket;
+use tokio::signal::unix::{SignalKind, signal};
+use tokio::time::sleep_until;
+
+/// The ground-station link: its socket and where telemetry goes.
+#[derive(Debug)]
+pub struct GcsLink {
+    pub socket: UdpSocket,
+    pub target: SocketAddr,
+}
+
+/// Largest datagram read.
+const RECEIVE_BUFFER: usize = 65_536;
+
+async fn send(socket: &UdpSocket, bytes: &[u8], to: SocketAddr, stats: &mut Stats) {
+    for datagram in wire::datagrams(bytes) {
+        if let Err(e) = socket.send_to(datagram, to).await {
+            stats.io_errors += 1;
+            tracing::debug!(%to, error = %e, "send failed");
+        }
+    }
+}
+
+async fn receive(socket: Option<&UdpSocket>, buf: &mut [u8]) -> io::Result<(usize, SocketAddr)> {
+    match socket {
+        Some(s) => s.recv_from(buf).await,
+        None => pending().await,
+    }
+}
+
+fn deadline(t: Instant) -> tokio::time::Instant {
+    tokio::time::Instant::from_std(t)
+}
+
+/// SIGINT and SIGTERM, caught from the moment this exists (install it before announcing the
+/// SITL is ready, so an early signal still stops it cleanly).
+#[derive(Debug)]
+pub struct Shutdown {
+    interrupt: tokio::signal::unix::Signal,
+    terminate: tokio::signal::unix::Signal,
+}
+
+impl Shutdown {
+    /// Must be called inside the tokio runtime.
+    pub fn install() -> io::Result<Self> {
+        Ok(Shutdown {
+            interrupt: signal(SignalKind::interrupt())?,
+            terminate: signal(SignalKind::terminate())?,
+        })
+    }
+}
+
+/// Runs until SIGINT or SIGTERM; returns the counters.
+pub async fn run(
+    mut sim: Sim,
+    controller: UdpSocket,
+    gcs: Option<GcsLink>,
+    shutdown: Shutdown,
+) -> io::Result<Stats> {
+    let Shutdown {
+        mut interrupt,
+        mut terminate,
+    } = shutdown;
+    let mut buf = vec![0u8; RECEIVE_BUFFER];
+    let mut gcs_buf = vec![0u8; RECEIVE_BUFFER];
+    let mut out = Vec::with_capacity(RECEIVE_BUFFER);
+    let realtime = sim.options.mode == Mode::Realtime;
+    let mut next_physics = Instant::now();
+    let mut next_gcs = Instant::now();
+    let gcs_socket = gcs.as_ref().map(|g| &g.socket);
+    loop {
+        tokio::select! {
+            biased;
+            _ = interrupt.recv() => break,
+            _ = terminate.recv() => break,
+            r = controller.recv_from(&mut buf) => match r {
+                Ok((n, from)) => {
+                    let start = Instant::now();
+                    out.clear();
+                    sim.handle(Link::Controller, from, &buf[..n], start, &mut out);
+                    sim.stats.handling += start.elapsed();
+                    if !out.is_empty() {
+                        send(&controller, &out, from, &mut sim.stats).await;
+                    }
+                    sim.stats.busy += start.elapsed();
+                }
+                Err(e) => {
+                    sim.stats.io_errors += 1;
+                    tracing::debug!(error = %e, "receive failed on the controller link");
+                }
+            },
+            r = receive(gcs_socket, &mut gcs_buf), if gcs_socket.is_some() => match (r, gcs_socket) {
+                (Ok((n, from)), Some(socket)) => {
+                    out.clear();
+                    sim.handle(Link::Gcs, from, &gcs_buf[..n], Instant::now(), &mut out);
+                    if !out.is_empty() {
+                        send(socket, &out, from, &mut sim.stats).await;
+                    }
+                }
+                (Err(e), _) => {
+                    sim.stats.io_errors += 1;
+                    tracing::debug!(error = %e, "receive failed on the ground-station link");
+                }
+                (Ok(_), None) => {}
+            },
+            _ = sleep_until(deadline(next_physics)), if realtime => {
+                next_physics = sim.realtime_tick(Instant::now());
+                let stream = std::mem::take(&mut sim.stream);
+                for (to, bytes) in &stream {
+                    send(&controller, bytes, *to, &mut sim.stats).await;
+                }
+                sim.stream = stream;
+            },
+            _ = sleep_until(deadline(next_gcs)), if gcs.is_some() => {
+                if let Some(g) = &gcs {
+                    out.clear();
+                    next_gcs = sim.gcs_tick(Instant::now(), &mut out);
+                    send(&g.socket, &out, g.target, &mut sim.stats).await;
+                }
+            },
+        }
+        flush_outboxes(&mut sim, &controller, gcs.as_ref()).await;
+    }
+    tracing::info!("stopping on a signal");
+    Ok(sim.stats)
+}
+
+/// Sends the event messages (failsafe, episode ends) raised while handling the last event.
+async fn flush_outboxes(sim: &mut Sim, controller: &UdpSocket, gcs: Option<&GcsLink>) {
+    if !sim.controller_outbox.is_empty() {
+        let bytes = std::mem::take(&mut sim.controller_outbox);
+        for to in sim.live_peers(Instant::now()) {
+            send(controller, &bytes, to, &mut sim.stats).await;
+        }
+    }
+    if !sim.gcs_outbox.is_empty() {
+        let bytes = std::mem::take(&mut sim.gcs_outbox);
+        if let Some(g) = gcs {
+            send(&g.socket, &bytes, g.target, &mut sim.stats).await;
+        }
+    }
+}

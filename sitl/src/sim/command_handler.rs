@@ -1,0 +1,240 @@
+//! Commands (COMMAND_LONG) on either link: reset, message intervals, message requests.
+
+use super::{Link, Mode, RESET_COMMAND, Sim};
+use crate::telemetry::{self, Status, id};
+use mavlink::MavHeader;
+use mavlink::dialects::common::{
+    COMMAND_ACK_DATA, COMMAND_LONG_DATA, MavCmd, MavMessage, MavResult, MavSeverity,
+};
+
+impl Sim {
+    fn ack(
+        &mut self,
+        link: Link,
+        out: &mut Vec<u8>,
+        i: usize,
+        header: MavHeader,
+        command: MavCmd,
+        result: MavResult,
+    ) {
+        let m = MavMessage::COMMAND_ACK(COMMAND_ACK_DATA {
+            command,
+            result,
+            progress: 0,
+            result_param2: 0,
+            target_system: header.system_id,
+            target_component: header.component_id,
+        });
+        self.push(link, out, i, &m);
+    }
+
+    // MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES is superseded but ground stations still send it.
+    #[allow(deprecated)]
+    pub(super) fn on_command(
+        &mut self,
+        link: Link,
+        header: MavHeader,
+        c: &COMMAND_LONG_DATA,
+        peer: Option<usize>,
+        out: &mut Vec<u8>,
+    ) {
+        let Some(targets) = self.targets(c.target_system) else {
+            return;
+        };
+        let all = c.target_system == 0;
+        match c.command {
+            RESET_COMMAND => match crate::commands::reset_request(c) {
+                Ok(request) => {
+                    for i in targets {
+                        let seed = request.seed_for(&self.vehicles[i], all);
+                        self.reset_vehicle(link, header, i, seed, peer, out);
+                    }
+                }
+                Err(e) => {
+                    self.stats.refused_requests += 1;
+                    tracing::debug!(error = %e, "reset refused");
+                    for i in targets {
+                        self.ack(
+                            link,
+                            out,
+                            i,
+                            header,
+                            c.command,
+                            MavResult::MAV_RESULT_DENIED,
+                        );
+                        self.push_text(
+                            link,
+                            out,
+                            i,
+                            MavSeverity::MAV_SEVERITY_ERROR,
+                            &format!("reset refused: {e}"),
+                        );
+                    }
+                }
+            },
+            MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL => {
+                let result = self.set_message_interval(link, c.param1, c.param2, peer);
+                if result != MavResult::MAV_RESULT_ACCEPTED {
+                    self.stats.refused_requests += 1;
+                }
+                for i in targets {
+                    self.ack(link, out, i, header, c.command, result);
+                }
+            }
+            MavCmd::MAV_CMD_REQUEST_MESSAGE | MavCmd::MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES => {
+                let message_id = if c.command == MavCmd::MAV_CMD_REQUEST_MESSAGE {
+                    crate::commands::message_id(c.param1)
+                } else {
+                    Some(id::AUTOPILOT_VERSION)
+                };
+                for i in targets {
+                    let reply = message_id.and_then(|m| self.message(link, i, m));
+                    let result = if reply.is_some() {
+                        MavResult::MAV_RESULT_ACCEPTED
+                    } else {
+                        self.stats.refused_requests += 1;
+                        MavResult::MAV_RESULT_UNSUPPORTED
+                    };
+                    self.ack(link, out, i, header, c.command, result);
+                    for m in reply.into_iter().flatten() {
+                        self.push(link, out, i, &m);
+                    }
+                }
+            }
+            _ => {
+                self.stats.ignored_messages += 1;
+                tracing::debug!(command = ?c.command, "unsupported command");
+                for i in targets {
+                    self.ack(
+                        link,
+                        out,
+                        i,
+                        header,
+                        c.command,
+                        MavResult::MAV_RESULT_UNSUPPORTED,
+                    );
+                }
+            }
+        }
+    }
+
+    fn reset_vehicle(
+        &mut self,
+        link: Link,
+        header: MavHeader,
+        i: usize,
+        seed: u64,
+        peer: Option<usize>,
+        out: &mut Vec<u8>,
+    ) {
+        match self.vehicles[i].reset(seed) {
+            Ok(()) => {
+                self.stats.resets += 1;
+                self.runtime[i].running = false;
+                self.runtime[i].failsafe = false;
+                self.ack(
+                    link,
+                    out,
+                    i,
+                    header,
+                    RESET_COMMAND,
+                    MavResult::MAV_RESULT_ACCEPTED,
+                );
+                if let Some(p) = peer {
+                    self.push_vehicle_reply(i, p, out);
+                }
+            }
+            Err(e) => {
+                self.stats.refused_requests += 1;
+                self.ack(
+                    link,
+                    out,
+                    i,
+                    header,
+                    RESET_COMMAND,
+                    MavResult::MAV_RESULT_FAILED,
+                );
+                self.push_text(
+                    link,
+                    out,
+                    i,
+                    MavSeverity::MAV_SEVERITY_ERROR,
+                    &format!("reset failed: {e}"),
+                );
+            }
+        }
+    }
+
+    /// SET_MESSAGE_INTERVAL: on the controller link it chooses what the sending peer gets
+    /// (HIL_STATE_QUATERNION, DEBUG_FLOAT_ARRAY); on the ground-station link it sets a stream.
+    fn set_message_interval(
+        &mut self,
+        link: Link,
+        message: f32,
+        interval: f32,
+        peer: Option<usize>,
+    ) -> MavResult {
+        let (Some(message), true) = (crate::commands::message_id(message), interval.is_finite())
+        else {
+            return MavResult::MAV_RESULT_DENIED;
+        };
+        match (link, peer) {
+            (Link::Controller, Some(p)) => {
+                let enabled = interval >= 0.0;
+                let default_us = (1e6 / self.options.state_rate_hz.max(1e-3)).round() as u64;
+                let p = &mut self.peers[p];
+                match message {
+                    id::HIL_STATE_QUATERNION => p.state = enabled,
+                    id::DEBUG_FLOAT_ARRAY => p.frame = enabled,
+                    _ => return MavResult::MAV_RESULT_UNSUPPORTED,
+                }
+                if interval > 0.0 {
+                    p.interval_us = interval as u64;
+                } else if interval == 0.0 {
+                    p.interval_us = default_us.max(1);
+                }
+                MavResult::MAV_RESULT_ACCEPTED
+            }
+            _ => self.gcs_streams.set_interval(message, interval),
+        }
+    }
+
+    /// The message `message_id` of vehicle `i` (one or more MAVLink messages), if this SITL
+    /// sends it.
+    pub(super) fn message(
+        &mut self,
+        link: Link,
+        i: usize,
+        message_id: u32,
+    ) -> Option<Vec<MavMessage>> {
+        let status = self.status(i);
+        let home = self.options.home;
+        let v = &mut self.vehicles[i];
+        Some(match message_id {
+            id::HEARTBEAT => vec![telemetry::heartbeat(v, status)],
+            id::SYS_STATUS => vec![telemetry::sys_status(v)],
+            id::ATTITUDE => vec![telemetry::attitude(v)],
+            id::LOCAL_POSITION_NED => vec![telemetry::local_position_ned(v)],
+            id::GLOBAL_POSITION_INT => vec![telemetry::global_position_int(v, &home)],
+            id::VFR_HUD => vec![telemetry::vfr_hud(v, &home)],
+            id::HIL_STATE_QUATERNION => vec![telemetry::hil_state_quaternion(v, &home)],
+            id::AUTOPILOT_VERSION => vec![telemetry::autopilot_version(v)],
+            id::HOME_POSITION => vec![telemetry::home_position(v, &home)],
+            id::DEBUG_FLOAT_ARRAY if link == Link::Controller => {
+                let (name, time) = (v.kind.frame_name(), v.clock_us);
+                crate::task_frame::messages(name, time, v.frame()).collect()
+            }
+            _ => return None,
+        })
+    }
+
+    pub(super) fn status(&self, i: usize) -> Status {
+        let rt = &self.runtime[i];
+        match self.options.mode {
+            Mode::Lockstep => Status::Active,
+            Mode::Realtime if rt.failsafe => Status::Failsafe,
+            Mode::Realtime if rt.running => Status::Active,
+            Mode::Realtime => Status::Standby,
+        }
+    }
+}

@@ -1,0 +1,411 @@
+//! The simulation as the network sees it: vehicles addressed by system id, the datagram
+//! handler for both links, and the real-time clock's steps. No sockets here: the server
+//! ([`crate::server`]) passes datagrams in and sends what comes out, so tests and the fuzz
+//! target drive this directly.
+
+use crate::gcs_streams::GcsStreams;
+use crate::kinematics::Home;
+use crate::model::{TaskConfig, TaskKind};
+use crate::stats::Stats;
+use crate::telemetry;
+use crate::vehicle::Vehicle;
+use crate::wire::{self, Encoder, Incoming};
+
+use flyloop_core::ParamError;
+use mavlink::MavHeader;
+use mavlink::dialects::common::{
+    HIL_ACTUATOR_CONTROLS_DATA, HilActuatorControlsFlags, MavCmd, MavMessage, MavSeverity,
+};
+use std::net::SocketAddr;
+use std::time::{Duration, Instant};
+
+mod command_handler;
+mod realtime;
+
+/// How physics is paced.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Mode {
+    /// One control period per HIL_ACTUATOR_CONTROLS with the LOCKSTEP flag; no wall clock.
+    Lockstep,
+    /// Paced by the wall clock at the task's control rate; the last command holds.
+    Realtime,
+}
+
+impl Mode {
+    /// The name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Lockstep => "lockstep",
+            Mode::Realtime => "realtime",
+        }
+    }
+}
+
+/// Which socket a datagram came in on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Link {
+    /// The controller link (`--listen`): lockstep, ground truth, task frames.
+    Controller,
+    /// The ground-station link (`--gcs`).
+    Gcs,
+}
+
+/// Reset command (COMMAND_LONG): MAV_CMD_USER_1.
+pub const RESET_COMMAND: MavCmd = MavCmd::MAV_CMD_USER_1;
+
+/// Everything the simulation is started with.
+#[derive(Debug, Clone)]
+pub struct SimOptions {
+    pub task: TaskKind,
+    pub vehicles: u8,
+    /// Vehicle k starts with seed `seed + k − 1` (wrapping).
+    pub seed: u64,
+    pub config: TaskConfig,
+    pub mode: Mode,
+    pub home: Home,
+    /// Whether a controller peer gets HIL_STATE_QUATERNION in its replies until it says
+    /// otherwise (SET_MESSAGE_INTERVAL).
+    pub state_in_reply: bool,
+    /// Real time: controller silence after which the motors go off.
+    pub failsafe_timeout: Duration,
+    /// Real time: HIL_STATE_QUATERNION (and task frame) stream rate to controller peers, Hz.
+    pub state_rate_hz: f64,
+}
+
+impl SimOptions {
+    pub fn new(task: TaskKind) -> Self {
+        SimOptions {
+            task,
+            vehicles: 1,
+            seed: 0,
+            config: TaskConfig::default(),
+            mode: Mode::Lockstep,
+            home: Home::default(),
+            state_in_reply: true,
+            failsafe_timeout: Duration::from_millis(500),
+            state_rate_hz: 50.0,
+        }
+    }
+}
+
+/// A controller peer: where replies and the real-time stream go, and what they hold.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Peer {
+    addr: SocketAddr,
+    /// HIL_STATE_QUATERNION in lockstep replies / the real-time stream.
+    state: bool,
+    /// Task frame in lockstep replies / the real-time stream.
+    frame: bool,
+    /// Real-time stream interval, µs of simulation time.
+    interval_us: u64,
+    last_heard: Instant,
+}
+
+/// Peers silent this long stop getting the real-time stream.
+const PEER_TIMEOUT: Duration = Duration::from_secs(5);
+/// Peers remembered at once (the least recently heard one is forgotten).
+const MAX_PEERS: usize = 32;
+/// Real time: steps a late vehicle may catch up at once before the clock skips ahead.
+const MAX_CATCH_UP: u32 = 10;
+
+/// Real-time bookkeeping of a vehicle.
+#[derive(Debug, Clone, Copy)]
+struct Runtime {
+    /// Steps only while running: from its first command until its episode terminates.
+    running: bool,
+    failsafe: bool,
+    last_command: Option<Instant>,
+    next_due: Instant,
+}
+
+/// The simulation.
+#[derive(Debug)]
+pub struct Sim {
+    pub options: SimOptions,
+    pub vehicles: Vec<Vehicle>,
+    runtime: Vec<Runtime>,
+    pub stats: Stats,
+    controller_encoder: Encoder,
+    gcs_encoder: Encoder,
+    peers: Vec<Peer>,
+    next_text_id: u16,
+    gcs_streams: GcsStreams,
+    /// Messages for the ground station raised by events (failsafe, resets), sent by the server.
+    pub gcs_outbox: Vec<u8>,
+    /// Messages for every live controller peer raised by events in real time.
+    pub controller_outbox: Vec<u8>,
+    /// Real-time stream output: one datagram per peer.
+    pub stream: Vec<(SocketAddr, Vec<u8>)>,
+}
+
+impl Sim {
+    /// Vehicles 1..=N, each reset with its own seed.
+    pub fn new(options: SimOptions, now: Instant) -> Result<Self, ParamError> {
+        let vehicles = (1..=options.vehicles)
+            .map(|k| {
+                let seed = options.seed.wrapping_add(u64::from(k) - 1);
+                Vehicle::new(k, options.task, options.config.clone(), seed)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let runtime = vec![
+            Runtime {
+                running: false,
+                failsafe: false,
+                last_command: None,
+                next_due: now,
+            };
+            vehicles.len()
+        ];
+        Ok(Sim {
+            options,
+            vehicles,
+            runtime,
+            stats: Stats::default(),
+            controller_encoder: Encoder::default(),
+            gcs_encoder: Encoder::default(),
+            peers: Vec::new(),
+            next_text_id: 1,
+            gcs_streams: GcsStreams::new(now),
+            gcs_outbox: Vec::new(),
+            controller_outbox: Vec::new(),
+            stream: Vec::new(),
+        })
+    }
+
+    fn vehicle_index(&self, system_id: u8) -> Option<usize> {
+        let i = usize::from(system_id).checked_sub(1)?;
+        (i < self.vehicles.len()).then_some(i)
+    }
+
+    /// The vehicles a message with `target_system` addresses (0 = all); None if no vehicle has
+    /// that id.
+    pub(crate) fn targets(&mut self, target_system: u8) -> Option<std::ops::Range<usize>> {
+        if target_system == 0 {
+            return Some(0..self.vehicles.len());
+        }
+        match self.vehicle_index(target_system) {
+            Some(i) => Some(i..i + 1),
+            None => {
+                self.stats.unknown_vehicle += 1;
+                tracing::debug!(target_system, "message for an unknown system id skipped");
+                None
+            }
+        }
+    }
+
+    fn encoder(&mut self, link: Link) -> &mut Encoder {
+        match link {
+            Link::Controller => &mut self.controller_encoder,
+            Link::Gcs => &mut self.gcs_encoder,
+        }
+    }
+
+    /// Appends `message` from vehicle index `i` on `link`.
+    pub(crate) fn push(&mut self, link: Link, out: &mut Vec<u8>, i: usize, message: &MavMessage) {
+        let system_id = self.vehicles[i].system_id;
+        self.encoder(link).push(out, system_id, message);
+    }
+
+    /// Appends a STATUSTEXT (chunked if long) from vehicle index `i`.
+    pub(crate) fn push_text(
+        &mut self,
+        link: Link,
+        out: &mut Vec<u8>,
+        i: usize,
+        severity: MavSeverity,
+        text: &str,
+    ) {
+        let id = self.next_text_id;
+        self.next_text_id = self.next_text_id.checked_add(1).unwrap_or(1);
+        for m in telemetry::statustext(severity, text, id) {
+            self.push(link, out, i, &m);
+        }
+    }
+
+    fn peer_index(&mut self, addr: SocketAddr, now: Instant) -> usize {
+        if let Some(i) = self.peers.iter().position(|p| p.addr == addr) {
+            self.peers[i].last_heard = now;
+            return i;
+        }
+        if self.peers.len() >= MAX_PEERS {
+            if let Some(oldest) = (0..self.peers.len()).min_by_key(|&i| self.peers[i].last_heard) {
+                self.peers.swap_remove(oldest);
+            }
+        }
+        let interval_us = (1e6 / self.options.state_rate_hz.max(1e-3)).round() as u64;
+        self.peers.push(Peer {
+            addr,
+            state: self.options.state_in_reply,
+            frame: true,
+            interval_us: interval_us.max(1),
+            last_heard: now,
+        });
+        self.peers.len() - 1
+    }
+
+    /// Handles one datagram from `from` on `link`; replies for the sender are appended to
+    /// `out` (the server sends them back as one datagram).
+    pub fn handle(
+        &mut self,
+        link: Link,
+        from: SocketAddr,
+        datagram: &[u8],
+        now: Instant,
+        out: &mut Vec<u8>,
+    ) {
+        match link {
+            Link::Controller => self.stats.datagrams += 1,
+            Link::Gcs => self.stats.gcs_datagrams += 1,
+        }
+        for frame in wire::frames(datagram) {
+            match frame {
+                Ok(incoming) => {
+                    self.stats.frames += 1;
+                    self.dispatch(link, from, incoming, now, out);
+                }
+                Err(e) => {
+                    self.stats.count_frame_error(e);
+                    tracing::debug!(%from, ?link, error = ?e, "frame skipped");
+                }
+            }
+        }
+    }
+
+    fn dispatch(
+        &mut self,
+        link: Link,
+        from: SocketAddr,
+        incoming: Incoming,
+        now: Instant,
+        out: &mut Vec<u8>,
+    ) {
+        let peer = (link == Link::Controller).then(|| self.peer_index(from, now));
+        let Incoming { header, message } = incoming;
+        match (&message, peer) {
+            (MavMessage::HIL_ACTUATOR_CONTROLS(c), Some(p)) => {
+                self.on_controls(header, c, p, now, out)
+            }
+            (MavMessage::COMMAND_LONG(c), _) => self.on_command(link, header, c, peer, out),
+            (MavMessage::PARAM_REQUEST_LIST(m), _) => {
+                let t = m.target_system;
+                self.on_param_request_list(link, t, out)
+            }
+            (MavMessage::PARAM_REQUEST_READ(m), _) => {
+                self.on_param_request_read(link, header, m, out)
+            }
+            (MavMessage::PARAM_SET(m), _) => self.on_param_set(link, header, m, out),
+            (MavMessage::HEARTBEAT(_), _) => {}
+            _ => {
+                self.stats.ignored_messages += 1;
+                tracing::debug!(%from, ?link, message = message_name(&message), "message ignored");
+            }
+        }
+    }
+
+    fn on_controls(
+        &mut self,
+        header: MavHeader,
+        c: &HIL_ACTUATOR_CONTROLS_DATA,
+        peer: usize,
+        now: Instant,
+        out: &mut Vec<u8>,
+    ) {
+        let Some(i) = self.vehicle_index(header.system_id) else {
+            self.stats.unknown_vehicle += 1;
+            tracing::debug!(
+                system_id = header.system_id,
+                "controls for an unknown system id skipped"
+            );
+            return;
+        };
+        let lockstep_flag = c
+            .flags
+            .contains(HilActuatorControlsFlags::HIL_ACTUATOR_CONTROLS_FLAGS_LOCKSTEP);
+        if self.options.mode == Mode::Lockstep && !lockstep_flag {
+            self.stats.ignored_messages += 1;
+            tracing::debug!(
+                system_id = header.system_id,
+                "controls without the LOCKSTEP flag ignored in lockstep"
+            );
+            return;
+        }
+        match self.vehicles[i].set_controls(&c.controls) {
+            Ok(report) => {
+                if report.clamped {
+                    self.stats.clamped_controls += 1;
+                    tracing::debug!(
+                        system_id = header.system_id,
+                        "controls clamped into the action bounds"
+                    );
+                }
+            }
+            Err(e) => {
+                self.stats.refused_controls += 1;
+                tracing::debug!(system_id = header.system_id, error = %e, "controls refused");
+                let text = format!("vehicle {}: {e}", header.system_id);
+                self.push_text(
+                    Link::Controller,
+                    out,
+                    i,
+                    MavSeverity::MAV_SEVERITY_WARNING,
+                    &text,
+                );
+                return;
+            }
+        }
+        match self.options.mode {
+            Mode::Lockstep => {
+                let start = Instant::now();
+                self.vehicles[i].step();
+                self.stats.physics += start.elapsed();
+                self.stats.steps += 1;
+                self.push_vehicle_reply(i, peer, out);
+            }
+            Mode::Realtime => self.command_arrived(i, now),
+        }
+    }
+
+    /// HIL_STATE_QUATERNION and the task frame of vehicle `i`, as `peer` wants them.
+    fn push_vehicle_reply(&mut self, i: usize, peer: usize, out: &mut Vec<u8>) {
+        let Peer { state, frame, .. } = self.peers[peer];
+        if state {
+            let m = telemetry::hil_state_quaternion(&self.vehicles[i], &self.options.home);
+            self.push(Link::Controller, out, i, &m);
+        }
+        if frame {
+            self.push_frame(i, out);
+        }
+    }
+
+    fn push_frame(&mut self, i: usize, out: &mut Vec<u8>) {
+        let v = &mut self.vehicles[i];
+        let (name, time, system_id) = (v.kind.frame_name(), v.clock_us, v.system_id);
+        let values = v.frame();
+        for m in crate::task_frame::messages(name, time, values) {
+            self.controller_encoder.push(out, system_id, &m);
+        }
+    }
+
+    // ---- ground station ----
+
+    /// Appends the ground-station telemetry due at `now`; returns when the next is due.
+    pub fn gcs_tick(&mut self, now: Instant, out: &mut Vec<u8>) -> Instant {
+        let due = self.gcs_streams.due(now);
+        for message_id in due {
+            for i in 0..self.vehicles.len() {
+                if let Some(messages) = self.message(Link::Gcs, i, message_id) {
+                    for m in messages {
+                        self.push(Link::Gcs, out, i, &m);
+                    }
+                }
+            }
+        }
+        self.gcs_streams.next_due()
+    }
+}
+
+/// The message's name for logs.
+fn message_name(m: &MavMessage) -> &'static str {
+    use mavlink::Message;
+    m.message_name()
+}

@@ -1,0 +1,345 @@
+//! MAVLink messages built from a vehicle's state: the lockstep ground truth
+//! (HIL_STATE_QUATERNION) and the ground-station telemetry. Frames and units follow the
+//! MAVLink spec (world NED, body FRD); the conversion itself lives in [`crate::kinematics`].
+
+use crate::kinematics::{Home, STANDARD_GRAVITY, round_i16, round_u16};
+use crate::model::TaskKind;
+use crate::vehicle::Vehicle;
+use mavlink::dialects::common::*;
+use mavlink::types::CharArray;
+
+/// Message ids this SITL can send on request (REQUEST_MESSAGE) or stream.
+pub mod id {
+    pub const HEARTBEAT: u32 = 0;
+    pub const SYS_STATUS: u32 = 1;
+    pub const ATTITUDE: u32 = 30;
+    pub const LOCAL_POSITION_NED: u32 = 32;
+    pub const GLOBAL_POSITION_INT: u32 = 33;
+    pub const VFR_HUD: u32 = 74;
+    pub const HIL_STATE_QUATERNION: u32 = 115;
+    pub const AUTOPILOT_VERSION: u32 = 148;
+    pub const HOME_POSITION: u32 = 242;
+    pub const DEBUG_FLOAT_ARRAY: u32 = 350;
+}
+
+/// What a ground station needs to draw a vehicle's status.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    /// Waiting for its first command (real time) or stepped by a controller (lockstep).
+    Standby,
+    Active,
+    /// Failsafe: the controller went silent and the motors are off.
+    Failsafe,
+}
+
+/// Ground truth for a controller: attitude (FRD → NED), body rates, global position,
+/// NED velocity, airspeed and the accelerometer's specific force, at simulation time.
+pub fn hil_state_quaternion(v: &Vehicle, home: &Home) -> MavMessage {
+    let k = v.task.kinematics();
+    let q = crate::kinematics::attitude_ned(&k.attitude);
+    let rates = k.body_rates_frd();
+    let g = home.global(&k.position);
+    let vel = k.velocity_ned();
+    let acc = k.specific_force_frd() * (1000.0 / STANDARD_GRAVITY);
+    let airspeed = round_u16(k.airspeed() * 100.0);
+    MavMessage::HIL_STATE_QUATERNION(HIL_STATE_QUATERNION_DATA {
+        time_usec: v.clock_us,
+        attitude_quaternion: [q.w as f32, q.i as f32, q.j as f32, q.k as f32],
+        rollspeed: rates.x as f32,
+        pitchspeed: rates.y as f32,
+        yawspeed: rates.z as f32,
+        lat: g.lat,
+        lon: g.lon,
+        alt: g.alt_mm,
+        vx: round_i16(vel.x * 100.0),
+        vy: round_i16(vel.y * 100.0),
+        vz: round_i16(vel.z * 100.0),
+        ind_airspeed: airspeed,
+        true_airspeed: airspeed,
+        xacc: round_i16(acc.x),
+        yacc: round_i16(acc.y),
+        zacc: round_i16(acc.z),
+    })
+}
+
+pub fn mav_type(kind: TaskKind) -> MavType {
+    match kind.model() {
+        crate::model::ModelKind::Quadrotor => MavType::MAV_TYPE_QUADROTOR,
+        crate::model::ModelKind::Lander2d => MavType::MAV_TYPE_GENERIC,
+    }
+}
+
+pub fn heartbeat(v: &Vehicle, status: Status) -> MavMessage {
+    // The crate's Default for bitflags is not empty: build from empty().
+    let mut base_mode = MavModeFlag::empty();
+    let system_status = match status {
+        Status::Standby => MavState::MAV_STATE_STANDBY,
+        Status::Active => {
+            base_mode |= MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED;
+            MavState::MAV_STATE_ACTIVE
+        }
+        Status::Failsafe => MavState::MAV_STATE_EMERGENCY,
+    };
+    MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+        custom_mode: 0,
+        mavtype: mav_type(v.kind),
+        autopilot: MavAutopilot::MAV_AUTOPILOT_GENERIC,
+        base_mode,
+        system_status,
+        mavlink_version: 3,
+    })
+}
+
+pub fn attitude(v: &Vehicle) -> MavMessage {
+    let k = v.task.kinematics();
+    let (roll, pitch, yaw) = crate::kinematics::euler_ned(&k.attitude);
+    let rates = k.body_rates_frd();
+    MavMessage::ATTITUDE(ATTITUDE_DATA {
+        time_boot_ms: v.time_boot_ms(),
+        roll: roll as f32,
+        pitch: pitch as f32,
+        yaw: yaw as f32,
+        rollspeed: rates.x as f32,
+        pitchspeed: rates.y as f32,
+        yawspeed: rates.z as f32,
+    })
+}
+
+/// Heading in centidegrees [0, 36000).
+fn heading_cdeg(v: &Vehicle) -> u16 {
+    let (_, _, yaw) = crate::kinematics::euler_ned(&v.task.kinematics().attitude);
+    let deg = yaw.to_degrees().rem_euclid(360.0);
+    round_u16(deg * 100.0) % 36000
+}
+
+pub fn global_position_int(v: &Vehicle, home: &Home) -> MavMessage {
+    let k = v.task.kinematics();
+    let g = home.global(&k.position);
+    let vel = k.velocity_ned();
+    MavMessage::GLOBAL_POSITION_INT(GLOBAL_POSITION_INT_DATA {
+        time_boot_ms: v.time_boot_ms(),
+        lat: g.lat,
+        lon: g.lon,
+        alt: g.alt_mm,
+        relative_alt: g.relative_alt_mm,
+        vx: round_i16(vel.x * 100.0),
+        vy: round_i16(vel.y * 100.0),
+        vz: round_i16(vel.z * 100.0),
+        hdg: heading_cdeg(v),
+    })
+}
+
+pub fn local_position_ned(v: &Vehicle) -> MavMessage {
+    let k = v.task.kinematics();
+    let p = k.position_ned();
+    let vel = k.velocity_ned();
+    MavMessage::LOCAL_POSITION_NED(LOCAL_POSITION_NED_DATA {
+        time_boot_ms: v.time_boot_ms(),
+        x: p.x as f32,
+        y: p.y as f32,
+        z: p.z as f32,
+        vx: vel.x as f32,
+        vy: vel.y as f32,
+        vz: vel.z as f32,
+    })
+}
+
+pub fn vfr_hud(v: &Vehicle, home: &Home) -> MavMessage {
+    let k = v.task.kinematics();
+    let n = v.command.len().max(1) as f64;
+    let (lo, hi) = v.task.action_bounds();
+    let throttle: f64 = v
+        .command
+        .iter()
+        .zip(lo.iter().zip(&hi))
+        .map(|(c, (l, h))| (c - l) / (h - l))
+        .sum::<f64>()
+        / n;
+    MavMessage::VFR_HUD(VFR_HUD_DATA {
+        airspeed: k.airspeed() as f32,
+        groundspeed: k.velocity.xy().norm() as f32,
+        alt: (home.altitude_m + k.position.z) as f32,
+        climb: k.velocity.z as f32,
+        heading: (heading_cdeg(v) / 100) as i16,
+        throttle: round_u16(throttle * 100.0),
+    })
+}
+
+pub fn home_position(v: &Vehicle, home: &Home) -> MavMessage {
+    let g = home.global(&nalgebra::Vector3::zeros());
+    MavMessage::HOME_POSITION(HOME_POSITION_DATA {
+        latitude: g.lat,
+        longitude: g.lon,
+        altitude: g.alt_mm,
+        x: 0.0,
+        y: 0.0,
+        z: 0.0,
+        q: [1.0, 0.0, 0.0, 0.0],
+        approach_x: 0.0,
+        approach_y: 0.0,
+        approach_z: 0.0,
+        time_usec: v.clock_us,
+    })
+}
+
+/// SYS_STATUS with the battery: the lander's charge in percent; the quadrotor has no battery
+/// model, so its battery is reported unknown (remaining −1, voltage UINT16_MAX).
+pub fn sys_status(v: &Vehicle) -> MavMessage {
+    let (remaining, voltage) = match v.task.battery_fraction() {
+        Some(f) => {
+            let percent = (f * 100.0).round().clamp(0.0, 100.0) as i8;
+            // A nominal 4S pack: 16.8 V full, 13.2 V empty, linear in between.
+            (
+                percent,
+                round_u16((13.2 + 3.6 * f.clamp(0.0, 1.0)) * 1000.0),
+            )
+        }
+        None => (-1, u16::MAX),
+    };
+    let sensors = MavSysStatusSensor::empty();
+    MavMessage::SYS_STATUS(SYS_STATUS_DATA {
+        onboard_control_sensors_present: sensors,
+        onboard_control_sensors_enabled: sensors,
+        // 1 = healthy: nothing reports an error.
+        onboard_control_sensors_health: MavSysStatusSensor::all(),
+        load: 0,
+        voltage_battery: voltage,
+        current_battery: -1,
+        drop_rate_comm: 0,
+        errors_comm: 0,
+        errors_count1: 0,
+        errors_count2: 0,
+        errors_count3: 0,
+        errors_count4: 0,
+        battery_remaining: remaining,
+        onboard_control_sensors_present_extended: MavSysStatusSensorExtended::empty(),
+        onboard_control_sensors_enabled_extended: MavSysStatusSensorExtended::empty(),
+        onboard_control_sensors_health_extended: MavSysStatusSensorExtended::all(),
+    })
+}
+
+/// flyloop's version as MAVLink's flight_sw_version: major, minor, patch, type (255 = release).
+fn software_version() -> u32 {
+    let part = |s: &str| s.parse::<u32>().unwrap_or(0) & 0xFF;
+    let major = part(env!("CARGO_PKG_VERSION_MAJOR"));
+    let minor = part(env!("CARGO_PKG_VERSION_MINOR"));
+    let patch = part(env!("CARGO_PKG_VERSION_PATCH"));
+    (major << 24) | (minor << 16) | (patch << 8) | 0xFF
+}
+
+pub fn autopilot_version(v: &Vehicle) -> MavMessage {
+    let capabilities = MavProtocolCapability::MAV_PROTOCOL_CAPABILITY_MAVLINK2
+        | MavProtocolCapability::MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_C_CAST;
+    MavMessage::AUTOPILOT_VERSION(AUTOPILOT_VERSION_DATA {
+        capabilities,
+        uid: u64::from(v.system_id),
+        flight_sw_version: software_version(),
+        middleware_sw_version: 0,
+        os_sw_version: 0,
+        board_version: 0,
+        vendor_id: 0,
+        product_id: 0,
+        flight_custom_version: [0; 8],
+        middleware_custom_version: [0; 8],
+        os_custom_version: [0; 8],
+        uid2: [0; 18],
+    })
+}
+
+/// STATUSTEXT messages carrying `text`: one if it fits in 50 bytes, else chunks with a common
+/// non-zero `id` and `chunk_seq` 0, 1, … (the last chunk shorter than 50 bytes, or followed
+/// by an empty one, ends the text, as the MAVLink spec says).
+pub fn statustext(severity: MavSeverity, text: &str, id: u16) -> Vec<MavMessage> {
+    let bytes = text.as_bytes();
+    let make = |chunk: &[u8], id: u16, seq: u8| {
+        let mut t = [0u8; 50];
+        t[..chunk.len()].copy_from_slice(chunk);
+        MavMessage::STATUSTEXT(STATUSTEXT_DATA {
+            severity,
+            text: CharArray::from(t),
+            id,
+            chunk_seq: seq,
+        })
+    };
+    if bytes.len() <= 50 {
+        return vec![make(bytes, 0, 0)];
+    }
+    let mut out: Vec<MavMessage> = bytes
+        .chunks(50)
+        .zip(0u8..)
+        .map(|(c, seq)| make(c, id, seq))
+        .collect();
+    if bytes.len() % 50 == 0 {
+        out.push(make(&[], id, out.len() as u8));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::TaskConfig;
+
+    fn hover() -> Vehicle {
+        let mut config = TaskConfig::default();
+        config.flight.start_attitude_range = 0.0;
+        Vehicle::new(1, TaskKind::Hover, config, 3).unwrap()
+    }
+
+    #[test]
+    fn hil_state_of_a_level_quadrotor_facing_east() {
+        let v = hover();
+        let MavMessage::HIL_STATE_QUATERNION(s) = hil_state_quaternion(&v, &Home::default()) else {
+            unreachable!()
+        };
+        let h = std::f32::consts::FRAC_1_SQRT_2;
+        assert_eq!(s.attitude_quaternion, [h, 0.0, 0.0, h]);
+        assert_eq!(s.time_usec, 0);
+        assert_eq!(s.alt, 488_000 + 1_500);
+        assert_eq!((s.vx, s.vy, s.vz), (0, 0, 0));
+        // At rest, hover thrust balances gravity: the accelerometer reads about −1 g.
+        assert!((i32::from(s.zacc) + 1000).abs() <= 3, "{}", s.zacc);
+    }
+
+    #[test]
+    fn heartbeat_flags_start_from_empty() {
+        let MavMessage::HEARTBEAT(h) = heartbeat(&hover(), Status::Standby) else {
+            unreachable!()
+        };
+        assert_eq!(h.base_mode, MavModeFlag::empty());
+        assert_eq!(h.mavtype, MavType::MAV_TYPE_QUADROTOR);
+        let MavMessage::HEARTBEAT(h) = heartbeat(&hover(), Status::Active) else {
+            unreachable!()
+        };
+        assert_eq!(h.base_mode, MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED);
+    }
+
+    #[test]
+    fn long_status_texts_are_chunked() {
+        let text = "x".repeat(120);
+        let msgs = statustext(MavSeverity::MAV_SEVERITY_ERROR, &text, 7);
+        assert_eq!(msgs.len(), 3);
+        let MavMessage::STATUSTEXT(last) = &msgs[2] else {
+            unreachable!()
+        };
+        assert_eq!((last.id, last.chunk_seq), (7, 2));
+        assert_eq!(statustext(MavSeverity::MAV_SEVERITY_INFO, "ok", 7).len(), 1);
+        assert_eq!(
+            statustext(MavSeverity::MAV_SEVERITY_INFO, &"y".repeat(100), 1).len(),
+            3
+        );
+    }
+
+    #[test]
+    fn the_lander_reports_its_battery_and_the_quadrotor_none() {
+        let MavMessage::SYS_STATUS(s) = sys_status(&hover()) else {
+            unreachable!()
+        };
+        assert_eq!((s.battery_remaining, s.voltage_battery), (-1, u16::MAX));
+        let lander = Vehicle::new(1, TaskKind::Landing, TaskConfig::default(), 0).unwrap();
+        let MavMessage::SYS_STATUS(s) = sys_status(&lander) else {
+            unreachable!()
+        };
+        assert_eq!((s.battery_remaining, s.voltage_battery), (100, 16_800));
+    }
+}

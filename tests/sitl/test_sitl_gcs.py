@@ -1,0 +1,169 @@
+"""The ground-station link as its own peer: telemetry streams, requests, and a real MAVProxy
+that detects the vehicle and shows its attitude."""
+
+from __future__ import annotations
+
+import math
+import os
+import queue
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+from sitl_client import decode_frame, mavlink2, of_type
+
+
+class GroundStation:
+    """A pymavlink ground station listening like QGroundControl does (udpin)."""
+
+    def __init__(self):
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.sock.bind(("127.0.0.1", 0))
+        self.port = self.sock.getsockname()[1]
+        self.mav = mavlink2.MAVLink(None, srcSystem=255, srcComponent=190)
+        self.parser = mavlink2.MAVLink(None)
+        self.sitl_address = None
+
+    def listen(self, seconds: float) -> list:
+        out = []
+        end = time.monotonic() + seconds
+        while (left := end - time.monotonic()) > 0:
+            self.sock.settimeout(left)
+            try:
+                data, self.sitl_address = self.sock.recvfrom(65536)
+            except TimeoutError:
+                break
+            out.extend(self.parser.parse_buffer(data) or [])
+        return out
+
+    def command(self, command: int, params, target: int = 1) -> None:
+        p = list(params) + [0.0] * (7 - len(params))
+        msg = self.mav.command_long_encode(target, 1, command, 0, *p)
+        self.sock.sendto(msg.pack(self.mav), self.sitl_address)
+
+
+def test_the_ground_station_gets_heartbeats_and_telemetry(start_sitl, client_for):
+    gcs = GroundStation()
+    sitl = start_sitl("--home", "10.5,-20.25,30", gcs=f"127.0.0.1:{gcs.port}")
+    msgs = gcs.listen(1.2)
+    beats = of_type(msgs, "HEARTBEAT")
+    assert beats and beats[0].get_srcSystem() == 1 and beats[0].get_srcComponent() == 1
+    assert beats[0].type == mavlink2.MAV_TYPE_QUADROTOR
+    assert beats[0].autopilot == mavlink2.MAV_AUTOPILOT_GENERIC
+    assert 1 <= len(beats) <= 3
+    assert len(of_type(msgs, "ATTITUDE")) >= 8  # 10 Hz
+    home = of_type(msgs, "HOME_POSITION")[0]
+    assert (home.latitude, home.longitude, home.altitude) == (105_000_000, -202_500_000, 30_000)
+    position = of_type(msgs, "GLOBAL_POSITION_INT")[-1]
+    assert (position.lat, position.lon, position.relative_alt) == (105_000_000, -202_500_000, 1500)
+    assert of_type(msgs, "SYS_STATUS")[0].battery_remaining == -1  # no battery model
+    assert of_type(msgs, "LOCAL_POSITION_NED")[-1].z == -1.5
+    assert sitl.gcs_local[1] == gcs.sitl_address[1]
+
+    # The ground station sees what the controller flies.
+    client = client_for(sitl)
+    for _ in range(30):
+        msgs = client.step([0.52, 0.48, 0.5, 0.5])
+    state = of_type(msgs, "HIL_STATE_QUATERNION")[0]
+    attitude = of_type(gcs.listen(0.3), "ATTITUDE")[-1]
+    w, x, y, z = state.attitude_quaternion
+    roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+    assert abs(attitude.roll - roll) < 1e-6 and attitude.time_boot_ms == 300
+
+
+def test_requests_and_intervals_on_the_ground_station_link(start_sitl):
+    gcs = GroundStation()
+    start_sitl("--model", "lander2d", gcs=f"127.0.0.1:{gcs.port}")
+    gcs.listen(0.3)
+    gcs.command(mavlink2.MAV_CMD_REQUEST_MESSAGE, [mavlink2.MAVLINK_MSG_ID_AUTOPILOT_VERSION])
+    msgs = gcs.listen(0.3)
+    ack = of_type(msgs, "COMMAND_ACK")[0]
+    assert (ack.command, ack.result) == (mavlink2.MAV_CMD_REQUEST_MESSAGE, 0)
+    version = of_type(msgs, "AUTOPILOT_VERSION")[0]
+    assert version.capabilities & mavlink2.MAV_PROTOCOL_CAPABILITY_MAVLINK2
+    assert (
+        of_type(msgs, "SYS_STATUS") == [] or of_type(msgs, "SYS_STATUS")[0].battery_remaining == 100
+    )
+
+    gcs.command(mavlink2.MAV_CMD_SET_MESSAGE_INTERVAL, [mavlink2.MAVLINK_MSG_ID_ATTITUDE, -1])
+    gcs.listen(0.1)
+    assert of_type(gcs.listen(0.5), "ATTITUDE") == []
+    gcs.command(mavlink2.MAV_CMD_SET_MESSAGE_INTERVAL, [mavlink2.MAVLINK_MSG_ID_ATTITUDE, 50_000])
+    assert len(of_type(gcs.listen(1.0), "ATTITUDE")) >= 15  # 20 Hz
+    gcs.command(mavlink2.MAV_CMD_REQUEST_MESSAGE, [4242])
+    assert of_type(gcs.listen(0.3), "COMMAND_ACK")[0].result == mavlink2.MAV_RESULT_UNSUPPORTED
+    # The lander's battery is reported in percent.
+    status = of_type(gcs.listen(1.1), "SYS_STATUS")[0]
+    assert status.battery_remaining == 100 and status.voltage_battery == 16_800
+
+
+def free_udp_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Lines:
+    """A process's stdout lines, read by a thread so the test can wait for one with a timeout."""
+
+    def __init__(self, stream):
+        self.queue: queue.Queue[str] = queue.Queue()
+        self.seen: list[str] = []
+        threading.Thread(target=self._read, args=(stream,), daemon=True).start()
+
+    def _read(self, stream):
+        for line in stream:
+            self.queue.put(line)
+
+    def wait_for(self, text: str, timeout: float) -> str:
+        end = time.monotonic() + timeout
+        while (left := end - time.monotonic()) > 0:
+            try:
+                line = self.queue.get(timeout=left)
+            except queue.Empty:
+                break
+            self.seen.append(line)
+            if text in line:
+                return line
+        raise AssertionError(f"no {text!r} within {timeout} s in:\n{''.join(self.seen)}")
+
+
+def test_mavproxy_detects_the_vehicle_and_shows_its_attitude(start_sitl, client_for, tmp_path):
+    port = free_udp_port()
+    mavproxy = Path(sys.executable).parent / "mavproxy.py"
+    proc = subprocess.Popen(
+        [sys.executable, str(mavproxy), f"--master=udpin:127.0.0.1:{port}", "--nowait"],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        cwd=tmp_path,  # its logs (mav.tlog, mav.parm) go there
+        env={**os.environ, "MAVLINK20": "1"},
+    )
+    lines = Lines(proc.stdout)
+    try:
+        lines.wait_for("Connect udpin", timeout=30)
+        sitl = start_sitl("--seed", "6", gcs=f"127.0.0.1:{port}")
+        frame = decode_frame(client_for(sitl).reset(6), 1)
+        lines.wait_for("Detected vehicle 1:1 on link 0", timeout=30)
+        lines.wait_for("online system 1", timeout=30)
+        time.sleep(0.5)  # a few ATTITUDE messages at 10 Hz
+        proc.stdin.write("status ATTITUDE\n")
+        proc.stdin.flush()
+        line = lines.wait_for("ATTITUDE {", timeout=10)
+    finally:
+        # MAVProxy's own shutdown can take long; what we needed is already read.
+        proc.kill()
+        proc.wait()
+    fields = dict(
+        kv.split(" : ") for kv in line.split("ATTITUDE {", 1)[1].strip().rstrip("}").split(", ")
+    )
+    # The start attitude of seed 6, from the task frame's quaternion (ENU/FLU): yaw_ned =
+    # 90 deg - yaw_enu.
+    w, x, y, z = frame.obs[9:13]
+    yaw_enu = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    assert abs(float(fields["yaw"]) - (math.pi / 2 - yaw_enu)) < 1e-5, fields
+    assert abs(float(fields["roll"])) < 0.11 and abs(float(fields["pitch"])) < 0.11
