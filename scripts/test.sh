@@ -15,7 +15,7 @@ cargo nextest run --workspace --release
 say "Rust doctests"
 cargo test --workspace --release --doc
 say "ruff"
-.venv/bin/ruff check python tests
-.venv/bin/ruff format --check python tests
+.venv/bin/ruff check .
+.venv/bin/ruff format --check .
 say "Python system tests (pytest)"
 .venv/bin/pytest -q

@@ -1,3 +1,27 @@
-"""flyloop: gymnasium environments over flyloop's MAVLink SITL."""
+"""flyloop: gymnasium environments over flyloop's MAVLink SITL.
+
+Importing the package registers the envs with gymnasium:
+
+    import gymnasium, flyloop
+    env = gymnasium.make("flyloop/QuadHover-v0")          # or QuadWaypoints-v0, Lander2D-v0
+    envs = gymnasium.make_vec("flyloop/QuadHover-v0", num_envs=16)  # one SITL, 16 vehicles
+
+`gymnasium.make("flyloop:flyloop/QuadHover-v0")` imports the package itself. Rendering lives
+in `flyloop.rendering` (pygame is imported only when a view is made).
+"""
+
+from .errors import SitlError, SitlNotFoundError, SitlParameterError
+from .registration import register_envs
+from .sitl_process import find_sitl_binary
 
 __version__ = "0.1.0"
+
+__all__ = [
+    "SitlError",
+    "SitlNotFoundError",
+    "SitlParameterError",
+    "find_sitl_binary",
+    "register_envs",
+]
+
+register_envs()

@@ -1,0 +1,185 @@
+"""flyloop/Lander2D-v0: land a 2D two-motor drone on a (possibly moving) platform."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from ..tasks import LANDING
+from .base import FlyloopEnv
+
+# Landing-task parameters the scene draws, with the core's defaults (docs/parameters.md).
+_SCENE_DEFAULTS = {"platform_speed": 1.5, "initial_pos_random_range_m": 5.0}
+
+
+class Lander2DEnv(FlyloopEnv):
+    """Land a 2D drone with two motors on a platform (seed 000's ``Drone2dEnv``).
+
+    ``gymnasium.make("flyloop/Lander2D-v0")`` (after ``import flyloop``). The physics
+    (rapier2d), observation, reward and outcome are computed by flyloop's Rust core inside
+    the ``flyloop-sitl`` process this env starts, one MAVLink datagram per step.
+
+    ## Frames and units
+
+    A vertical plane: x to the right in (0, 50) m, y up in (0, 50) m, gravity 9.81 m/s² along
+    −y, ground at y = 10 m. Angles counter-clockwise, wrapped to (−π, π]. The drone: 1.5 kg,
+    1.0 m wide (frame box and two motor boxes, one rigid body). Platform 5 m × 0.5 m centred at
+    x = 25 m, top at y = 10.5 m.
+
+    ## Action space
+
+    ``Box(-1, 1, (2,), float32)``: left and right motor; a maps to thrust (a + 1)/2 · 15 N,
+    plus Gaussian noise (σ = 1.5 N, seeded), along the body's +y at x = ∓0.4 m. Values outside
+    [−1, 1] are clipped by the core; a non-finite value raises ``ValueError``.
+
+    ## Observation space
+
+    ``Box(low, high, (11,) or (12,), float32)``, each value clipped to [−1, 1] (battery and
+    distance to [0, 1]):
+
+    | index | value |
+    |---|---|
+    | 0, 1 | x/25 − 1, y/25 − 1 |
+    | 2, 3 | vx/15, vy/15 (m/s) |
+    | 4, 5 | angle/π, angular velocity/10 (rad/s) |
+    | 6 | battery / 100 |
+    | 7, 8 | err_x/25, err_y/25: drone → platform top centre (m) |
+    | 9 | (atan2(err_y, err_x) − angle)/π: bearing of the platform from the body |
+    | 10 | distance to the platform / 50 |
+    | 11 | platform vx / platform_speed (only with ``moving_platform=True``) |
+
+    ## Reward
+
+    Per step on the observation values n: ``2·exp(−0.1·n10) − 0.1·(n2² + n3²) − 0.2·|n4| −
+    0.1·|n5|``, +5 on a step touching the platform. The first terminal condition adds: landed
+    +100 if calm (‖(n2, n3)‖ < 0.1 and |n5| < 0.1) else +20; crashed −50; lost control −50;
+    battery empty −50; out of bounds −50; time limit −10.
+
+    ## Starting state
+
+    Spawn at (25, 40) ± ``initial_pos_random_range_m`` in x and y (kept inside the world and
+    above the platform), angle uniform in ±``initial_angle_random_range_rad``, at rest, battery
+    full. Wind: a constant force of wind_speed · 0.5 · 1.0 m (2.5 N) in a direction uniform in
+    [0, 2π) per episode (or ``wind_direction``). A moving platform starts in a random
+    direction. All drawn from the episode's seed.
+
+    ## Episode end
+
+    Terminated when landed (first platform contact slower than ``max_safe_landing_speed``
+    1.5 m/s and within ``max_safe_landing_angle`` 0.2 rad), crashed (ground contact or a hard
+    platform contact), lost control (|angle| > ``max_allowed_tilt_angle_rad``, π/2), battery
+    empty, or out of the world. Truncated at exactly ``max_steps`` steps.
+
+    ## Info
+
+    ``position`` (2, m), ``velocity`` (2, m/s), ``angle`` (rad), ``angular_velocity`` (rad/s),
+    ``battery``, ``thrust`` (2, N), ``wind_force`` (2, N), ``platform_position`` (2, m: top
+    centre), ``distance`` (m), ``landed``, ``crashed``, ``lost_control``, ``out_of_bounds``,
+    ``battery_empty``, ``time_limit``, ``platform_contact``, ``touchdown_speed`` (m/s),
+    ``step``. Values travel as float32.
+
+    ## Arguments
+
+    - ``max_steps=1000``, ``dt=0.02`` (s, 50 Hz control).
+    - ``moving_platform=False``, ``platform_speed=1.5`` (m/s),
+      ``platform_random_start_x=False``.
+    - ``initial_pos_random_range_m=5.0`` (0 = fixed start at (25, 40)),
+      ``initial_angle_random_range_rad=0.1``.
+    - ``use_wind=True``, ``wind_speed=5.0`` (m/s), ``wind_direction=None`` (None = random per
+      episode, else radians from +x toward +y).
+    - ``thrust_noise_std=1.5`` (N), ``max_safe_landing_speed=1.5``,
+      ``max_safe_landing_angle=0.2``, ``max_allowed_tilt_angle_rad=π/2``.
+    - ``model_params=None``: other Lander2D parameters by core name (``drone_mass``,
+      ``max_thrust``, ``initial_battery``, ``world_width``, ...; docs/parameters.md).
+    - ``render_mode=None`` / ``"human"`` / ``"rgb_array"``; ``render_path=True``,
+      ``render_shade=True``, ``shade_distance_m=2.0`` (the seed's drawing options).
+    - ``sitl_path``, ``sitl_address``, ``vehicle``, ``timeout``: as ``QuadHoverEnv``.
+
+    ## Errors
+
+    As ``QuadHoverEnv``: ``SitlParameterError`` for refused arguments, ``SitlError`` for a
+    SITL that exits or stays silent for ``timeout`` seconds.
+
+    ## Version history
+
+    - v0: first version. Differs from the seed on purpose: a rigid drone by construction, a
+      pad landing no longer also counts as a ground crash, the time limit fires at exactly
+      ``max_steps`` and is a truncation, wind can be switched off, seeded resets.
+    """
+
+    SPEC = LANDING
+
+    def __init__(
+        self,
+        max_steps: int = 1000,
+        moving_platform: bool = False,
+        platform_speed: float = 1.5,
+        initial_pos_random_range_m: float = 5.0,
+        render_mode: str | None = None,
+        render_path: bool = True,
+        render_shade: bool = True,
+        shade_distance_m: float = 2.0,
+        *,
+        dt: float = 0.02,
+        initial_angle_random_range_rad: float = 0.1,
+        use_wind: bool = True,
+        wind_speed: float = 5.0,
+        wind_direction: float | None = None,
+        platform_random_start_x: bool = False,
+        thrust_noise_std: float = 1.5,
+        max_safe_landing_speed: float = 1.5,
+        max_safe_landing_angle: float = 0.2,
+        max_allowed_tilt_angle_rad: float = 1.5707963267948966,
+        model_params: Mapping[str, Any] | None = None,
+        sitl_path: str | None = None,
+        sitl_address: Any = None,
+        vehicle: int = 1,
+        timeout: float = 5.0,
+    ) -> None:
+        self._render_options = dict(
+            show_path=bool(render_path),
+            show_shades=bool(render_shade),
+            shade_distance_m=float(shade_distance_m),
+        )
+        super().__init__(
+            arguments=dict(
+                max_steps=max_steps,
+                dt=dt,
+                moving_platform=moving_platform,
+                platform_speed=platform_speed,
+                initial_pos_random_range_m=initial_pos_random_range_m,
+                initial_angle_random_range_rad=initial_angle_random_range_rad,
+                use_wind=use_wind,
+                wind_speed=wind_speed,
+                wind_direction=wind_direction,
+                platform_random_start_x=platform_random_start_x,
+                thrust_noise_std=thrust_noise_std,
+                max_safe_landing_speed=max_safe_landing_speed,
+                max_safe_landing_angle=max_safe_landing_angle,
+                max_allowed_tilt_angle_rad=max_allowed_tilt_angle_rad,
+            ),
+            model_params=model_params,
+            render_mode=render_mode,
+            sitl_path=sitl_path,
+            sitl_address=sitl_address,
+            vehicle=vehicle,
+            timeout=timeout,
+        )
+
+    def _make_view(self, render_mode: str):
+        from ..rendering import LanderView
+
+        return LanderView(render_mode, fps=self.metadata["render_fps"], **self._render_options)
+
+    def _scene(self, obs, info, reward):
+        from ..rendering import lander_scene
+
+        return lander_scene(
+            info,
+            obs,
+            dt=self.dt,
+            reward=reward,
+            episode_return=self._episode_return,
+            max_steps=int(self.config["max_steps"]),
+            params={**_SCENE_DEFAULTS, **self.config},
+        )

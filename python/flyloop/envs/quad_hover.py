@@ -1,0 +1,194 @@
+"""flyloop/QuadHover-v0: fly a quadrotor to a target and hold it."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from ..tasks import CORE_DEFAULTS, HOVER
+from .base import FlyloopEnv
+
+
+class QuadHoverEnv(FlyloopEnv):
+    """Fly a quadrotor to a target point and hold it there (seed 001's ``DroneEnv``).
+
+    ``gymnasium.make("flyloop/QuadHover-v0")`` (after ``import flyloop``). The physics,
+    observation, reward and termination are computed by flyloop's Rust core inside the
+    ``flyloop-sitl`` process this env starts; the env exchanges one MAVLink datagram with it
+    per step (lockstep, no wall clock).
+
+    ## Frames and units
+
+    World ENU (x east, y north, z up, gravity along −z), body FLU (x forward, y left, z up),
+    quaternions ``[w, x, y, z]`` rotating body → world. Metres, seconds, radians (tilt
+    thresholds in degrees, as in the seed). Motors follow PX4's quad-X: 0 front-right (CCW),
+    1 rear-left (CCW), 2 front-left (CW), 3 rear-right (CW); thrust per motor 10 N · m² for
+    motor state m ∈ [0, 1]; hover at m ≈ 0.495 with the default mass of 1 kg.
+
+    ## Action space
+
+    ``Box(0, 1, (4,), float32)``: commanded motor states, in motor order above. Values outside
+    [0, 1] are clipped by the core; a non-finite value raises ``ValueError``. The motors follow
+    the command with a first-order lag (τ = 0.08 s).
+
+    ## Observation space
+
+    ``Box(low, high, (33,), float32)``; every value is clipped into its bound by the core:
+
+    | index | value | unit | bound |
+    |---|---|---|---|
+    | 0–2 | target − position | m | ±√3·space_side_length (±5.196) |
+    | 3–5 | velocity | m/s | ±40 |
+    | 6–8 | linear acceleration (total force / mass, gravity included) | m/s² | ±50 |
+    | 9–12 | attitude quaternion w, x, y, z (w ≥ 0) | 1 | ±1 |
+    | 13–15 | body rates | rad/s | ±10 |
+    | 16–18 | angular acceleration | rad/s² | ±100 |
+    | 19–21 | body z axis in the world ("normal") | 1 | ±1 |
+    | 22–24 | wind velocity | m/s | ±(wind max + 5 σ/√(2θ)) (±10 by default; ±1 without wind) |
+    | 25–28 | motor states | 1 | [0, 1] |
+    | 29–32 | motor commands in effect | 1 | [0, 1] |
+
+    ## Reward
+
+    With d = ‖target − position‖ and d̂ the unit vector toward the target:
+    ``r_pos = exp(−d)``, ``r_vel = tanh((v · d̂) / velocity_scale)``,
+    ``reward = r_pos + 0.5 · (1 − r_pos) · r_vel`` — 1 on the target, in (−0.5, 1].
+
+    ## Starting state
+
+    Position (0, 0, start_height = 1.5 m), roll, pitch and yaw each uniform in
+    ±start_attitude_range (0.1 rad), at rest, motors at the hover state. Target: x, y uniform
+    in ±space_side_length/2, z in [0, space_side_length], at least min_target_distance (1 m)
+    from the start. Everything is drawn from the episode's seed.
+
+    ## Episode end
+
+    Terminated on a crash (``enable_crash_detection``: height ≤ 0, vertical velocity below
+    ``crash_z_vel_threshold``, or |roll| or |pitch| above ``crash_tilt_threshold`` degrees) or
+    out of bounds (``enable_out_of_bounds_detection``: d > √3·space_side_length). Truncated when
+    the step count reaches ``max_steps``. With ``target_change_interval`` N a new target is
+    drawn every N steps (it appears in the observation of that step).
+
+    ## Info
+
+    ``distance_to_target`` (m), ``position`` (3, m), ``target_position`` (3, m),
+    ``step_count``, ``episode_time`` (s), ``distance_progress`` (initial − current distance,
+    m), ``crashed``, ``out_of_bounds`` — in reset() and every step(). Values travel as
+    float32.
+
+    ## Arguments
+
+    - ``max_steps=1000``: steps until truncation.
+    - ``dt=0.01``: control period, s (one action per dt; the core integrates with RK4).
+    - ``target_change_interval=None``: steps between new targets (None: never).
+    - ``wind_strength_range=(0.0, 5.0)``: per-episode mean wind speed drawn in this range, m/s,
+      plus Ornstein–Uhlenbeck turbulence.
+    - ``use_wind=True``: wind on or off.
+    - ``enable_crash_detection=True``, ``enable_out_of_bounds_detection=True``,
+      ``crash_z_vel_threshold=-20.0`` (m/s), ``crash_tilt_threshold=80.0`` (degrees).
+    - ``space_side_length=3.0``, ``start_height=1.5``, ``start_attitude_range=0.1``,
+      ``min_target_distance=1.0``, ``velocity_scale=3.0``: task geometry and reward scale.
+    - ``model_params=None``: other physical parameters of the quadrotor by their core name,
+      e.g. ``{"mass": 1.2, "pendulum_coefficient": 0.03}`` (docs/parameters.md).
+    - ``render_mode=None``: ``"human"`` (a pygame window) or ``"rgb_array"``.
+    - ``sitl_path=None``: the flyloop-sitl binary (see ``flyloop.find_sitl_binary``).
+    - ``sitl_address=None``: ``"host:port"`` of a running SITL to use instead of starting one
+      (parameters are then set over MAVLink as float32); ``vehicle=1``: its system id there.
+    - ``timeout=5.0``: seconds to wait for any SITL reply before raising ``SitlError``.
+
+    Out-of-range values are refused by the core's parameter table: ``SitlParameterError``
+    (a ``ValueError``) naming the argument and its bound; wrong types raise ``TypeError``.
+
+    ## Errors
+
+    A SITL that exits, is killed or stays silent for ``timeout`` seconds raises
+    ``flyloop.SitlError`` (exit code and last stderr lines in the message) — never a hang.
+    ``close()`` stops the SITL; one forgotten is stopped when the env is garbage-collected
+    or Python exits.
+
+    ## Version history
+
+    - v0: first version. Differs from the seed on purpose: correct rigid-body physics (body
+      rates, rotor geometry), observations declared with bounds they respect, seeded
+      reproducible resets, the pendulum torque off by default, the time limit as truncation.
+    """
+
+    SPEC = HOVER
+
+    def __init__(
+        self,
+        max_steps: int = 1000,
+        dt: float = 0.01,
+        target_change_interval: int | None = None,
+        wind_strength_range: tuple[float, float] = (0.0, 5.0),
+        use_wind: bool = True,
+        render_mode: str | None = None,
+        enable_crash_detection: bool = True,
+        enable_out_of_bounds_detection: bool = True,
+        crash_z_vel_threshold: float = -20.0,
+        crash_tilt_threshold: float = 80.0,
+        *,
+        space_side_length: float = 3.0,
+        start_height: float = 1.5,
+        start_attitude_range: float = 0.1,
+        min_target_distance: float = 1.0,
+        velocity_scale: float = 3.0,
+        model_params: Mapping[str, Any] | None = None,
+        sitl_path: str | None = None,
+        sitl_address: Any = None,
+        vehicle: int = 1,
+        timeout: float = 5.0,
+        **task_arguments: Any,
+    ) -> None:
+        arguments = dict(
+            max_steps=max_steps,
+            dt=dt,
+            target_change_interval=target_change_interval,
+            wind_strength_range=wind_strength_range,
+            use_wind=use_wind,
+            enable_crash_detection=enable_crash_detection,
+            enable_out_of_bounds_detection=enable_out_of_bounds_detection,
+            crash_z_vel_threshold=crash_z_vel_threshold,
+            crash_tilt_threshold=crash_tilt_threshold,
+            space_side_length=space_side_length,
+            start_height=start_height,
+            start_attitude_range=start_attitude_range,
+            min_target_distance=min_target_distance,
+            velocity_scale=velocity_scale,
+        )
+        known = {a.name for a in self.SPEC.arguments}
+        unknown = set(task_arguments) - known
+        if unknown:
+            raise TypeError(
+                f"{type(self).__name__}() got unexpected arguments {sorted(unknown)}; "
+                f"task arguments: {sorted(known)}"
+            )
+        arguments.update(task_arguments)
+        super().__init__(
+            arguments=arguments,
+            model_params=model_params,
+            render_mode=render_mode,
+            sitl_path=sitl_path,
+            sitl_address=sitl_address,
+            vehicle=vehicle,
+            timeout=timeout,
+        )
+
+    def _make_view(self, render_mode: str):
+        from ..rendering import QuadrotorView
+
+        return QuadrotorView(render_mode, fps=self.metadata["render_fps"])
+
+    def _scene(self, obs, info, reward):
+        from ..rendering import quad_scene
+
+        side = float(self.config.get("space_side_length", CORE_DEFAULTS["space_side_length"]))
+        arm = float(self.config.get("arm_length", CORE_DEFAULTS["arm_length"]))
+        return quad_scene(
+            obs,
+            info,
+            reward=reward,
+            episode_return=self._episode_return,
+            bounds_half_size=side / 2.0,
+            arm_length=arm,
+        )

@@ -1,0 +1,28 @@
+"""Registering the envs with gymnasium (done by `import flyloop`)."""
+
+from __future__ import annotations
+
+import gymnasium
+
+ENVS = {
+    "flyloop/QuadHover-v0": ("flyloop.envs:QuadHoverEnv", "flyloop.vector:QuadHoverVectorEnv"),
+    "flyloop/QuadWaypoints-v0": (
+        "flyloop.envs:QuadWaypointsEnv",
+        "flyloop.vector:QuadWaypointsVectorEnv",
+    ),
+    "flyloop/Lander2D-v0": ("flyloop.envs:Lander2DEnv", "flyloop.vector:Lander2DVectorEnv"),
+}
+
+
+def register_envs() -> None:
+    """Registers the three env ids (idempotent). No TimeLimit wrapper: the core truncates at
+    `max_steps` itself; the env checker is left on (gymnasium's default)."""
+    for env_id, (entry, vector_entry) in ENVS.items():
+        if env_id in gymnasium.registry:
+            continue
+        gymnasium.register(
+            id=env_id,
+            entry_point=entry,
+            vector_entry_point=vector_entry,
+            max_episode_steps=None,
+        )
