@@ -37,4 +37,6 @@ if [[ $demo -eq 1 ]]; then
     cargo run --release -q -p flyloop-core --example hover
     say "Demo 2: Quadrotor.fmu simulated with fmpy (plot)"
     .venv/bin/python examples/fmu_fmpy_demo.py
+    say "Demo 3: the SITL flown through the gym env by a PD controller (GIF)"
+    .venv/bin/python examples/demo_gym_pd.py
 fi

@@ -1,0 +1,146 @@
+"""Evaluate a model saved by train_sb3.py: N episodes, success rate and mean return.
+
+    .venv/bin/python examples/train/evaluate.py runs/hover_ppo --episodes 100
+    .venv/bin/python examples/train/evaluate.py runs/hover_ppo --random   # the random bar
+
+The folder holds model.zip, vecnormalize.pkl and summary.json (which env and algorithm).
+The policy acts deterministically (the mean of its action distribution). Episode k has seed
+--seed + k, so two evaluations with the same seeds fly the same episodes; the default seeds
+(1,000,000 and up) are never among the training seeds.
+
+What counts as a success:
+- hover (QuadHover-v0): the episode reaches the time limit (truncated: no crash, not out of
+  bounds) and ends within 0.5 m of the target;
+- lander (Lander2D-v0): the drone landed on the platform (info['landed']).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import pickle
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from training_envs import make_env, preset
+
+EVAL_SEED = 1_000_000
+
+
+class SavedRun:
+    """A trained policy from a train_sb3.py folder, with its observation normalisation."""
+
+    def __init__(self, folder: Path) -> None:
+        folder = Path(folder)
+        summary_path = folder / "summary.json"
+        if not summary_path.is_file():
+            raise FileNotFoundError(f"{summary_path} not found: is {folder} a train_sb3.py output?")
+        self.summary = json.loads(summary_path.read_text())
+        self.preset = preset(self.summary["env"])
+        # Imported only now: torch and stable-baselines3 take seconds to load.
+        from stable_baselines3 import PPO, SAC
+
+        algorithms = {"ppo": PPO, "sac": SAC}
+        self.model = algorithms[self.summary["algo"]].load(folder / "model.zip", device="cpu")
+        # The normalisation statistics only: a VecNormalize pickled without its envs
+        # (stable-baselines3 drops them on save), so no env is made for it.
+        with open(folder / "vecnormalize.pkl", "rb") as f:
+            self.norm = pickle.load(f)
+        self.norm.training = False
+
+    def act(self, obs: np.ndarray) -> np.ndarray:
+        normalised = self.norm.normalize_obs(obs[None, :].astype(np.float32))
+        action, _ = self.model.predict(normalised, deterministic=True)
+        return action[0]
+
+
+def evaluate(
+    folder: Path | None,
+    episodes: int,
+    seed: int = EVAL_SEED,
+    *,
+    env: str | None = None,
+) -> dict[str, Any]:
+    """Runs `episodes` episodes of the saved policy in `folder` (or of uniformly random
+    actions when folder is None; then `env` names the preset) and returns the figures."""
+    if folder is not None:
+        import torch
+
+        torch.set_num_threads(1)
+    run = SavedRun(folder) if folder is not None else None
+    p = run.preset if run is not None else preset(env or "hover")
+    action = run.summary.get("action") if run is not None else None
+    rng = np.random.default_rng(seed)
+    e = make_env(p.name, action=action)
+    returns, lengths, successes, final_distances = [], [], [], []
+    try:
+        for k in range(episodes):
+            obs, info = e.reset(seed=seed + k)
+            total, length, done = 0.0, 0, False
+            while not done:
+                if run is not None:
+                    action = run.act(obs)
+                else:
+                    action = rng.uniform(e.action_space.low, e.action_space.high)
+                obs, reward, terminated, truncated, info = e.step(action.astype(np.float32))
+                total += reward
+                length += 1
+                done = terminated or truncated
+            returns.append(total)
+            lengths.append(length)
+            successes.append(bool(p.success(terminated, truncated, info)))
+            if "distance_to_target" in info:
+                final_distances.append(float(info["distance_to_target"]))
+    finally:
+        e.close()
+    return dict(
+        env=p.name,
+        env_id=p.env_id,
+        policy=str(folder) if folder is not None else "random",
+        episodes=episodes,
+        first_seed=seed,
+        success_rate=float(np.mean(successes)),
+        mean_return=float(np.mean(returns)),
+        std_return=float(np.std(returns)),
+        mean_length=float(np.mean(lengths)),
+        median_final_distance_m=float(np.median(final_distances)) if final_distances else None,
+        success=p.success_text,
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("run", type=Path, nargs="?", help="train_sb3.py output folder")
+    parser.add_argument("--episodes", type=int, default=100)
+    parser.add_argument("--seed", type=int, default=EVAL_SEED, help="seed of the first episode")
+    parser.add_argument("--random", action="store_true", help="evaluate random actions instead")
+    parser.add_argument("--env", default="hover", help="with --random: hover or lander")
+    parser.add_argument("--json", type=Path, help="also write the figures to this file")
+    args = parser.parse_args(argv)
+    if args.episodes < 1:
+        parser.error("--episodes must be >= 1")
+    if args.random == (args.run is not None):
+        parser.error("give either a run folder or --random")
+    try:
+        result = evaluate(None if args.random else args.run, args.episodes, args.seed, env=args.env)
+    except (FileNotFoundError, ValueError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    print(
+        f"{result['policy']} on {result['env_id']}, {args.episodes} episodes "
+        f"(seeds {args.seed}..{args.seed + args.episodes - 1}):"
+    )
+    print(f"  success rate {100 * result['success_rate']:.1f} %  ({result['success']})")
+    print(f"  mean return {result['mean_return']:.1f} ± {result['std_return']:.1f}")
+    print(f"  mean episode length {result['mean_length']:.0f} steps")
+    if result["median_final_distance_m"] is not None:
+        print(f"  median final distance to target {result['median_final_distance_m']:.3f} m")
+    if args.json is not None:
+        args.json.write_text(json.dumps(result, indent=2) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

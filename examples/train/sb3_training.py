@@ -1,0 +1,172 @@
+"""stable-baselines3 training of the presets in training_envs.py: hyperparameters, the
+episode log, and train() that writes a run folder (see train_sb3.py, its command line)."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+from learning_curve import EpisodeLog, plot_learning_curve
+from stable_baselines3 import PPO, SAC
+from stable_baselines3.common.callbacks import BaseCallback
+from stable_baselines3.common.vec_env import DummyVecEnv, VecMonitor, VecNormalize
+from training_envs import check_action, make_success_env, preset, random_policy_baseline
+
+ALGORITHMS = {"ppo": PPO, "sac": SAC}
+
+# Hyperparameters per (env preset, algorithm); tuned only as far as "learns on 2 cores in
+# minutes". n_envs is the number of envs (and SITL processes) stepped together.
+HYPERPARAMETERS: dict[tuple[str, str], dict[str, Any]] = {
+    ("hover", "ppo"): dict(
+        n_envs=4,
+        n_steps=512,
+        batch_size=256,
+        n_epochs=10,
+        learning_rate=3e-4,
+        gamma=0.99,
+        gae_lambda=0.95,
+        policy_kwargs=dict(net_arch=[64, 64]),
+    ),
+    ("lander", "ppo"): dict(
+        n_envs=4,
+        n_steps=1024,
+        batch_size=256,
+        n_epochs=10,
+        learning_rate=3e-4,
+        gamma=0.99,
+        gae_lambda=0.95,
+        policy_kwargs=dict(net_arch=[64, 64]),
+    ),
+    ("hover", "sac"): dict(
+        n_envs=1,
+        learning_rate=3e-4,
+        buffer_size=200_000,
+        batch_size=256,
+        learning_starts=5_000,
+        gamma=0.99,
+        policy_kwargs=dict(net_arch=[64, 64]),
+    ),
+    ("lander", "sac"): dict(
+        n_envs=1,
+        learning_rate=3e-4,
+        buffer_size=200_000,
+        batch_size=256,
+        learning_starts=5_000,
+        gamma=0.99,
+        policy_kwargs=dict(net_arch=[64, 64]),
+    ),
+}
+
+
+class EpisodeRecorder(BaseCallback):
+    """Appends every finished episode (from VecMonitor's info['episode']) to an EpisodeLog."""
+
+    def __init__(self, log: EpisodeLog) -> None:
+        super().__init__()
+        self.log = log
+
+    def _on_step(self) -> bool:
+        for info in self.locals["infos"]:
+            episode = info.get("episode")
+            if episode is not None:
+                self.log.add(
+                    self.num_timesteps, episode["r"], episode["l"], bool(info.get("is_success"))
+                )
+        return True
+
+
+def make_vec_env(
+    env: str, action: str | None, n_envs: int, seed: int, gamma: float
+) -> VecNormalize:
+    """n_envs preset envs (one SITL each), monitored and normalised; env i's first episode
+    has seed `seed + i`."""
+    venv = DummyVecEnv([lambda: make_success_env(env, action=action)] * n_envs)
+    venv.seed(seed)
+    return VecNormalize(VecMonitor(venv), gamma=gamma)
+
+
+def train(
+    env: str,
+    algo: str,
+    timesteps: int,
+    seed: int,
+    out: Path,
+    *,
+    action: str | None = None,
+    progress_bar: bool = True,
+    baseline_episodes: int = 20,
+    n_envs: int | None = None,
+) -> dict[str, Any]:
+    """Trains, saves everything under `out` and returns the summary (also in summary.json)."""
+    torch.set_num_threads(1)
+    p = preset(env)
+    if algo not in ALGORITHMS:
+        raise ValueError(f"unknown algorithm {algo!r}; choose one of {sorted(ALGORITHMS)}")
+    action = check_action(p, action)
+    hyper = dict(HYPERPARAMETERS[(p.name, algo)])
+    n = int(hyper.pop("n_envs"))
+    n = n if n_envs is None else int(n_envs)
+    out.mkdir(parents=True, exist_ok=True)
+
+    random_return, random_success = random_policy_baseline(
+        p.name, episodes=baseline_episodes, seed=10_000 + seed, action=action
+    )
+    print(
+        f"random policy on {p.env_id}: mean return {random_return:.1f}, "
+        f"success {100 * random_success:.0f} % ({baseline_episodes} episodes)"
+    )
+
+    venv = make_vec_env(p.name, action, n, seed, gamma=hyper.get("gamma", 0.99))
+    log = EpisodeLog()
+    try:
+        model = ALGORITHMS[algo](
+            "MlpPolicy",
+            venv,
+            seed=seed,
+            verbose=0,
+            tensorboard_log=str(out / "tb"),
+            device="cpu",
+            **hyper,
+        )
+        start = time.perf_counter()
+        model.learn(
+            total_timesteps=timesteps,
+            callback=EpisodeRecorder(log),
+            progress_bar=progress_bar,
+            tb_log_name=f"{p.name}_{algo}",
+        )
+        wall = time.perf_counter() - start
+        steps = int(model.num_timesteps)
+        model.save(out / "model.zip")
+        venv.save(str(out / "vecnormalize.pkl"))
+    finally:
+        venv.close()
+
+    log.write_csv(out / "episodes.csv")
+    title = f"{algo.upper()} on {p.env_id} (seed {seed}, {n} envs, {steps:,} steps, {wall:.0f} s)"
+    plot_learning_curve(log, out / "learning_curve.png", title=title, random_return=random_return)
+    last = slice(-max(1, len(log) // 10), None)
+    summary = dict(
+        env=p.name,
+        env_id=p.env_id,
+        env_kwargs=dict(p.env_kwargs),
+        action=action,
+        algo=algo,
+        seed=seed,
+        n_envs=n,
+        timesteps=steps,
+        wall_time_s=wall,
+        env_steps_per_s=steps / wall,
+        episodes=len(log),
+        random_mean_return=random_return,
+        random_success_rate=random_success,
+        last_tenth_mean_return=float(np.mean(log.returns[last])) if len(log) else None,
+        last_tenth_success_rate=float(np.mean(log.successes[last])) if len(log) else None,
+        success=p.success_text,
+    )
+    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    return summary

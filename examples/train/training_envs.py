@@ -1,0 +1,186 @@
+"""The envs as the training and evaluation scripts make them: one preset per task, with the
+action wrapper, the env arguments and what counts as a success.
+
+QuadHover is trained on the raw motor commands, rescaled from [0, 1]⁴ to [-1, 1]⁴ so that the
+zero action, where a fresh Gaussian policy starts, is every motor at 0.5 (hover is 0.495),
+at a 20 ms control period (dt=0.02, 250 steps = 5 s per episode). Measured on this machine
+(PPO, seed 0, mean training return after ~100k env steps; see the issue-8 report): raw motors
+at dt=0.02 learned fastest (114 of at most 250); MotionPrimitiveActionWrapper (rescaled the
+same way) reached 50, and at dt=0.01 raw motors, motion primitives and
+ThrustChangeController all learned slower per env step and per second. Lander2D's two
+motors are already in [-1, 1].
+
+The same presets serve stable-baselines3 (train_sb3.py), the evaluation (evaluate.py) and
+RLlib (train_rllib.py), so a model is always evaluated on the env it was trained on.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import flyloop  # noqa: F401  (registers the envs)
+import gymnasium as gym
+import numpy as np
+from flyloop.wrappers import MotionPrimitiveActionWrapper, ThrustChangeController
+
+# A hover episode is a success when it ran to the time limit (no crash, not out of bounds)
+# and ended within this distance of the target.
+HOVER_SUCCESS_DISTANCE_M = 0.5
+
+
+def hover_success(terminated: bool, truncated: bool, info: Mapping[str, Any]) -> bool:
+    return (
+        truncated
+        and not terminated
+        and float(info["distance_to_target"]) < HOVER_SUCCESS_DISTANCE_M
+    )
+
+
+def lander_success(terminated: bool, truncated: bool, info: Mapping[str, Any]) -> bool:
+    return bool(info["landed"])
+
+
+def unit_actions(env: gym.Env) -> gym.Env:
+    """The env's Box actions rescaled to [-1, 1] (float32 bounds)."""
+    unit = np.ones(env.action_space.shape, np.float32)
+    return gym.wrappers.RescaleAction(env, -unit, unit)
+
+
+def motion_primitives(env: gym.Env) -> gym.Env:
+    """[hover, roll, pitch, yaw] in [-1, 1]⁴ (hover 0 = half throttle)."""
+    return unit_actions(MotionPrimitiveActionWrapper(env))
+
+
+# The quadrotor's action interfaces (train_sb3.py --action): what the policy outputs.
+QUAD_ACTIONS: dict[str, Callable[[gym.Env], gym.Env]] = {
+    "motors": unit_actions,
+    "primitives": motion_primitives,
+    "rates": ThrustChangeController,
+}
+
+
+class SuccessInfo(gym.Wrapper):
+    """Sets info['is_success'] on the last step of an episode (stable-baselines3 logs its mean
+    as rollout/success_rate)."""
+
+    def __init__(self, env: gym.Env, success: Callable[[bool, bool, Mapping[str, Any]], bool]):
+        super().__init__(env)
+        self._success = success
+
+    def step(self, action):
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        if terminated or truncated:
+            info = {**info, "is_success": bool(self._success(terminated, truncated, info))}
+        return obs, reward, terminated, truncated, info
+
+
+@dataclass(frozen=True)
+class Preset:
+    name: str
+    env_id: str
+    env_kwargs: Mapping[str, Any]
+    # Action interfaces by name (the first is the default); None: the env's own actions.
+    actions: Mapping[str, Callable[[gym.Env], gym.Env]] | None
+    success: Callable[[bool, bool, Mapping[str, Any]], bool]
+    success_text: str
+
+    @property
+    def default_action(self) -> str | None:
+        return next(iter(self.actions)) if self.actions else None
+
+
+PRESETS: dict[str, Preset] = {
+    "hover": Preset(
+        name="hover",
+        env_id="flyloop/QuadHover-v0",
+        # 5 s episodes (250 steps of 20 ms), the default wind (mean 0–5 m/s + turbulence).
+        env_kwargs={"max_steps": 250, "dt": 0.02},
+        actions=QUAD_ACTIONS,
+        success=hover_success,
+        success_text=(
+            f"reached the time limit (no crash, not out of bounds) within "
+            f"{HOVER_SUCCESS_DISTANCE_M} m of the target"
+        ),
+    ),
+    "lander": Preset(
+        name="lander",
+        env_id="flyloop/Lander2D-v0",
+        env_kwargs={"max_steps": 1000},
+        actions=None,
+        success=lander_success,
+        success_text="landed on the platform (info['landed'])",
+    ),
+}
+
+ALIASES = {
+    "QuadHover": "hover",
+    "flyloop/QuadHover-v0": "hover",
+    "Lander2D": "lander",
+    "flyloop/Lander2D-v0": "lander",
+}
+
+
+def preset(name: str) -> Preset:
+    key = ALIASES.get(name, name)
+    if key not in PRESETS:
+        choices = sorted(PRESETS) + sorted(ALIASES)
+        raise ValueError(f"unknown env {name!r}; choose one of {choices}")
+    return PRESETS[key]
+
+
+def check_action(p: Preset, action: str | None) -> str | None:
+    """The action interface's name (the preset's default for None), or a ValueError."""
+    if action is None:
+        return p.default_action
+    if not p.actions or action not in p.actions:
+        choices = sorted(p.actions) if p.actions else ["its own (leave --action out)"]
+        raise ValueError(f"env {p.name!r} has no action interface {action!r}; choose {choices}")
+    return action
+
+
+def make_env(
+    name: str,
+    *,
+    action: str | None = None,
+    render_mode: str | None = None,
+    overrides: Mapping[str, Any] | None = None,
+) -> gym.Env:
+    """The preset's env with its action interface (default: the preset's first), as it is
+    trained; each env starts its own SITL."""
+    p = preset(name)
+    action = check_action(p, action)
+    kwargs = {**p.env_kwargs, **(overrides or {})}
+    env = gym.make(p.env_id, render_mode=render_mode, **kwargs)
+    return p.actions[action](env) if action is not None else env
+
+
+def make_success_env(name: str, **kwargs: Any) -> gym.Env:
+    """make_env, with info['is_success'] at the end of each episode."""
+    return SuccessInfo(make_env(name, **kwargs), preset(name).success)
+
+
+def random_policy_baseline(
+    name: str, episodes: int, seed: int, action: str | None = None
+) -> tuple[float, float]:
+    """Mean return and success rate of uniformly random actions (the bar training must
+    clear), over `episodes` episodes seeded seed, seed + 1, ..."""
+    env = make_env(name, action=action)
+    rng = np.random.default_rng(seed)
+    p = preset(name)
+    returns, successes = [], 0
+    try:
+        for episode in range(episodes):
+            env.reset(seed=seed + episode)
+            total, done = 0.0, False
+            while not done:
+                action = rng.uniform(env.action_space.low, env.action_space.high).astype(np.float32)
+                _, reward, terminated, truncated, info = env.step(action)
+                total += reward
+                done = terminated or truncated
+            returns.append(total)
+            successes += p.success(terminated, truncated, info)
+    finally:
+        env.close()
+    return float(np.mean(returns)), successes / episodes

@@ -1,0 +1,92 @@
+"""evaluate.py loads what train_sb3.py saved (PPO and SAC, hover and lander), reports success
+rate and mean return, repeats itself exactly, and refuses a folder that holds no run."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from training_support import TRAIN, run_script
+
+
+def train_tiny(out, env, algo, timesteps):
+    """A run folder from a few thousand steps (in this process: no second torch import)."""
+    from sb3_training import train
+
+    return train(env, algo, timesteps, 1, out, progress_bar=False, baseline_episodes=2)
+
+
+def evaluate_cli(run, tmp_path, episodes=3):
+    path = tmp_path / "eval.json"
+    done = run_script(
+        TRAIN / "evaluate.py", str(run), "--episodes", str(episodes), "--json", str(path)
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    return done.stdout, json.loads(path.read_text())
+
+
+@pytest.mark.training
+def test_evaluate_loads_a_saved_ppo_model_and_repeats_exactly(sitl_binary, tmp_path):
+    run = tmp_path / "ppo"
+    summary = train_tiny(run, "hover", "ppo", 2048)
+    assert summary["timesteps"] == 2048 and summary["action"] == "motors"
+
+    stdout, first = evaluate_cli(run, tmp_path)
+    assert "success rate" in stdout and "mean return" in stdout
+    assert first["episodes"] == 3 and first["policy"] == str(run)
+    assert 0.0 <= first["success_rate"] <= 1.0
+    assert np.isfinite(first["mean_return"]) and first["mean_length"] >= 1
+    # Deterministic policy, seeded episodes: a second evaluation gives the same figures.
+    import evaluate
+
+    assert evaluate.evaluate(run, 3) == first
+
+    # The loaded policy acts as the saved one: same normalised observation, same action.
+    from stable_baselines3 import PPO
+
+    loaded = evaluate.SavedRun(run)
+    direct = PPO.load(run / "model.zip", device="cpu")
+    obs = np.zeros(33, np.float32)
+    obs[2] = 1.0  # target 1 m above
+    normalised = loaded.norm.normalize_obs(obs[None, :])
+    expected, _ = direct.predict(normalised, deterministic=True)
+    assert np.array_equal(loaded.act(obs), expected[0])
+    # VecNormalize statistics were saved, not the identity.
+    assert not np.allclose(normalised[0], obs)
+
+
+@pytest.mark.training
+def test_evaluate_loads_sac_and_lander_runs(sitl_binary, tmp_path):
+    import evaluate
+
+    sac = tmp_path / "sac"
+    train_tiny(sac, "hover", "sac", 300)
+    result = evaluate.evaluate(sac, 2)
+    assert result["env_id"] == "flyloop/QuadHover-v0" and np.isfinite(result["mean_return"])
+
+    lander = tmp_path / "lander"
+    summary = train_tiny(lander, "lander", "ppo", 1024)
+    assert summary["action"] is None
+    result = evaluate.evaluate(lander, 2)
+    assert result["env_id"] == "flyloop/Lander2D-v0"
+    assert result["median_final_distance_m"] is None  # hover-only figure
+    assert np.isfinite(result["mean_return"])
+
+
+def test_evaluate_refuses_a_folder_without_a_run(tmp_path):
+    done = run_script(TRAIN / "evaluate.py", str(tmp_path), "--episodes", "1")
+    assert done.returncode == 2
+    assert "summary.json not found" in done.stderr
+
+
+def test_train_refuses_bad_arguments(tmp_path):
+    for args, message in (
+        (["--env", "moon"], "unknown env 'moon'"),
+        (["--env", "lander", "--action", "rates"], "has no action interface 'rates'"),
+        (["--timesteps", "0"], "--timesteps must be > 0"),
+    ):
+        done = run_script(TRAIN / "train_sb3.py", *args, "--out", str(tmp_path / "x"))
+        assert done.returncode == 2, args
+        assert message in done.stderr, done.stderr
+        assert not (tmp_path / "x").exists()
