@@ -84,3 +84,20 @@ pub fn parameter_at<P: Parameters>(
         .and_then(|i| P::specs().get(i as usize))
         .ok_or(ParamError::UnknownValueReference(vr))
 }
+
+/// Test helper: every variable of a table has a unique name, a unique value reference and a
+/// description.
+#[cfg(test)]
+pub(crate) fn assert_names_and_value_references_are_unique(vars: &[Variable]) {
+    let mut names = std::collections::HashSet::new();
+    let mut vrs = std::collections::HashSet::new();
+    for v in vars {
+        assert!(names.insert(v.name), "duplicate name {}", v.name);
+        assert!(
+            vrs.insert(v.value_reference),
+            "duplicate vr {}",
+            v.value_reference
+        );
+        assert!(!v.description.is_empty(), "{} has no description", v.name);
+    }
+}

@@ -311,16 +311,8 @@ mod tests {
         let vars = variables();
         let q = quad();
         let init = QuadrotorInitial::default();
-        let mut names = std::collections::HashSet::new();
-        let mut vrs = std::collections::HashSet::new();
+        crate::variables::assert_names_and_value_references_are_unique(&vars);
         for v in &vars {
-            assert!(names.insert(v.name), "duplicate name {}", v.name);
-            assert!(
-                vrs.insert(v.value_reference),
-                "duplicate vr {}",
-                v.value_reference
-            );
-            assert!(!v.description.is_empty());
             let value = get(&q, &init, v.value_reference).unwrap();
             assert!(value.is_finite(), "{} = {value}", v.name);
             if let Some(start) = v.start {
