@@ -27,6 +27,7 @@ pub mod params;
 pub mod quadrotor;
 pub mod reference;
 pub mod rng;
+pub mod sensors;
 pub mod snapshot;
 pub mod tasks;
 pub mod variables;

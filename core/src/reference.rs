@@ -6,6 +6,7 @@
 use crate::lander2d::{Lander2dInitial, Lander2dParams};
 use crate::params::Parameters;
 use crate::quadrotor::{QuadrotorInitial, QuadrotorParams};
+use crate::sensors::SensorParams;
 use crate::tasks::flight::FlightParams;
 use crate::tasks::landing::LandingParams;
 use crate::tasks::waypoints::WaypointParams;
@@ -22,6 +23,11 @@ pub fn parameter_reference() -> String {
             "Quadrotor start values (`QuadrotorInitial`, FMU only)",
             "Seed and initial state of an FMU instance.",
             QuadrotorInitial::markdown_table(),
+        ),
+        (
+            "Quadrotor sensors (`SensorParams`, PX4 mode)",
+            "Home point, Earth field and noise of the IMU (body FRD), magnetometer, barometer (ISA) and GPS that PX4 reads; the field defaults are the World Magnetic Model at the default home.",
+            SensorParams::markdown_table(),
         ),
         (
             "Hover and Waypoints tasks (`FlightParams`)",
