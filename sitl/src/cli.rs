@@ -83,6 +83,28 @@ pub struct Args {
     #[arg(long, default_value_t = 50.0, value_parser = parse_rate)]
     pub state_rate: f64,
 
+    /// PX4 mode: be PX4's simulator (TCP, HIL_SENSOR / HIL_GPS out, HIL_ACTUATOR_CONTROLS in,
+    /// lockstep); quadrotor only, the Iris preset unless `--config` names another file.
+    #[arg(long)]
+    pub px4: bool,
+
+    /// PX4 mode: TCP address PX4 connects to (PX4 instance k uses port 4560 + k).
+    #[arg(long, default_value = "127.0.0.1:4560")]
+    pub px4_listen: SocketAddr,
+
+    /// PX4 mode: physics step per HIL_ACTUATOR_CONTROLS, s.
+    #[arg(long, default_value_t = 0.004, value_parser = parse_step)]
+    pub px4_step: f64,
+
+    /// PX4 mode: simulation seconds per wall-clock second (0 = as fast as possible). Start PX4
+    /// with the same PX4_SIM_SPEED_FACTOR.
+    #[arg(long, default_value_t = 1.0, value_parser = parse_speed)]
+    pub speed_factor: f64,
+
+    /// PX4 mode: write the ground-truth track (CSV, 50 Hz of simulation time) to this file.
+    #[arg(long)]
+    pub track: Option<PathBuf>,
+
     /// Print the parameter table (MAVLink ids, names, ranges, defaults) and exit.
     #[arg(long)]
     pub list_params: bool,
@@ -134,6 +156,22 @@ fn parse_seconds(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(v) if v > 0.0 && v <= 3600.0 => Ok(v),
         _ => Err(format!("`{s}` is not a number of seconds in (0, 3600]")),
+    }
+}
+
+fn parse_step(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if (1e-4..=0.1).contains(&v) => Ok(v),
+        _ => Err(format!("`{s}` is not a step in [0.0001, 0.1] s")),
+    }
+}
+
+fn parse_speed(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if (0.0..=1000.0).contains(&v) => Ok(v),
+        _ => Err(format!(
+            "`{s}` is not a speed factor in [0, 1000] (0 = as fast as possible)"
+        )),
     }
 }
 
@@ -226,6 +264,20 @@ mod tests {
         assert_eq!(
             parse(&["--task", "landing"]).unwrap().model(),
             ModelKind::Lander2d
+        );
+        assert!(parse(&["--px4-step", "0"]).is_err());
+        assert!(parse(&["--speed-factor", "-1"]).is_err());
+        let a = parse(&[
+            "--px4",
+            "--px4-listen",
+            "127.0.0.1:4561",
+            "--speed-factor",
+            "0",
+        ])
+        .unwrap();
+        assert_eq!(
+            (a.px4, a.px4_listen.port(), a.speed_factor, a.px4_step),
+            (true, 4561, 0.0, 0.004)
         );
         let h = parse(&["--home", "10.5, -20.25, 3"]).unwrap().home;
         assert_eq!(

@@ -5,8 +5,8 @@ use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 /// Standard gravity for milli-g units (mG), m/s².
 pub const STANDARD_GRAVITY: f64 = 9.80665;
-/// Earth radius of the flat-earth projection (WGS-84 equatorial radius), m.
-pub const EARTH_RADIUS: f64 = 6_378_137.0;
+use flyloop_core::sensors::Geodetic;
+pub use flyloop_core::sensors::gps::EARTH_RADIUS;
 
 /// A vehicle's state in the core's frames.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,15 +38,7 @@ fn flu_from_frd() -> UnitQuaternion<f64> {
     UnitQuaternion::new_unchecked(Quaternion::new(0.0, 1.0, 0.0, 0.0))
 }
 
-/// A world ENU vector in NED: (north, east, down) = (y, x, −z).
-pub fn enu_to_ned(v: &Vector3<f64>) -> Vector3<f64> {
-    Vector3::new(v.y, v.x, -v.z)
-}
-
-/// A body FLU vector in FRD: (x, −y, −z).
-pub fn flu_to_frd(v: &Vector3<f64>) -> Vector3<f64> {
-    Vector3::new(v.x, -v.y, -v.z)
-}
+pub use flyloop_core::sensors::frames::{enu_to_ned, flu_to_frd};
 
 /// The attitude body FRD → world NED, in the hemisphere w ≥ 0.
 pub fn attitude_ned(attitude_enu: &UnitQuaternion<f64>) -> UnitQuaternion<f64> {
@@ -82,8 +74,11 @@ impl Kinematics {
     /// What an accelerometer measures (acceleration minus gravity) in body FRD, m/s²: about
     /// (0, 0, −g) in a level hover.
     pub fn specific_force_frd(&self) -> Vector3<f64> {
-        let world = self.acceleration + Vector3::new(0.0, 0.0, self.gravity);
-        flu_to_frd(&self.attitude.inverse_transform_vector(&world))
+        flyloop_core::sensors::imu::specific_force_frd(
+            &self.attitude,
+            &self.acceleration,
+            self.gravity,
+        )
     }
 
     /// Speed relative to the air, m/s.
@@ -129,13 +124,16 @@ impl Home {
     /// lat = lat0 + deg(north / R), lon = lon0 + deg(east / (R cos lat0)), alt = alt0 + up,
     /// with R = [`EARTH_RADIUS`]; each rounded to the nearest integer unit.
     pub fn global(&self, position_enu: &Vector3<f64>) -> GlobalPosition {
-        let lat = self.latitude_deg + (position_enu.y / EARTH_RADIUS).to_degrees();
-        let lon = self.longitude_deg
-            + (position_enu.x / (EARTH_RADIUS * self.latitude_deg.to_radians().cos())).to_degrees();
+        let origin = Geodetic {
+            latitude_deg: self.latitude_deg,
+            longitude_deg: self.longitude_deg,
+            altitude_m: self.altitude_m,
+        };
+        let g = origin.offset(position_enu);
         GlobalPosition {
-            lat: round_i32(lat * 1e7),
-            lon: round_i32(lon * 1e7),
-            alt_mm: round_i32((self.altitude_m + position_enu.z) * 1000.0),
+            lat: round_i32(g.latitude_deg * 1e7),
+            lon: round_i32(g.longitude_deg * 1e7),
+            alt_mm: round_i32(g.altitude_m * 1000.0),
             relative_alt_mm: round_i32(position_enu.z * 1000.0),
         }
     }

@@ -7,7 +7,8 @@
 //! - [`wire`]: frames in and out of datagrams,
 //! - [`kinematics`]: the one place where ENU/FLU becomes NED/FRD,
 //! - [`task_frame`]: the task frame layout (DEBUG_FLOAT_ARRAY),
-//! - [`param_table`], [`param_protocol`], [`config`]: parameters over MAVLink and from TOML.
+//! - [`param_table`], [`param_protocol`], [`config`]: parameters over MAVLink and from TOML,
+//! - [`px4`]: PX4 mode, flyloop as PX4's simulator over TCP.
 
 pub mod cli;
 pub mod commands;
@@ -17,6 +18,7 @@ pub mod kinematics;
 pub mod model;
 pub mod param_protocol;
 pub mod param_table;
+pub mod px4;
 pub mod server;
 pub mod sim;
 pub mod stats;

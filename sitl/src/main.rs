@@ -4,7 +4,12 @@ use clap::Parser;
 use flyloop_core::ParamError;
 use flyloop_sitl::cli::{Args, GcsTarget};
 use flyloop_sitl::config::{self, ConfigError};
-use flyloop_sitl::model::{TaskConfig, TaskInstance, TaskKind};
+use flyloop_sitl::model::{ModelKind, TaskConfig, TaskInstance, TaskKind};
+use flyloop_sitl::px4;
+use flyloop_sitl::px4::config::Px4Config;
+use flyloop_sitl::px4::server::Pacing;
+use flyloop_sitl::px4::session::{Session, SessionOptions};
+use flyloop_sitl::px4::track::Track;
 use flyloop_sitl::server::{self, GcsLink};
 use flyloop_sitl::sim::{Sim, SimOptions};
 use flyloop_sitl::{param_table, task_frame};
@@ -26,6 +31,11 @@ enum StartError {
     Bind {
         link: &'static str,
         addr: SocketAddr,
+        source: std::io::Error,
+    },
+    #[error("cannot write the track file {path}: {source}")]
+    Track {
+        path: std::path::PathBuf,
         source: std::io::Error,
     },
     #[error("cannot start the runtime: {0}")]
@@ -86,7 +96,82 @@ fn describe_frame(task: TaskKind, config: &TaskConfig) -> Result<String, ParamEr
     Ok(out)
 }
 
+/// PX4 mode: the vehicle and sensor parameters, the TCP listener, then PX4 connections until
+/// a signal.
+fn start_px4(args: Args) -> Result<(), StartError> {
+    if args.model() != ModelKind::Quadrotor {
+        return Err(StartError::Options(
+            "--px4 flies the quadrotor only".to_string(),
+        ));
+    }
+    let mut config = match &args.config {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+                path: path.clone(),
+                source,
+            })?;
+            Px4Config::parse(&text).map_err(|source| ConfigError::Invalid {
+                path: path.clone(),
+                source,
+            })?
+        }
+        None => Px4Config::iris(),
+    };
+    config.sensors.home_latitude = args.home.latitude_deg;
+    config.sensors.home_longitude = args.home.longitude_deg;
+    config.sensors.home_altitude = args.home.altitude_m;
+    let step_us = (args.px4_step * 1e6).round() as u64;
+    let mut session = Session::new(&SessionOptions {
+        config,
+        step_us,
+        seed: args.seed,
+    })?;
+    if let Some(path) = &args.track {
+        let track = Track::create(path).map_err(|source| StartError::Track {
+            path: path.clone(),
+            source,
+        })?;
+        session.set_track(track);
+    }
+    let listener =
+        std::net::TcpListener::bind(args.px4_listen).map_err(|source| StartError::Bind {
+            link: "PX4",
+            addr: args.px4_listen,
+            source,
+        })?;
+    listener.set_nonblocking(true)?;
+    let listen = listener.local_addr()?;
+    let speed = args.speed_factor;
+    let ready = format!(
+        "flyloop-sitl ready px4={listen} mode=px4 model=quadrotor step_us={step_us} speed_factor={speed} seed={}",
+        args.seed
+    );
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()?;
+    let session = runtime.block_on(async move {
+        let shutdown = server::Shutdown::install()?;
+        let listener = tokio::net::TcpListener::from_std(listener)?;
+        println!("{ready}");
+        tracing::info!(%listen, speed_factor = speed, "flyloop-sitl waiting for PX4");
+        px4::server::run(
+            session,
+            listener,
+            Pacing {
+                speed_factor: speed,
+            },
+            shutdown,
+        )
+        .await
+    })?;
+    tracing::info!("stopped: {}", session.stats);
+    Ok(())
+}
+
 fn start(args: Args) -> Result<(), StartError> {
+    if args.px4 {
+        return start_px4(args);
+    }
     let task = args.task().map_err(StartError::Options)?;
     let config = match &args.config {
         Some(path) => config::load(task, path)?,

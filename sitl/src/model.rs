@@ -188,7 +188,8 @@ impl TaskInstance {
     }
 }
 
-fn quadrotor_kinematics(q: &flyloop_core::quadrotor::Quadrotor) -> Kinematics {
+/// The state of a core quadrotor as [`Kinematics`].
+pub fn quadrotor_kinematics(q: &flyloop_core::quadrotor::Quadrotor) -> Kinematics {
     let b = &q.body;
     Kinematics {
         position: b.position,

@@ -46,8 +46,8 @@ fn deadline(t: Instant) -> tokio::time::Instant {
 /// SITL is ready, so an early signal still stops it cleanly).
 #[derive(Debug)]
 pub struct Shutdown {
-    interrupt: tokio::signal::unix::Signal,
-    terminate: tokio::signal::unix::Signal,
+    pub(crate) interrupt: tokio::signal::unix::Signal,
+    pub(crate) terminate: tokio::signal::unix::Signal,
 }
 
 impl Shutdown {

@@ -2,7 +2,7 @@
 //! (HIL_STATE_QUATERNION) and the ground-station telemetry. Frames and units follow the
 //! MAVLink spec (world NED, body FRD); the conversion itself lives in [`crate::kinematics`].
 
-use crate::kinematics::{Home, STANDARD_GRAVITY, round_i16, round_u16};
+use crate::kinematics::{Home, Kinematics, STANDARD_GRAVITY, round_i16, round_u16};
 use crate::model::TaskKind;
 use crate::vehicle::Vehicle;
 use mavlink::dialects::common::*;
@@ -35,7 +35,11 @@ pub enum Status {
 /// Ground truth for a controller: attitude (FRD → NED), body rates, global position,
 /// NED velocity, airspeed and the accelerometer's specific force, at simulation time.
 pub fn hil_state_quaternion(v: &Vehicle, home: &Home) -> MavMessage {
-    let k = v.task.kinematics();
+    hil_state_quaternion_of(&v.task.kinematics(), home, v.clock_us)
+}
+
+/// HIL_STATE_QUATERNION of state `k` at simulation time `time_usec` (µs).
+pub fn hil_state_quaternion_of(k: &Kinematics, home: &Home, time_usec: u64) -> MavMessage {
     let q = crate::kinematics::attitude_ned(&k.attitude);
     let rates = k.body_rates_frd();
     let g = home.global(&k.position);
@@ -43,7 +47,7 @@ pub fn hil_state_quaternion(v: &Vehicle, home: &Home) -> MavMessage {
     let acc = k.specific_force_frd() * (1000.0 / STANDARD_GRAVITY);
     let airspeed = round_u16(k.airspeed() * 100.0);
     MavMessage::HIL_STATE_QUATERNION(HIL_STATE_QUATERNION_DATA {
-        time_usec: v.clock_us,
+        time_usec,
         attitude_quaternion: [q.w as f32, q.i as f32, q.j as f32, q.k as f32],
         rollspeed: rates.x as f32,
         pitchspeed: rates.y as f32,

@@ -114,6 +114,82 @@ fn decode_v2(bytes: &[u8]) -> (Result<Incoming, FrameError>, Option<usize>) {
     }
 }
 
+/// Reassembles MAVLink 2 frames from a byte stream (PX4's TCP link), where frames may be
+/// split across reads. Bytes that do not start a frame are skipped up to the next start
+/// marker (one [`FrameError::Garbage`] per run of them); a frame with a bad checksum or an
+/// unknown id is skipped by its start byte only, so a damaged length field cannot swallow the
+/// good frames after it.
+#[derive(Debug, Clone, Default)]
+pub struct StreamDecoder {
+    pending: Vec<u8>,
+}
+
+/// Bytes kept waiting for the rest of a frame at most (a MAVLink 2 frame is at most 280).
+const MAX_PENDING: usize = 1 << 16;
+
+impl StreamDecoder {
+    /// Appends bytes read from the stream.
+    pub fn push(&mut self, bytes: &[u8]) {
+        self.pending.extend_from_slice(bytes);
+        if self.pending.len() > MAX_PENDING {
+            // Only reachable when the peer floods garbage faster than frames are taken out.
+            let cut = self.pending.len() - MAX_PENDING;
+            self.pending.drain(..cut);
+        }
+    }
+
+    /// Bytes waiting for the rest of their frame.
+    pub fn pending(&self) -> usize {
+        self.pending.len()
+    }
+
+    /// Forgets everything buffered (a new connection starts clean).
+    pub fn clear(&mut self) {
+        self.pending.clear();
+    }
+
+    /// The next complete frame (or why bytes were skipped); `None` until more bytes arrive.
+    pub fn next_frame(&mut self) -> Option<Result<Incoming, FrameError>> {
+        let start = self
+            .pending
+            .iter()
+            .position(|&b| b == STX_V2 || b == STX_V1);
+        match start {
+            Some(0) => {}
+            Some(n) => {
+                self.pending.drain(..n);
+                return Some(Err(FrameError::Garbage));
+            }
+            None if self.pending.is_empty() => return None,
+            None => {
+                self.pending.clear();
+                return Some(Err(FrameError::Garbage));
+            }
+        }
+        let (result, used) = if self.pending[0] == STX_V2 {
+            decode_v2(&self.pending)
+        } else {
+            match self
+                .pending
+                .get(1)
+                .map(|&len| usize::from(len) + V1_OVERHEAD)
+            {
+                Some(n) if n <= self.pending.len() => (Err(FrameError::MavlinkV1), Some(n)),
+                _ => (Err(FrameError::Truncated), None),
+            }
+        };
+        let skip = match (&result, used) {
+            // Wait for the rest of the frame.
+            (Err(FrameError::Truncated), None) => return None,
+            (Err(FrameError::BadCrc { .. } | FrameError::UnknownMessage { .. }), _) => 1,
+            (_, Some(n)) => n,
+            (_, None) => 1,
+        };
+        self.pending.drain(..skip);
+        Some(result)
+    }
+}
+
 /// Largest datagram this SITL sends; a longer reply is split at frame boundaries.
 pub const MAX_DATAGRAM: usize = 60_000;
 
@@ -278,5 +354,36 @@ mod tests {
             })
             .collect();
         assert_eq!(seqs, vec![(1, 0), (2, 0), (1, 1)]);
+    }
+
+    #[test]
+    fn a_stream_reassembles_split_frames_and_resyncs_after_damage() {
+        let good = frame(1, &controls());
+        let mut bad_crc = good.clone();
+        let n = bad_crc.len();
+        bad_crc[n - 1] ^= 0x55;
+        let mut bytes = vec![0x00, 0x11, 0x22];
+        bytes.extend(&good);
+        bytes.extend(&bad_crc);
+        bytes.extend(&good);
+        let mut decoder = StreamDecoder::default();
+        let mut got = Vec::new();
+        // Fed one byte at a time: frames split anywhere still come out whole.
+        for b in &bytes {
+            decoder.push(std::slice::from_ref(b));
+            while let Some(f) = decoder.next_frame() {
+                got.push(f);
+            }
+        }
+        let good_frames = got.iter().filter(|f| f.is_ok()).count();
+        assert_eq!(good_frames, 2, "{got:?}");
+        assert_eq!(got[0], Err(FrameError::Garbage));
+        assert!(got.contains(&Err(FrameError::BadCrc { message_id: 93 })));
+        // A frame cut short waits for its end instead of being an error.
+        decoder.push(&good[..good.len() - 3]);
+        assert_eq!(decoder.next_frame(), None);
+        decoder.push(&good[good.len() - 3..]);
+        assert_eq!(decoder.next_frame().unwrap().unwrap().message, controls());
+        assert_eq!(decoder.pending(), 0);
     }
 }

@@ -1,0 +1,189 @@
+//! The TCP side of PX4 mode: accept PX4, pace its lockstep against the wall clock, and live
+//! through PX4 going away (reset, accept the next one).
+
+use super::session::Session;
+use crate::server::Shutdown;
+use std::io;
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+use tokio::io::{AsyncReadExt, AsyncWriteExt};
+use tokio::net::{TcpListener, TcpStream};
+use tokio::time::sleep_until;
+
+/// Wall-clock pacing of simulation time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pacing {
+    /// Simulation seconds per wall second; 0 = as fast as PX4 answers.
+    pub speed_factor: f64,
+}
+
+/// Simulation time a paced run may fall behind the wall clock before it stops trying to
+/// catch up (a stall does not turn into a burst).
+const MAX_LAG: Duration = Duration::from_millis(100);
+/// Before lockstep at `--speed-factor 0`: free steps this many times faster than real time.
+const FREE_RUN_SPEED: f64 = 10.0;
+
+impl Pacing {
+    /// Wall time of one step before lockstep.
+    fn free_step(&self, step_us: u64) -> Duration {
+        let speed = if self.speed_factor > 0.0 {
+            self.speed_factor
+        } else {
+            FREE_RUN_SPEED
+        };
+        Duration::from_secs_f64(step_us as f64 * 1e-6 / speed)
+    }
+}
+
+/// Where the wall clock and simulation time were lined up last.
+#[derive(Debug, Clone, Copy)]
+struct Anchor {
+    wall: Instant,
+    sim_us: u64,
+}
+
+impl Anchor {
+    /// When simulation time `sim_us` is due on the wall clock; re-anchors when far behind.
+    fn due(&mut self, sim_us: u64, speed: f64, now: Instant) -> Instant {
+        let ahead = sim_us.saturating_sub(self.sim_us) as f64 * 1e-6 / speed;
+        let due = self.wall + Duration::from_secs_f64(ahead);
+        if now > due + MAX_LAG {
+            *self = Anchor { wall: now, sim_us };
+            return now;
+        }
+        due
+    }
+}
+
+fn unix_now_us() -> u64 {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_micros() as u64)
+}
+
+/// What ended a connection.
+enum End {
+    Shutdown,
+    Closed(String),
+}
+
+/// Serves PX4 connections one at a time until SIGINT / SIGTERM.
+pub async fn run(
+    mut session: Session,
+    listener: TcpListener,
+    pacing: Pacing,
+    shutdown: Shutdown,
+) -> io::Result<Session> {
+    let Shutdown {
+        mut interrupt,
+        mut terminate,
+    } = shutdown;
+    let mut connections = 0u64;
+    loop {
+        let accepted = tokio::select! {
+            biased;
+            _ = interrupt.recv() => break,
+            _ = terminate.recv() => break,
+            r = listener.accept() => r,
+        };
+        let (stream, peer) = match accepted {
+            Ok(a) => a,
+            Err(e) => {
+                tracing::warn!(error = %e, "accepting a PX4 connection failed");
+                continue;
+            }
+        };
+        connections += 1;
+        tracing::info!(%peer, connection = connections, "PX4 connected");
+        let end = serve(
+            &mut session,
+            stream,
+            &listener,
+            pacing,
+            (&mut interrupt, &mut terminate),
+        )
+        .await;
+        session.flush_track();
+        match end {
+            End::Shutdown => break,
+            End::Closed(why) => {
+                tracing::warn!(
+                    %peer,
+                    time_us = session.time_us(),
+                    steps = session.stats.steps,
+                    "PX4 disconnected ({why}): vehicle reset to its start state, waiting for the next connection"
+                );
+            }
+        }
+    }
+    tracing::info!("stopping on a signal");
+    Ok(session)
+}
+
+type Signals<'a> = (
+    &'a mut tokio::signal::unix::Signal,
+    &'a mut tokio::signal::unix::Signal,
+);
+
+/// One PX4 connection, from its first HIL_SENSOR to its end.
+async fn serve(
+    session: &mut Session,
+    mut stream: TcpStream,
+    listener: &TcpListener,
+    pacing: Pacing,
+    signals: Signals<'_>,
+) -> End {
+    let (interrupt, terminate) = signals;
+    if let Err(e) = stream.set_nodelay(true) {
+        tracing::debug!(error = %e, "TCP_NODELAY not set");
+    }
+    let mut buf = vec![0u8; 16_384];
+    let mut out = Vec::with_capacity(4096);
+    session.connect(unix_now_us(), &mut out);
+    if let Err(e) = stream.write_all(&out).await {
+        return End::Closed(format!("write failed: {e}"));
+    }
+    let free_step = pacing.free_step(session.step_us());
+    let mut next_free = Instant::now() + free_step;
+    let mut anchor: Option<Anchor> = None;
+    loop {
+        out.clear();
+        tokio::select! {
+            biased;
+            _ = interrupt.recv() => return End::Shutdown,
+            _ = terminate.recv() => return End::Shutdown,
+            r = stream.read(&mut buf) => match r {
+                Ok(0) => return End::Closed("connection closed".into()),
+                Ok(n) => {
+                    let start = Instant::now();
+                    let steps = session.receive(&buf[..n], &mut out);
+                    session.stats.handling += start.elapsed();
+                    if steps > 0 && pacing.speed_factor > 0.0 {
+                        let a = anchor.get_or_insert(Anchor { wall: start, sim_us: session.time_us() });
+                        let due = a.due(session.time_us(), pacing.speed_factor, Instant::now());
+                        sleep_until(due.into()).await;
+                    }
+                }
+                Err(e) => return End::Closed(format!("read failed: {e}")),
+            },
+            r = listener.accept() => {
+                if let Ok((second, addr)) = r {
+                    tracing::warn!(peer = %addr, "refused a second PX4 connection: one PX4 is already connected");
+                    drop(second);
+                }
+            },
+            _ = sleep_until(next_free.into()), if !session.is_lockstep() => {
+                session.free_step(&mut out);
+                next_free += free_step;
+                let now = Instant::now();
+                if next_free + MAX_LAG < now {
+                    next_free = now + free_step;
+                }
+            },
+        }
+        if !out.is_empty() {
+            if let Err(e) = stream.write_all(&out).await {
+                return End::Closed(format!("write failed: {e}"));
+            }
+        }
+    }
+}

@@ -1,0 +1,262 @@
+//! One vehicle flown by one PX4 connection, without sockets: bytes from PX4 in, bytes for PX4
+//! out. The server feeds it; tests drive it directly.
+
+use super::config::Px4Config;
+use super::messages;
+use super::track::Track;
+use crate::kinematics::Home;
+use crate::model::quadrotor_kinematics;
+use crate::stats::Stats;
+use crate::telemetry;
+use crate::wire::{Encoder, StreamDecoder};
+use flyloop_core::ParamError;
+use flyloop_core::quadrotor::{BodyState, Quadrotor};
+use flyloop_core::rng::SimRng;
+use flyloop_core::sensors::Sensors;
+use mavlink::dialects::common::{COMMAND_LONG_DATA, MavCmd, MavMessage};
+use nalgebra::Vector3;
+use std::time::Instant;
+
+/// System id of the simulator's messages to PX4.
+const SIMULATOR_SYSTEM: u8 = 1;
+
+/// What a session is built from.
+#[derive(Debug, Clone)]
+pub struct SessionOptions {
+    pub config: Px4Config,
+    /// Physics step per controls message, µs (PX4 expects 4000).
+    pub step_us: u64,
+    /// Seed of the vehicle's and the sensors' random generators.
+    pub seed: u64,
+}
+
+/// The vehicle, its sensors and PX4's lockstep state.
+#[derive(Debug)]
+pub struct Session {
+    start: (Quadrotor, Sensors),
+    quad: Quadrotor,
+    sensors: Sensors,
+    home: Home,
+    step_us: u64,
+    /// Simulation time of the latest HIL_SENSOR, µs (> 0: PX4 refuses time 0).
+    time_us: u64,
+    /// Whether PX4's first HIL_ACTUATOR_CONTROLS has arrived (from then on: lockstep).
+    lockstep: bool,
+    /// HIL_STATE_QUATERNION interval PX4 asked for, µs.
+    state_interval_us: Option<u64>,
+    next_state_us: u64,
+    /// UNIX time of simulation time 0 for HIL_GPS, µs.
+    gps_epoch_us: u64,
+    decoder: StreamDecoder,
+    encoder: Encoder,
+    /// Ground-truth CSV (`--track`), if any.
+    track: Option<Track>,
+    pub stats: Stats,
+}
+
+impl Session {
+    /// The vehicle at rest on the ground at the origin, facing north.
+    pub fn new(options: &SessionOptions) -> Result<Self, ParamError> {
+        let c = &options.config;
+        let body = BodyState::at_rest(Vector3::zeros(), 0.0, 0.0, std::f64::consts::FRAC_PI_2, 0.0);
+        let mut quad = Quadrotor::new(c.quadrotor.clone(), body, SimRng::new(options.seed))?;
+        // One step with the motors off puts it onto the ground plane, so the first HIL_SENSOR
+        // already feels the ground carrying it (−g, not free fall).
+        quad.step(options.step_us.max(1) as f64 * 1e-6);
+        let sensors = Sensors::new(c.sensors.clone(), options.seed)?;
+        let home = Home {
+            latitude_deg: c.sensors.home_latitude,
+            longitude_deg: c.sensors.home_longitude,
+            altitude_m: c.sensors.home_altitude,
+        };
+        Ok(Session {
+            start: (quad.clone(), sensors.clone()),
+            quad,
+            sensors,
+            home,
+            step_us: options.step_us.max(1),
+            time_us: 0,
+            lockstep: false,
+            state_interval_us: None,
+            next_state_us: 0,
+            gps_epoch_us: 0,
+            decoder: StreamDecoder::default(),
+            encoder: Encoder::default(),
+            track: None,
+            stats: Stats::default(),
+        })
+    }
+
+    /// A new PX4 connection: the vehicle and sensors back to their start state, time back to
+    /// the first step, and the first HIL_SENSOR appended to `out`. `gps_epoch_us` is the UNIX
+    /// time (µs) HIL_GPS counts from.
+    pub fn connect(&mut self, gps_epoch_us: u64, out: &mut Vec<u8>) {
+        self.quad = self.start.0.clone();
+        self.sensors = self.start.1.clone();
+        self.time_us = self.step_us;
+        self.lockstep = false;
+        self.state_interval_us = None;
+        self.next_state_us = 0;
+        self.gps_epoch_us = gps_epoch_us;
+        self.decoder.clear();
+        if let Some(track) = &mut self.track {
+            let result = track.connect();
+            self.track_result(result);
+        }
+        self.emit(out);
+    }
+
+    /// Writes the ground truth to `track` from now on.
+    pub fn set_track(&mut self, track: Track) {
+        self.track = Some(track);
+    }
+
+    /// Writes out buffered track rows (on disconnect and shutdown).
+    pub fn flush_track(&mut self) {
+        if let Some(track) = &mut self.track {
+            let result = track.flush();
+            self.track_result(result);
+        }
+    }
+
+    /// A failed track write is logged once and ends the track; the flight goes on.
+    fn track_result(&mut self, result: std::io::Result<()>) {
+        if let Err(e) = result {
+            tracing::error!(error = %e, "writing the track failed: track stopped");
+            self.track = None;
+        }
+    }
+
+    /// Whether PX4 drives the steps (its first controls have arrived).
+    pub fn is_lockstep(&self) -> bool {
+        self.lockstep
+    }
+
+    /// Simulation time of the latest HIL_SENSOR, µs.
+    pub fn time_us(&self) -> u64 {
+        self.time_us
+    }
+
+    /// Physics step, µs.
+    pub fn step_us(&self) -> u64 {
+        self.step_us
+    }
+
+    /// The simulated vehicle.
+    pub fn quadrotor(&self) -> &Quadrotor {
+        &self.quad
+    }
+
+    /// The home point (local origin).
+    pub fn home(&self) -> &Home {
+        &self.home
+    }
+
+    /// Before lockstep: one step on the simulator's own clock (motors as last commanded,
+    /// off until PX4 speaks), sensors appended to `out`.
+    pub fn free_step(&mut self, out: &mut Vec<u8>) {
+        self.advance(out);
+    }
+
+    /// Bytes from PX4. Each HIL_ACTUATOR_CONTROLS is one step, answered in `out`; returns the
+    /// number of steps taken.
+    pub fn receive(&mut self, bytes: &[u8], out: &mut Vec<u8>) -> u32 {
+        self.stats.datagrams += 1;
+        self.decoder.push(bytes);
+        let mut steps = 0;
+        while let Some(frame) = self.decoder.next_frame() {
+            let incoming = match frame {
+                Ok(incoming) => incoming,
+                Err(e) => {
+                    self.stats.count_frame_error(e);
+                    tracing::debug!(?e, "bad bytes from PX4 skipped");
+                    continue;
+                }
+            };
+            self.stats.frames += 1;
+            match incoming.message {
+                MavMessage::HIL_ACTUATOR_CONTROLS(c) => {
+                    self.apply_controls(&c.controls);
+                    if !self.lockstep {
+                        tracing::info!(time_us = self.time_us, "first controls from PX4: lockstep");
+                        self.lockstep = true;
+                    }
+                    self.advance(out);
+                    steps += 1;
+                }
+                MavMessage::COMMAND_LONG(c) => self.command(&c),
+                _ => self.stats.ignored_messages += 1,
+            }
+        }
+        steps
+    }
+
+    /// Motor commands from controls[0..4]; a non-finite one refuses the whole set (counted),
+    /// and the previous command holds.
+    fn apply_controls(&mut self, controls: &[f32; 16]) {
+        let command = [0, 1, 2, 3].map(|i| f64::from(controls[i]));
+        if let Err(e) = self.quad.set_command(command) {
+            self.stats.refused_controls += 1;
+            tracing::warn!(
+                refused = self.stats.refused_controls,
+                "controls from PX4 skipped: {e}"
+            );
+        }
+    }
+
+    /// SET_MESSAGE_INTERVAL for HIL_STATE_QUATERNION (PX4 asks for it on connect); other
+    /// commands need no answer from a simulator.
+    fn command(&mut self, c: &COMMAND_LONG_DATA) {
+        let is_state = c.param1 == telemetry::id::HIL_STATE_QUATERNION as f32;
+        if c.command != MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL || !is_state {
+            self.stats.ignored_messages += 1;
+            return;
+        }
+        self.state_interval_us = (c.param2.is_finite() && c.param2 >= 0.0).then(|| {
+            // 0 means "the default rate": every step.
+            (c.param2 as u64).max(self.step_us)
+        });
+        self.next_state_us = self.time_us;
+    }
+
+    /// One physics step, then the sensors of the new time.
+    fn advance(&mut self, out: &mut Vec<u8>) {
+        let start = Instant::now();
+        self.quad.step(self.step_us as f64 * 1e-6);
+        self.time_us += self.step_us;
+        self.stats.steps += 1;
+        self.emit(out);
+        self.stats.physics += start.elapsed();
+    }
+
+    /// HIL_SENSOR now, HIL_GPS when a fix is delivered, HIL_STATE_QUATERNION when due.
+    fn emit(&mut self, out: &mut Vec<u8>) {
+        let dt = self.step_us as f64 * 1e-6;
+        let reading = self.sensors.sample(&self.quad, dt);
+        let sensor = messages::hil_sensor(&reading, self.time_us);
+        self.encoder.push(out, SIMULATOR_SYSTEM, &sensor);
+        if let Some(track) = &mut self.track {
+            let result = track.record(self.time_us, &self.quad);
+            self.track_result(result);
+        }
+        if let Some(fix) = self.sensors.gps(&self.quad, self.time_us as f64 * 1e-6) {
+            let stamp = self.gps_epoch_us + (fix.measured_at * 1e6).round() as u64;
+            self.encoder
+                .push(out, SIMULATOR_SYSTEM, &messages::hil_gps(&fix, stamp));
+        }
+        if let Some(interval) = self.state_interval_us {
+            if self.time_us >= self.next_state_us {
+                let k = quadrotor_kinematics(&self.quad);
+                let state = telemetry::hil_state_quaternion_of(&k, &self.home, self.time_us);
+                self.encoder.push(out, SIMULATOR_SYSTEM, &state);
+                self.next_state_us += interval;
+                if self.next_state_us <= self.time_us {
+                    self.next_state_us = self.time_us + interval;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,84 @@
+//! The flight track of PX4 mode (`--track FILE`): ground truth as CSV, one row every
+//! [`TRACK_INTERVAL_US`] of simulation time, for plots and for checking PX4's estimate.
+//!
+//! Columns: `connection` (1 for the first PX4, 2 after a reconnect, …), `time_us` (simulation
+//! time = PX4's clock), `north,east,down` (m from home), `vn,ve,vd` (m/s),
+//! `roll,pitch,yaw` (rad, FRD → NED), `m0..m3` (motor states in [0, 1]), `grounded` (0/1).
+
+use crate::kinematics::{attitude_ned, enu_to_ned};
+use flyloop_core::quadrotor::Quadrotor;
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::Path;
+
+/// Simulation time between two rows, µs (50 Hz).
+pub const TRACK_INTERVAL_US: u64 = 20_000;
+
+/// The CSV header line.
+pub const HEADER: &str =
+    "connection,time_us,north,east,down,vn,ve,vd,roll,pitch,yaw,m0,m1,m2,m3,grounded";
+
+/// A track file being written.
+#[derive(Debug)]
+pub struct Track {
+    out: BufWriter<File>,
+    next_us: u64,
+    connection: u32,
+}
+
+impl Track {
+    /// Creates (truncates) `path` and writes the header.
+    pub fn create(path: &Path) -> io::Result<Self> {
+        let mut out = BufWriter::new(File::create(path)?);
+        writeln!(out, "{HEADER}")?;
+        Ok(Track {
+            out,
+            next_us: 0,
+            connection: 0,
+        })
+    }
+
+    /// A new PX4 connection: rows from now on carry its number.
+    pub fn connect(&mut self) -> io::Result<()> {
+        self.connection += 1;
+        self.next_us = 0;
+        self.out.flush()
+    }
+
+    /// Appends a row for `quad` at `time_us` when one is due.
+    pub fn record(&mut self, time_us: u64, quad: &Quadrotor) -> io::Result<()> {
+        if time_us < self.next_us {
+            return Ok(());
+        }
+        self.next_us = time_us + TRACK_INTERVAL_US;
+        let b = &quad.body;
+        let p = enu_to_ned(&b.position);
+        let v = enu_to_ned(&b.velocity);
+        let (roll, pitch, yaw) = attitude_ned(&quad.attitude()).euler_angles();
+        let m = b.motors;
+        writeln!(
+            self.out,
+            "{},{time_us},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.5},{:.5},{:.5},{:.4},{:.4},{:.4},{:.4},{}",
+            self.connection,
+            p.x,
+            p.y,
+            p.z,
+            v.x,
+            v.y,
+            v.z,
+            roll,
+            pitch,
+            yaw,
+            m[0],
+            m[1],
+            m[2],
+            m[3],
+            u8::from(quad.is_grounded())
+        )
+    }
+
+    /// Writes buffered rows out.
+    pub fn flush(&mut self) -> io::Result<()> {
+        self.out.flush()
+    }
+}
