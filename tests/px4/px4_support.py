@@ -1,0 +1,323 @@
+"""A real PX4 SITL flying flyloop-sitl: finding PX4, starting both on ports that cannot clash,
+commanding PX4 with pymavlink, and reading flyloop's ground-truth track.
+
+PX4 comes from $FLYLOOP_PX4: an unpacked PX4 SITL build (a directory with bin/px4 and etc/),
+a release tarball, or a directory holding one. Without it the PX4 tests skip with one line
+saying how to get PX4; with FLYLOOP_REQUIRE_PX4=1 (set by .ci/run) a missing PX4 fails them.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+import signal
+import socket
+import subprocess
+import tarfile
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+os.environ["MAVLINK20"] = "1"
+from pymavlink import mavutil  # noqa: E402
+
+HOW_TO_GET_PX4 = (
+    "PX4 tests need a PX4 SITL build: build PX4-Autopilot's px4_sitl_default (v1.14 or later) "
+    "and set FLYLOOP_PX4 to its build/px4_sitl_default directory (or to a SITL tarball)"
+)
+EARTH_RADIUS = 6_378_137.0
+HOME = (47.397742, 8.545594, 488.0)
+# Simulation seconds per wall second for flyloop and PX4 in the tests.
+SPEED = 4
+# Takeoff height above home, m (PX4's MIS_TAKEOFF_ALT).
+TAKEOFF_ALT = 5.0
+
+
+def px4_root(unpack_into: Path) -> Path:
+    """The PX4 directory (with bin/px4 and etc/) from $FLYLOOP_PX4, unpacking a tarball."""
+    given = os.environ.get("FLYLOOP_PX4", "")
+    if not given:
+        if os.environ.get("FLYLOOP_REQUIRE_PX4") == "1":
+            pytest.fail(f"FLYLOOP_REQUIRE_PX4=1 but FLYLOOP_PX4 is not set. {HOW_TO_GET_PX4}")
+        pytest.skip(HOW_TO_GET_PX4)
+    path = Path(given).resolve()
+    for candidate in (path, path / "px4"):
+        if (candidate / "bin" / "px4").exists():
+            return candidate
+    tarballs = [path] if path.is_file() else sorted(path.glob("px4-sitl-*.tar.xz"))
+    if not tarballs:
+        pytest.fail(f"FLYLOOP_PX4={given} holds neither bin/px4 nor a px4-sitl-*.tar.xz")
+    with tarfile.open(tarballs[0]) as tar:
+        tar.extractall(unpack_into, filter="tar")
+    return unpack_into / "px4"
+
+
+def _free(kind: int, port: int) -> bool:
+    with socket.socket(socket.AF_INET, kind) as s:
+        try:
+            s.bind(("127.0.0.1", port))
+        except OSError:
+            return False
+    return True
+
+
+def free_instance() -> int:
+    """A PX4 instance number whose simulator port (4560 + i), MAVLink ports (14580 + i,
+    18570 + i, 14280 + i, 13030 + i) and server socket are all free right now."""
+    for _ in range(200):
+        i = 10 + int.from_bytes(os.urandom(2), "little") % 240  # MAV_SYS_ID = i + 1 ≤ 251
+        if Path(f"/tmp/px4-sock-{i}").exists():
+            continue
+        if _free(socket.SOCK_STREAM, 4560 + i) and all(
+            _free(socket.SOCK_DGRAM, p) for p in (14580 + i, 18570 + i, 14280 + i, 13030 + i)
+        ):
+            return i
+    raise RuntimeError("no free PX4 instance found")
+
+
+def stop(proc: subprocess.Popen, sig: int = signal.SIGTERM, timeout: float = 10) -> None:
+    """Stops a process by its PID (SIGKILL if it does not go)."""
+    if proc.poll() is None:
+        proc.send_signal(sig)
+        try:
+            proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+class Flyloop:
+    """flyloop-sitl in PX4 mode, writing its ground-truth track."""
+
+    def __init__(self, binary: Path, instance: int, workdir: Path, *args: str):
+        self.track = workdir / "track.csv"
+        self.log = open(workdir / "flyloop.log", "w+")
+        self.proc = subprocess.Popen(
+            [
+                str(binary),
+                "--px4",
+                "--px4-listen",
+                f"127.0.0.1:{4560 + instance}",
+                "--speed-factor",
+                str(SPEED),
+                "--track",
+                str(self.track),
+                *args,
+            ],
+            stdout=subprocess.PIPE,
+            stderr=self.log,
+            text=True,
+        )
+        line = self.proc.stdout.readline()
+        if not line.startswith("flyloop-sitl ready "):
+            stop(self.proc)
+            raise RuntimeError(f"flyloop-sitl did not start: {line!r} {self.stderr()}")
+        self.ready = dict(kv.split("=", 1) for kv in line.split()[2:])
+
+    def stderr(self) -> str:
+        self.log.flush()
+        return Path(self.log.name).read_text()
+
+    def rows(self) -> list[dict[str, float]]:
+        with open(self.track) as f:
+            return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+
+    def stop(self) -> int:
+        stop(self.proc)
+        return self.proc.returncode
+
+
+class Px4:
+    """A PX4 SITL instance in its own working directory, and a pymavlink link to it."""
+
+    def __init__(self, root: Path, instance: int, workdir: Path):
+        self.instance = instance
+        workdir.mkdir(parents=True, exist_ok=True)
+        env = dict(
+            os.environ,
+            PX4_SYS_AUTOSTART="10016",
+            PX4_SIM_MODEL="none_iris",
+            PX4_SIM_SPEED_FACTOR=str(SPEED),
+            PX4_PARAM_COM_RC_IN_MODE="4",
+            # Takeoff height relative to home: a GPS altitude sample at arming cannot offset it.
+            PX4_PARAM_MIS_TAKEOFF_ALT=str(TAKEOFF_ALT),
+        )
+        self.log = open(workdir / "px4.log", "w+")
+        self.proc = subprocess.Popen(
+            [
+                str(root / "bin" / "px4"),
+                "-d",
+                "-i",
+                str(instance),
+                "-w",
+                str(workdir),
+                str(root / "etc"),
+            ],
+            cwd=workdir,
+            env=env,
+            stdin=subprocess.DEVNULL,
+            stdout=self.log,
+            stderr=subprocess.STDOUT,
+        )
+        # PX4's offboard link listens on 14580 + i and answers whoever talks to it (its
+        # default partner port is shared by instances above 9), so the test talks first.
+        self.link = mavutil.mavlink_connection(
+            f"udpout:127.0.0.1:{14580 + instance}", source_system=245, dialect="common"
+        )
+        self.target = 1 + instance
+        self.last_beat = 0.0
+
+    def output(self) -> str:
+        self.log.flush()
+        return Path(self.log.name).read_text()
+
+    def kill(self) -> None:
+        # SIGKILL: PX4 ignores SIGTERM while it waits for a simulator.
+        stop(self.proc, signal.SIGKILL)
+        self.link.close()
+
+    def wait_for(self, what: str, predicate, timeout: float, types=None):
+        """The first message (of `types`) for which `predicate` holds, or a failure naming
+        `what`."""
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            if self.proc.poll() is not None:
+                tail = self.output()[-3000:]
+                raise AssertionError(f"PX4 exited while waiting for {what}:\n{tail}")
+            if time.monotonic() - self.last_beat > 0.5:
+                self.last_beat = time.monotonic()
+                self.link.mav.heartbeat_send(
+                    mavutil.mavlink.MAV_TYPE_GCS, mavutil.mavlink.MAV_AUTOPILOT_INVALID, 0, 0, 0
+                )
+            m = self.link.recv_match(type=types, blocking=True, timeout=0.2)
+            if m is not None and predicate(m):
+                return m
+        raise AssertionError(f"timed out waiting for {what}:\n{self.output()[-3000:]}")
+
+    def command(self, command: int, *params: float) -> None:
+        p = list(params) + [0.0] * (7 - len(params))
+        self.link.mav.command_long_send(self.target, 1, command, 0, *p)
+
+    def armed(self, hb) -> bool:
+        return bool(hb.base_mode & mavutil.mavlink.MAV_MODE_FLAG_SAFETY_ARMED)
+
+    def heartbeat(self, timeout: float):
+        """PX4's first heartbeat; its system id becomes the target of commands."""
+        hb = self.wait_for(
+            "a heartbeat",
+            lambda m: m.autopilot == mavutil.mavlink.MAV_AUTOPILOT_PX4,
+            timeout,
+            "HEARTBEAT",
+        )
+        self.target = hb.get_srcSystem()
+        return hb
+
+    def arm_when_ready(self, timeout: float) -> None:
+        """Arms as soon as PX4 accepts (its estimator needs GPS and a few seconds)."""
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            self.command(mavutil.mavlink.MAV_CMD_COMPONENT_ARM_DISARM, 1)
+            try:
+                self.wait_for(
+                    "arming",
+                    lambda m: (
+                        m.command == mavutil.mavlink.MAV_CMD_COMPONENT_ARM_DISARM and m.result == 0
+                    ),
+                    1.0,
+                    "COMMAND_ACK",
+                )
+                return
+            except AssertionError:
+                time.sleep(0.5)
+        raise AssertionError(f"PX4 did not arm:\n{self.output()[-3000:]}")
+
+    def takeoff(self) -> None:
+        """Takeoff to MIS_TAKEOFF_ALT above home, here."""
+        nan = float("nan")
+        self.command(mavutil.mavlink.MAV_CMD_NAV_TAKEOFF, -1, 0, 0, nan, nan, nan, nan)
+
+    def reposition(self, north: float, east: float) -> None:
+        """Go to a point `north`, `east` metres from home at the current altitude (COMMAND_INT
+        keeps degE7 exact; altitude NaN keeps the current one)."""
+        lat = HOME[0] + math.degrees(north / EARTH_RADIUS)
+        lon = HOME[1] + math.degrees(east / (EARTH_RADIUS * math.cos(math.radians(HOME[0]))))
+        self.link.mav.command_int_send(
+            self.target,
+            1,
+            mavutil.mavlink.MAV_FRAME_GLOBAL,
+            mavutil.mavlink.MAV_CMD_DO_REPOSITION,
+            0,
+            0,
+            -1,
+            1,
+            0,
+            float("nan"),
+            round(lat * 1e7),
+            round(lon * 1e7),
+            float("nan"),
+        )
+
+    def land(self) -> None:
+        self.command(mavutil.mavlink.MAV_CMD_NAV_LAND)
+
+
+@dataclass
+class Hold:
+    """PX4's local position estimate over a hold, and flyloop's truth at the same times."""
+
+    estimate: list[tuple[int, float, float, float]]  # time_boot_ms, north, east, down
+
+    def worst(self, target: tuple[float, float, float]) -> tuple[float, float]:
+        """Largest horizontal and vertical distance of the estimate from `target`."""
+        h = max(math.hypot(n - target[0], e - target[1]) for _, n, e, _ in self.estimate)
+        v = max(abs(d - target[2]) for _, _, _, d in self.estimate)
+        return h, v
+
+
+def collect(px4: Px4, seconds: float) -> Hold:
+    """PX4's LOCAL_POSITION_NED over `seconds` of PX4 time."""
+    samples: list[tuple[int, float, float, float]] = []
+    start = None
+    while True:
+        m = px4.wait_for("position estimates", lambda m: True, 30, "LOCAL_POSITION_NED")
+        start = m.time_boot_ms if start is None else start
+        samples.append((m.time_boot_ms, m.x, m.y, m.z))
+        if m.time_boot_ms - start >= seconds * 1000:
+            return Hold(samples)
+
+
+def settle(px4: Px4, target: tuple[float, float, float], tolerance: float, timeout: float) -> None:
+    """Waits until PX4's estimate is within `tolerance` of `target` and nearly still."""
+    last = []
+
+    def arrived(m) -> bool:
+        last[:] = [m]
+        return math.dist((m.x, m.y, m.z), target) < tolerance and math.hypot(m.vx, m.vy, m.vz) < 0.2
+
+    try:
+        px4.wait_for(f"arrival at {target}", arrived, timeout, "LOCAL_POSITION_NED")
+    except AssertionError as e:
+        raise AssertionError(f"last estimate {last}: {e}") from None
+
+
+def truth_vs_estimate(rows: list[dict[str, float]], hold: Hold, connection: int) -> float:
+    """Largest distance between PX4's estimate and flyloop's ground truth at the same time
+    (PX4's clock is flyloop's simulation time; the truth is interpolated between rows)."""
+    rows = [r for r in rows if r["connection"] == connection]
+    times = [r["time_us"] / 1000 for r in rows]
+    worst = 0.0
+    for t, n, e, d in hold.estimate:
+        i = next(k for k in range(1, len(times)) if times[k] >= t)
+        a, b = rows[i - 1], rows[i]
+        w = (t - times[i - 1]) / (times[i] - times[i - 1])
+        truth = [a[k] + w * (b[k] - a[k]) for k in ("north", "east", "down")]
+        worst = max(worst, math.dist(truth, (n, e, d)))
+    return worst
+
+
+def fresh_dir(prefix: str) -> Path:
+    return Path(tempfile.mkdtemp(prefix=prefix))

@@ -1,0 +1,129 @@
+"""PX4 mode's TCP link with a hand-driven peer over real sockets (no PX4 needed): the
+lockstep rule, bad bytes, NaN controls, a refused second connection and a reconnect."""
+
+from __future__ import annotations
+
+import os
+import socket
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+import pytest
+
+os.environ["MAVLINK20"] = "1"
+from px4_support import stop  # noqa: E402
+from pymavlink.dialects.v20 import common as mavlink2  # noqa: E402
+
+
+class Peer:
+    """A fake PX4: a TCP client that decodes what the simulator sends."""
+
+    def __init__(self, address: tuple[str, int]):
+        self.sock = socket.create_connection(address, timeout=5)
+        self.mav = mavlink2.MAVLink(None, srcSystem=1)
+        self.mav.robust_parsing = True
+        self.pending: list = []
+
+    def messages(self, wanted: int, kind: str = "HIL_SENSOR") -> list:
+        """The next `wanted` messages of `kind` (later ones stay queued)."""
+        while len([m for m in self.pending if m.get_type() == kind]) < wanted:
+            data = self.sock.recv(65536)
+            assert data, "the simulator closed the connection"
+            self.pending += self.mav.parse_buffer(data) or []
+        out = [m for m in self.pending if m.get_type() == kind][:wanted]
+        self.pending = self.pending[self.pending.index(out[-1]) + 1 :]
+        return out
+
+    def controls(self, value: float) -> bytes:
+        m = mavlink2.MAVLink_hil_actuator_controls_message(
+            0, [value] * 4 + [0.0] * 12, mavlink2.MAV_MODE_FLAG_SAFETY_ARMED, 1
+        )
+        return m.pack(self.mav)
+
+    def drain(self) -> None:
+        self.pending = []
+        self.sock.settimeout(0.2)
+        try:
+            while self.sock.recv(65536):
+                pass
+        except TimeoutError:
+            pass
+        self.sock.settimeout(5)
+
+
+@pytest.fixture
+def simulator(sitl_binary):
+    log = tempfile.NamedTemporaryFile("w+", prefix="px4-link-", suffix=".log", delete=False)
+    proc = subprocess.Popen(
+        [str(sitl_binary), "--px4", "--px4-listen", "127.0.0.1:0", "--speed-factor", "0"],
+        stdout=subprocess.PIPE,
+        stderr=log,
+        text=True,
+    )
+    line = proc.stdout.readline()
+    assert line.startswith("flyloop-sitl ready "), line
+    ready = dict(kv.split("=", 1) for kv in line.split()[2:])
+    host, port = ready["px4"].rsplit(":", 1)
+
+    def logged() -> str:
+        log.flush()
+        return Path(log.name).read_text()
+
+    yield (host, int(port)), proc, logged
+    stop(proc)
+
+
+def wait_for_log(logged, text: str) -> None:
+    deadline = time.monotonic() + 5
+    while text not in logged() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert text in logged(), logged()
+
+
+def test_lockstep_bad_input_second_connection_and_reconnect(simulator):
+    address, proc, logged = simulator
+    peer = Peer(address)
+    # Before any controls the simulator sends sensors on its own (never waits for PX4).
+    first = peer.messages(3)
+    assert [m.time_usec for m in first] == [4000, 8000, 12000]
+    assert abs(first[0].zacc + 9.81) < 0.5 and first[0].fields_updated == 0x1BFF
+
+    # Controls: from now on exactly one HIL_SENSOR per controls message, 4 ms apart.
+    peer.sock.sendall(peer.controls(0.0))
+    peer.drain()
+    for _ in range(3):
+        peer.sock.sendall(peer.controls(0.2))
+    got = peer.messages(3)
+    assert [b.time_usec - a.time_usec for a, b in zip(got, got[1:], strict=False)] == [4000, 4000]
+    peer.sock.settimeout(0.3)
+    with pytest.raises(TimeoutError):
+        peer.sock.recv(65536)  # lockstep: nothing more without controls
+    peer.sock.settimeout(5)
+
+    # Garbage, a frame split in two writes and NaN controls: skipped or held, lockstep lives.
+    frame = peer.controls(0.3)
+    peer.sock.sendall(b"\x00\x13garbage" + frame[:7])
+    time.sleep(0.05)
+    peer.sock.sendall(frame[7:] + peer.controls(float("nan")))
+    assert len(peer.messages(2)) == 2
+
+    # A second connection while one is active is refused with a log line.
+    other = socket.create_connection(address, timeout=5)
+    assert other.recv(100) == b""
+    other.close()
+    wait_for_log(logged, "refused a second PX4 connection")
+
+    # PX4 goes away: logged, the vehicle reset, the next connection starts over.
+    peer.sock.close()
+    wait_for_log(logged, "PX4 disconnected")
+    again = Peer(address)
+    assert again.messages(1)[0].time_usec == 4000
+    again.sock.close()
+    assert proc.poll() is None
+    stop(proc)
+    stats = logged().split("stopped: ", 1)[1]
+    counts = dict(kv.split("=") for kv in stats.split())
+    assert int(counts["garbage"]) >= 1
+    assert int(counts["refused_controls"]) == 1
