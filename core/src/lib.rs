@@ -32,7 +32,7 @@ pub mod snapshot;
 pub mod tasks;
 pub mod variables;
 
-pub use error::ParamError;
+pub use error::{InputError, ParamError};
 pub use params::{ParamSpec, Parameters, ValueKind};
 pub use rng::SimRng;
 pub use snapshot::SnapshotError;

@@ -1,5 +1,6 @@
 //! Byte snapshots of a whole model or task state (for the Lander2D: rapier world, RNG,
-//! battery, counters and contact flags).
+//! battery, counters and contact flags), and the one envelope every byte state of flyloop
+//! uses (the FMU's fmi2FMUstate bytes too, under their own tag).
 //!
 //! Layout: an 8-byte tag naming the format and its version, the payload length (u64 LE), the
 //! postcard payload, and an FNV-1a 64 checksum of the payload (u64 LE). postcard stores every
@@ -8,50 +9,29 @@
 
 use serde::Serialize;
 use serde::de::DeserializeOwned;
-use std::fmt;
 
 /// Why a snapshot could not be written or read back.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum SnapshotError {
     /// The bytes do not start with the expected format tag (another format or version).
+    #[error("not a {expected} snapshot (unknown format tag or version)")]
     WrongFormat { expected: &'static str },
     /// The bytes end before the length they announce, or go on past it.
+    #[error("snapshot payload announces {announced} bytes but {available} are present")]
     WrongLength { announced: u64, available: u64 },
     /// The payload does not match its checksum.
+    #[error("snapshot payload is damaged (checksum mismatch)")]
     Checksum,
     /// The payload does not decode into the state.
+    #[error("snapshot payload does not decode: {0}")]
     Decode(String),
     /// The payload decodes but does not describe a usable state.
+    #[error("snapshot describes an invalid state: {0}")]
     Invalid(String),
     /// The state could not be encoded.
+    #[error("state could not be encoded: {0}")]
     Encode(String),
 }
-
-impl fmt::Display for SnapshotError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            SnapshotError::WrongFormat { expected } => {
-                write!(
-                    f,
-                    "not a {expected} snapshot (unknown format tag or version)"
-                )
-            }
-            SnapshotError::WrongLength {
-                announced,
-                available,
-            } => write!(
-                f,
-                "snapshot payload announces {announced} bytes but {available} are present"
-            ),
-            SnapshotError::Checksum => write!(f, "snapshot payload is damaged (checksum mismatch)"),
-            SnapshotError::Decode(e) => write!(f, "snapshot payload does not decode: {e}"),
-            SnapshotError::Invalid(e) => write!(f, "snapshot describes an invalid state: {e}"),
-            SnapshotError::Encode(e) => write!(f, "state could not be encoded: {e}"),
-        }
-    }
-}
-
-impl std::error::Error for SnapshotError {}
 
 const HEADER: usize = 16;
 const TRAILER: usize = 8;
@@ -65,8 +45,8 @@ fn fnv1a64(bytes: &[u8]) -> u64 {
     hash
 }
 
-/// Encodes `value` behind the 8-byte `tag`.
-pub(crate) fn encode<T: Serialize>(tag: &[u8; 8], value: &T) -> Result<Vec<u8>, SnapshotError> {
+/// Encodes `value` behind the 8-byte `tag` (name and version of the format).
+pub fn encode<T: Serialize>(tag: &[u8; 8], value: &T) -> Result<Vec<u8>, SnapshotError> {
     let payload = postcard::to_stdvec(value).map_err(|e| SnapshotError::Encode(e.to_string()))?;
     let mut out = Vec::with_capacity(HEADER + payload.len() + TRAILER);
     out.extend_from_slice(tag);
@@ -77,7 +57,8 @@ pub(crate) fn encode<T: Serialize>(tag: &[u8; 8], value: &T) -> Result<Vec<u8>, 
 }
 
 /// Decodes bytes written by [`encode`] with the same `tag`; `name` goes into the errors.
-pub(crate) fn decode<T: DeserializeOwned>(
+/// Foreign, short, long or damaged bytes are an error, never a panic.
+pub fn decode<T: DeserializeOwned>(
     tag: &[u8; 8],
     name: &'static str,
     bytes: &[u8],

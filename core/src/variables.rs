@@ -3,7 +3,7 @@
 //! modelDescription.xml from it and dispatches get/set through it; the SITL serves it over
 //! the MAVLink parameter protocol.
 
-use crate::error::ParamError;
+use crate::error::{InputError, ParamError};
 use crate::params::{ParamSpec, Parameters, ValueKind};
 
 /// FMI 2.0 causality.
@@ -73,6 +73,211 @@ pub fn parameter_variables<P: Parameters>(
             min: (s.kind != ValueKind::Boolean).then_some(s.min),
             max: (s.kind != ValueKind::Boolean).then_some(s.max),
         })
+}
+
+/// One input of a model: a Real, range-checked before `set` sees it.
+#[derive(Debug)]
+pub struct InputRow<M> {
+    pub name: &'static str,
+    pub unit: &'static str,
+    pub description: &'static str,
+    /// Inclusive range; a value outside (or NaN) is refused with [`ParamError::OutOfRange`].
+    pub min: f64,
+    pub max: f64,
+    /// What the model reads before anything is set.
+    pub start: f64,
+    pub get: fn(&M) -> f64,
+    /// Writes a finite value inside `[min, max]`.
+    pub set: fn(&mut M, f64) -> Result<(), InputError>,
+}
+
+impl<M> InputRow<M> {
+    /// An input with its `[min, max]` range and `start` value.
+    pub const fn new(
+        name: &'static str,
+        unit: &'static str,
+        description: &'static str,
+        [min, max, start]: [f64; 3],
+        get: fn(&M) -> f64,
+        set: fn(&mut M, f64) -> Result<(), InputError>,
+    ) -> Self {
+        InputRow {
+            name,
+            unit,
+            description,
+            min,
+            max,
+            start,
+            get,
+            set,
+        }
+    }
+}
+
+/// One output of a model: read only.
+#[derive(Debug)]
+pub struct OutputRow<M> {
+    pub name: &'static str,
+    /// Real, or Boolean for flags (read as 0 / 1).
+    pub kind: ValueKind,
+    pub unit: &'static str,
+    pub description: &'static str,
+    pub get: fn(&M) -> f64,
+}
+
+impl<M> OutputRow<M> {
+    /// A Real output.
+    pub const fn real(
+        name: &'static str,
+        unit: &'static str,
+        description: &'static str,
+        get: fn(&M) -> f64,
+    ) -> Self {
+        OutputRow {
+            name,
+            kind: ValueKind::Real,
+            unit,
+            description,
+            get,
+        }
+    }
+
+    /// A Boolean output (a flag without unit).
+    pub const fn flag(name: &'static str, description: &'static str, get: fn(&M) -> f64) -> Self {
+        OutputRow {
+            name,
+            kind: ValueKind::Boolean,
+            unit: "",
+            description,
+            get,
+        }
+    }
+}
+
+/// A model with a variable table: inputs and outputs as rows, physical parameters and start
+/// values as [`Parameters`]. [`variables`], [`get`] and [`set`] serve every such model.
+pub trait VariableTable: Sized + 'static {
+    /// The physical parameters (value references from [`vr_block::PARAMETER`]).
+    type Params: Parameters;
+    /// The start values that are not physical parameters (from [`vr_block::INITIAL`]).
+    type Initial: Parameters;
+    /// Inputs in value-reference order from [`vr_block::INPUT`].
+    const INPUTS: &'static [InputRow<Self>];
+    /// Outputs in value-reference order from [`vr_block::OUTPUT`].
+    const OUTPUTS: &'static [OutputRow<Self>];
+
+    fn params(&self) -> &Self::Params;
+    /// Sets one physical parameter (range-checked; nothing changes when it is refused).
+    fn set_parameter(&mut self, name: &'static str, value: f64) -> Result<(), ParamError>;
+}
+
+/// Which row a value reference points at.
+enum Row<'a, M: VariableTable> {
+    Input(&'a InputRow<M>),
+    Output(&'a OutputRow<M>),
+    Parameter(&'static ParamSpec<M::Params>),
+    Initial(&'static ParamSpec<M::Initial>),
+}
+
+fn row<M: VariableTable>(vr: u32) -> Result<Row<'static, M>, ParamError> {
+    let unknown = ParamError::UnknownValueReference(vr);
+    let index = |first: u32| (vr - first) as usize;
+    Ok(if vr >= vr_block::INITIAL {
+        Row::Initial(parameter_at::<M::Initial>(vr, vr_block::INITIAL)?)
+    } else if vr >= vr_block::PARAMETER {
+        Row::Parameter(parameter_at::<M::Params>(vr, vr_block::PARAMETER)?)
+    } else if vr >= vr_block::OUTPUT {
+        Row::Output(M::OUTPUTS.get(index(vr_block::OUTPUT)).ok_or(unknown)?)
+    } else {
+        Row::Input(M::INPUTS.get(index(vr_block::INPUT)).ok_or(unknown)?)
+    })
+}
+
+/// Every variable of `M`, in value-reference order.
+pub fn variables<M: VariableTable>() -> Vec<Variable> {
+    let inputs = M::INPUTS
+        .iter()
+        .zip(vr_block::INPUT..)
+        .map(|(r, vr)| Variable {
+            name: r.name,
+            value_reference: vr,
+            kind: ValueKind::Real,
+            causality: Causality::Input,
+            variability: Variability::Continuous,
+            unit: r.unit,
+            description: r.description,
+            start: Some(r.start),
+            min: Some(r.min),
+            max: Some(r.max),
+        });
+    let outputs = M::OUTPUTS
+        .iter()
+        .zip(vr_block::OUTPUT..)
+        .map(|(r, vr)| Variable {
+            name: r.name,
+            value_reference: vr,
+            kind: r.kind,
+            causality: Causality::Output,
+            variability: if r.kind == ValueKind::Real {
+                Variability::Continuous
+            } else {
+                Variability::Discrete
+            },
+            unit: r.unit,
+            description: r.description,
+            start: None,
+            min: None,
+            max: None,
+        });
+    inputs
+        .chain(outputs)
+        .chain(parameter_variables::<M::Params>(
+            vr_block::PARAMETER,
+            Variability::Fixed,
+        ))
+        .chain(parameter_variables::<M::Initial>(
+            vr_block::INITIAL,
+            Variability::Fixed,
+        ))
+        .collect()
+}
+
+/// Reads variable `vr` of `model` (start values from `initial`).
+pub fn get<M: VariableTable>(model: &M, initial: &M::Initial, vr: u32) -> Result<f64, ParamError> {
+    Ok(match row::<M>(vr)? {
+        Row::Input(r) => (r.get)(model),
+        Row::Output(r) => (r.get)(model),
+        Row::Parameter(spec) => (spec.get)(model.params()),
+        Row::Initial(spec) => (spec.get)(initial),
+    })
+}
+
+/// Writes variable `vr`; the value is checked against the variable's range and nothing
+/// changes when it is refused. Outputs cannot be set.
+pub fn set<M: VariableTable>(
+    model: &mut M,
+    initial: &mut M::Initial,
+    vr: u32,
+    value: f64,
+) -> Result<(), ParamError> {
+    match row::<M>(vr)? {
+        Row::Input(r) => {
+            let out_of_range = ParamError::OutOfRange {
+                name: r.name,
+                value,
+                min: r.min,
+                max: r.max,
+                unit: r.unit,
+            };
+            if !(value >= r.min && value <= r.max) {
+                return Err(out_of_range);
+            }
+            (r.set)(model, value).map_err(|_| out_of_range)
+        }
+        Row::Output(r) => Err(ParamError::NotSettable(r.name)),
+        Row::Parameter(spec) => model.set_parameter(spec.name, value),
+        Row::Initial(spec) => initial.set(spec.name, value),
+    }
 }
 
 /// Looks up the parameter row behind `vr` in a block that starts at `first_vr`.

@@ -11,41 +11,15 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial, QuadrotorParams};
 use flyloop_fmu::exports::*;
 use flyloop_fmu::fmi2_types::*;
+use flyloop_fmu::importer_logger;
 use flyloop_fmu::models::tables;
 use std::hint::black_box;
 
-unsafe extern "C" fn quiet(
-    _env: fmi2ComponentEnvironment,
-    _name: fmi2String,
-    _status: fmi2Status,
-    _category: fmi2String,
-    _format: fmi2String,
-    _message: fmi2String,
-) {
-}
-
 fn instance(hover: f64) -> fmi2Component {
-    // SAFETY: a fixed-arity receiver for the FMU's one call shape (see tests/support).
-    let logger = unsafe {
-        std::mem::transmute::<
-            unsafe extern "C" fn(
-                fmi2ComponentEnvironment,
-                fmi2String,
-                fmi2Status,
-                fmi2String,
-                fmi2String,
-                fmi2String,
-            ),
-            fmi2CallbackLogger,
-        >(quiet)
-    };
-    let callbacks = Box::leak(Box::new(fmi2CallbackFunctions {
-        logger: Some(logger),
-        allocateMemory: None,
-        freeMemory: None,
-        stepFinished: None,
-        componentEnvironment: std::ptr::null_mut(),
-    }));
+    let callbacks = Box::leak(Box::new(importer_logger::callbacks(
+        importer_logger::quiet,
+        std::ptr::null_mut(),
+    )));
     let table = tables()[0];
     let vr = |name: &str| table.by_name(name).unwrap().value_reference;
     // SAFETY: valid strings, callbacks leaked for the process's lifetime.

@@ -47,11 +47,12 @@ pub fn of_interface(identifier: &str, variables: &[Variable]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use flyloop_core::quadrotor::variables::variables;
+    use flyloop_core::quadrotor::Quadrotor;
+    use flyloop_core::variables::variables;
 
     #[test]
     fn guid_has_the_uuid_shape_and_follows_the_interface() {
-        let vars = variables();
+        let vars = variables::<Quadrotor>();
         let guid = of_interface("Quadrotor", &vars);
         assert_eq!(guid.len(), 38, "{guid}");
         assert!(guid.starts_with('{') && guid.ends_with('}'));

@@ -17,6 +17,7 @@ pub mod error;
 pub mod exports;
 pub mod fmi2_types;
 pub mod guid;
+pub mod importer_logger;
 pub mod instance;
 pub mod log;
 pub mod model;

@@ -12,23 +12,12 @@ use std::collections::BTreeSet;
 use std::fmt::Write;
 
 /// A unit string the generator has no base-unit entry for (add it to `units.rs`).
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unit `{unit}` of variable `{variable}` has no entry in fmu/src/units.rs")]
 pub struct UnknownUnit {
     pub unit: String,
     pub variable: String,
 }
-
-impl std::fmt::Display for UnknownUnit {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "unit `{}` of variable `{}` has no entry in fmu/src/units.rs",
-            self.unit, self.variable
-        )
-    }
-}
-
-impl std::error::Error for UnknownUnit {}
 
 /// Escapes text for an XML attribute value.
 fn escape(text: &str) -> String {

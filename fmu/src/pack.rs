@@ -4,7 +4,6 @@
 
 use crate::model::ModelTable;
 use crate::model_description::{self, UnknownUnit};
-use std::fmt;
 use std::fs::{self, File};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
@@ -12,43 +11,17 @@ use zip::write::SimpleFileOptions;
 use zip::{CompressionMethod, ZipWriter};
 
 /// Why packing failed.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum PackError {
-    Io {
-        path: PathBuf,
-        source: io::Error,
-    },
+    #[error("{}: {source}", path.display())]
+    Io { path: PathBuf, source: io::Error },
+    #[error("{}: {source}", path.display())]
     Zip {
         path: PathBuf,
         source: zip::result::ZipError,
     },
-    Unit(UnknownUnit),
-}
-
-impl fmt::Display for PackError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            PackError::Io { path, source } => write!(f, "{}: {source}", path.display()),
-            PackError::Zip { path, source } => write!(f, "{}: {source}", path.display()),
-            PackError::Unit(e) => write!(f, "{e}"),
-        }
-    }
-}
-
-impl std::error::Error for PackError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            PackError::Io { source, .. } => Some(source),
-            PackError::Zip { source, .. } => Some(source),
-            PackError::Unit(e) => Some(e),
-        }
-    }
-}
-
-impl From<UnknownUnit> for PackError {
-    fn from(e: UnknownUnit) -> Self {
-        PackError::Unit(e)
-    }
+    #[error(transparent)]
+    Unit(#[from] UnknownUnit),
 }
 
 fn io(path: &Path) -> impl FnOnce(io::Error) -> PackError + '_ {

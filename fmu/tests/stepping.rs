@@ -170,7 +170,7 @@ fn quadrotor_outputs_are_the_cores_after_the_same_steps_bit_for_bit() {
         let (status, values) = fmu.get_reals(&vrs);
         assert_eq!(status, fmi2OK);
         for (&vr, value) in vrs.iter().zip(values) {
-            let expected = flyloop_core::quadrotor::variables::get(&core, &initial, vr).unwrap();
+            let expected = flyloop_core::variables::get(&core, &initial, vr).unwrap();
             assert_eq!(value.to_bits(), expected.to_bits(), "vr {vr} at t = {t}");
         }
     }
@@ -204,7 +204,7 @@ fn lander_steps_every_whole_period_on_its_grid_and_matches_the_core() {
                 continue;
             }
             let vr = variable.value_reference;
-            let expected = flyloop_core::lander2d::variables::get(&core, &initial, vr).unwrap();
+            let expected = flyloop_core::variables::get(&core, &initial, vr).unwrap();
             let value = fmu.get(variable.name);
             assert_eq!(
                 value.to_bits(),

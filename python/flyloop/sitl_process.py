@@ -59,7 +59,9 @@ def _usable(path: Path) -> bool:
     return path.is_file() and os.access(path, os.X_OK)
 
 
-def find_sitl_binary(sitl_path: str | os.PathLike[str] | None = None) -> Path:
+def find_sitl_binary(
+    sitl_path: str | os.PathLike[str] | None = None, *, build: bool = False
+) -> Path:
     """The flyloop-sitl binary, looked up in this order:
 
     1. `sitl_path` (an env's constructor argument),
@@ -68,6 +70,9 @@ def find_sitl_binary(sitl_path: str | os.PathLike[str] | None = None) -> Path:
     4. the workspace build: <repo>/target/release/flyloop-sitl, or
        $CARGO_TARGET_DIR/release/flyloop-sitl when CARGO_TARGET_DIR is set
        (only when this package is used from the repository, e.g. `pip install -e python`).
+
+    With `build=True` (the test suites), 3 is skipped and 4 is first brought up to date
+    with `cargo build --release -p flyloop-sitl`, so tests fly the code of the checkout.
 
     An explicit path (1 or 2) that is not an executable file is an error, not skipped.
     Raises SitlNotFoundError naming every place it looked and the command that builds it.
@@ -81,7 +86,10 @@ def find_sitl_binary(sitl_path: str | os.PathLike[str] | None = None) -> Path:
                     f"flyloop-sitl binary (build one with: {BUILD_COMMAND})"
                 )
             return path
-    on_path = shutil.which(BINARY_NAME)
+    root = _workspace_root()
+    if build and root is not None:
+        subprocess.run([*BUILD_COMMAND.split(), "--quiet"], cwd=root, check=True)
+    on_path = None if build else shutil.which(BINARY_NAME)
     if on_path:
         return Path(on_path)
     workspace = _workspace_binary()

@@ -4,33 +4,17 @@ FLYLOOP_SITL does not name one) and a tracker that closes every env a test made.
 from __future__ import annotations
 
 import os
-import subprocess
 from pathlib import Path
 
 import pytest
 
-REPO = Path(__file__).resolve().parents[2]
-
-
-def _cargo_binary() -> Path:
-    target = Path(os.environ.get("CARGO_TARGET_DIR") or REPO / "target")
-    if not target.is_absolute():
-        target = REPO / target
-    return target / "release" / "flyloop-sitl"
+from flyloop import find_sitl_binary
 
 
 @pytest.fixture(scope="session")
 def sitl_binary() -> Path:
     """The SITL every env test flies; exported as FLYLOOP_SITL so the envs find it."""
-    given = os.environ.get("FLYLOOP_SITL")
-    if given:
-        path = Path(given)
-    else:
-        subprocess.run(
-            ["cargo", "build", "--release", "-p", "flyloop-sitl", "--quiet"], cwd=REPO, check=True
-        )
-        path = _cargo_binary()
-    assert path.is_file(), f"no flyloop-sitl binary at {path}"
+    path = find_sitl_binary(build=True)
     os.environ["FLYLOOP_SITL"] = str(path)
     return path
 

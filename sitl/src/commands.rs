@@ -9,35 +9,17 @@
 
 use crate::vehicle::{Vehicle, next_seed};
 use mavlink::dialects::common::COMMAND_LONG_DATA;
-use std::fmt;
 
 /// Why a reset command was refused.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum ResetError {
     /// param1..4 must each be an integer in [0, 65535].
+    #[error("param{param} = {value} is not a 16-bit seed piece (an integer in [0, 65535])")]
     SeedPiece { param: usize, value: f32 },
     /// param5 must be 0 (use the seed) or 1 (next seed).
+    #[error("param5 = {value} must be 0 (use the seed) or 1 (next seed)")]
     SeedMode { value: f32 },
 }
-
-impl fmt::Display for ResetError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ResetError::SeedPiece { param, value } => write!(
-                f,
-                "param{param} = {value} is not a 16-bit seed piece (an integer in [0, 65535])"
-            ),
-            ResetError::SeedMode { value } => {
-                write!(
-                    f,
-                    "param5 = {value} must be 0 (use the seed) or 1 (next seed)"
-                )
-            }
-        }
-    }
-}
-
-impl std::error::Error for ResetError {}
 
 /// A decoded reset command.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

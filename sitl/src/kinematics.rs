@@ -1,6 +1,9 @@
-//! The one place where the core's frames (world ENU, body FLU) become MAVLink's (world NED,
-//! body FRD), and local metres become latitude / longitude / altitude around the home point.
+//! The one place where the models' frames become MAVLink's: the quadrotor's (world ENU,
+//! body FLU) and the lander's plane (mapped into ENU/FLU here) become world NED and body
+//! FRD, and local metres become latitude / longitude / altitude around the home point.
 
+use flyloop_core::lander2d::Lander2d;
+use flyloop_core::quadrotor::Quadrotor;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 /// Standard gravity for milli-g units (mG), m/s².
@@ -56,6 +59,39 @@ pub fn euler_ned(attitude_enu: &UnitQuaternion<f64>) -> (f64, f64, f64) {
 }
 
 impl Kinematics {
+    /// The quadrotor's state, already in ENU/FLU.
+    pub fn of_quadrotor(q: &Quadrotor) -> Self {
+        let b = &q.body;
+        Kinematics {
+            position: b.position,
+            velocity: b.velocity,
+            attitude: q.attitude(),
+            body_rates: b.body_rates,
+            acceleration: q.accelerations().0,
+            gravity: q.params.gravity,
+            air_velocity: b.velocity - q.wind_velocity(),
+        }
+    }
+
+    /// The lander's plane is the world's east–up plane: x → east, y → up, north = 0, the
+    /// body's forward axis along the lander's +x. Its angle is counter-clockwise as seen with
+    /// east to the right and up on top, i.e. looking north, so it turns the body about the
+    /// north axis by −angle: a positive angle lifts the nose (a positive FRD pitch).
+    pub fn of_lander(l: &Lander2d) -> Self {
+        let d = l.drone();
+        let [ax, ay] = l.acceleration();
+        let velocity = Vector3::new(d.vx, 0.0, d.vy);
+        Kinematics {
+            position: Vector3::new(d.x, 0.0, d.y),
+            velocity,
+            attitude: UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -d.angle),
+            body_rates: Vector3::new(0.0, -d.angular_velocity, 0.0),
+            acceleration: Vector3::new(ax, 0.0, ay),
+            gravity: l.params().gravity,
+            air_velocity: velocity,
+        }
+    }
+
     /// Position north, east, down from the local origin, m.
     pub fn position_ned(&self) -> Vector3<f64> {
         enu_to_ned(&self.position)
@@ -232,6 +268,41 @@ mod tests {
         assert_eq!(k.velocity_ned(), Vector3::new(-0.25, 0.5, -1.0));
         assert_eq!(k.body_rates_frd(), Vector3::new(0.1, -0.2, -0.3));
         assert_eq!(k.airspeed(), 5.0);
+    }
+
+    #[test]
+    fn a_lander_tilted_counter_clockwise_pitches_nose_up_in_frd() {
+        use flyloop_core::lander2d::{Lander2dInitial, Lander2dParams};
+        for angle in [0.3, -0.3] {
+            let initial = Lander2dInitial {
+                initial_x: 12.0,
+                initial_y: 30.0,
+                initial_angle: angle,
+                initial_angular_velocity: 0.5 * angle,
+                ..Lander2dInitial::default()
+            };
+            let lander = Lander2d::from_initial(Lander2dParams::default(), &initial).unwrap();
+            let k = Kinematics::of_lander(&lander);
+            // The nose (body x forward) points east and, for a positive angle, up.
+            let nose = k.attitude * Vector3::x();
+            assert!(
+                close(nose.x, angle.cos()) && close(nose.z, angle.sin()),
+                "{nose:?}"
+            );
+            assert!(close(nose.y, 0.0));
+            // In MAVLink's frames that is pitch = +angle (nose up), facing east (yaw 90°),
+            // the pitch rate following the angular velocity.
+            let (roll, pitch, yaw) = euler_ned(&k.attitude);
+            assert!(close(roll, 0.0) && close(pitch, angle) && close(yaw, FRAC_PI_2));
+            assert!(
+                close(k.body_rates_frd().y, 0.5 * angle),
+                "{:?}",
+                k.body_rates_frd()
+            );
+            // The plane is east–up: x east, height up, north 0.
+            assert_eq!(k.position, Vector3::new(12.0, 0.0, 30.0));
+            assert_eq!(k.position_ned(), Vector3::new(0.0, 12.0, -30.0));
+        }
     }
 
     #[test]

@@ -13,6 +13,7 @@
 pub mod cli;
 pub mod commands;
 pub mod config;
+pub mod fuzz;
 pub mod gcs_streams;
 pub mod kinematics;
 pub mod model;

@@ -11,7 +11,6 @@ use flyloop_core::tasks::hover::Hover;
 use flyloop_core::tasks::landing::{Landing, LandingParams};
 use flyloop_core::tasks::waypoints::{WaypointParams, Waypoints};
 use flyloop_core::tasks::{ActionError, Info, StepOutcome, Task};
-use nalgebra::{UnitQuaternion, Vector3};
 
 /// The simulated vehicle model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -181,43 +180,10 @@ impl TaskInstance {
     /// The vehicle's state in the core's frames (world ENU, body FLU).
     pub fn kinematics(&self) -> Kinematics {
         match self {
-            TaskInstance::Hover(t) => quadrotor_kinematics(t.quadrotor()),
-            TaskInstance::Waypoints(t) => quadrotor_kinematics(t.quadrotor()),
-            TaskInstance::Landing(t) => lander_kinematics(t),
+            TaskInstance::Hover(t) => Kinematics::of_quadrotor(t.quadrotor()),
+            TaskInstance::Waypoints(t) => Kinematics::of_quadrotor(t.quadrotor()),
+            TaskInstance::Landing(t) => Kinematics::of_lander(t.lander()),
         }
-    }
-}
-
-/// The state of a core quadrotor as [`Kinematics`].
-pub fn quadrotor_kinematics(q: &flyloop_core::quadrotor::Quadrotor) -> Kinematics {
-    let b = &q.body;
-    Kinematics {
-        position: b.position,
-        velocity: b.velocity,
-        attitude: q.attitude(),
-        body_rates: b.body_rates,
-        acceleration: q.accelerations().0,
-        gravity: q.params.gravity,
-        air_velocity: b.velocity - q.wind_velocity(),
-    }
-}
-
-/// The lander's plane is the world's east–up plane: x → east, y → up, north = 0. Its angle
-/// (counter-clockwise, seen with east to the right and up on top) turns the body about the
-/// north axis by −angle, so a positive angle is a nose-up pitch in FRD.
-fn lander_kinematics(t: &Landing) -> Kinematics {
-    let l = t.lander();
-    let d = l.drone();
-    let [ax, ay] = l.acceleration();
-    let velocity = Vector3::new(d.vx, 0.0, d.vy);
-    Kinematics {
-        position: Vector3::new(d.x, 0.0, d.y),
-        velocity,
-        attitude: UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -d.angle),
-        body_rates: Vector3::new(0.0, -d.angular_velocity, 0.0),
-        acceleration: Vector3::new(ax, 0.0, ay),
-        gravity: l.params().gravity,
-        air_velocity: velocity,
     }
 }
 
@@ -245,20 +211,5 @@ mod tests {
         config.quadrotor.mass = -1.0;
         let err = TaskInstance::build(TaskKind::Hover, &config).unwrap_err();
         assert!(err.to_string().contains("`mass`"), "{err}");
-    }
-
-    #[test]
-    fn a_tilted_lander_pitches_nose_up_for_a_positive_angle() {
-        let mut config = TaskConfig::default();
-        config.landing.initial_angle_random_range_rad = 0.0;
-        let mut task = TaskInstance::build(TaskKind::Landing, &config).unwrap();
-        task.reset(1);
-        let k = task.kinematics();
-        assert!((k.attitude.angle()).abs() < 1e-12);
-        assert_eq!(k.position.y, 0.0);
-        let TaskInstance::Landing(landing) = &task else {
-            unreachable!()
-        };
-        assert_eq!(k.position.z, landing.lander().drone().y);
     }
 }

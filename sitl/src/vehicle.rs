@@ -4,25 +4,13 @@
 use crate::model::{TaskConfig, TaskInstance, TaskKind};
 use crate::task_frame::FrameHeader;
 use flyloop_core::ParamError;
-use std::fmt;
 
 /// Why a set of controls was refused.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum ControlError {
+    #[error("controls[{channel}] = {value}: step refused")]
     NotFinite { channel: usize, value: f32 },
 }
-
-impl fmt::Display for ControlError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ControlError::NotFinite { channel, value } => {
-                write!(f, "controls[{channel}] = {value}: step refused")
-            }
-        }
-    }
-}
-
-impl std::error::Error for ControlError {}
 
 /// The next seed of a vehicle's sequence: the SplitMix64 output of the previous seed.
 pub fn next_seed(seed: u64) -> u64 {

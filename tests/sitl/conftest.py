@@ -4,12 +4,13 @@ and SITL processes on ephemeral ports, stopped after each test."""
 from __future__ import annotations
 
 import pytest
-from sitl_client import Client, Sitl, build_binary
+from flyloop import find_sitl_binary
+from sitl_client import Client, Sitl
 
 
 @pytest.fixture(scope="session")
 def sitl_binary():
-    return build_binary()
+    return find_sitl_binary(build=True)
 
 
 @pytest.fixture

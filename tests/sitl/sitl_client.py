@@ -20,7 +20,6 @@ os.environ["MAVLINK20"] = "1"  # pymavlink's mavutil would speak MAVLink 1 other
 
 from pymavlink.dialects.v20 import common as mavlink2  # noqa: E402
 
-REPO = Path(__file__).resolve().parents[2]
 RESET_COMMAND = mavlink2.MAV_CMD_USER_1
 LOCKSTEP = mavlink2.HIL_ACTUATOR_CONTROLS_FLAGS_LOCKSTEP
 EARTH_RADIUS = 6_378_137.0
@@ -37,24 +36,6 @@ HOVER_INFO = [
     ("crashed", 1),
     ("out_of_bounds", 1),
 ]
-
-
-def binary_path() -> Path:
-    """Where cargo puts the release binary (CARGO_TARGET_DIR respected)."""
-    target = Path(os.environ.get("CARGO_TARGET_DIR", REPO / "target"))
-    if not target.is_absolute():
-        target = REPO / target
-    return target / "release" / "flyloop-sitl"
-
-
-def build_binary() -> Path:
-    """Builds the release binary (a no-op when it is up to date) and returns its path."""
-    subprocess.run(
-        ["cargo", "build", "--release", "-p", "flyloop-sitl", "--quiet"], cwd=REPO, check=True
-    )
-    path = binary_path()
-    assert path.exists(), f"cargo built no binary at {path}"
-    return path
 
 
 def seed_params(seed: int) -> list[float]:

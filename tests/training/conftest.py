@@ -8,12 +8,12 @@ The `training` marker tags the tests that train (minutes of CPU). They run in th
 from __future__ import annotations
 
 import os
-import subprocess
 import sys
 from pathlib import Path
 
 import pytest
-from training_support import EXAMPLES, REPO, TRAIN
+from flyloop import find_sitl_binary
+from training_support import EXAMPLES, TRAIN
 
 for folder in (TRAIN, EXAMPLES):
     if str(folder) not in sys.path:
@@ -26,25 +26,10 @@ def pytest_configure(config: pytest.Config) -> None:
     )
 
 
-def _cargo_binary() -> Path:
-    target = Path(os.environ.get("CARGO_TARGET_DIR") or REPO / "target")
-    if not target.is_absolute():
-        target = REPO / target
-    return target / "release" / "flyloop-sitl"
-
-
 @pytest.fixture(scope="session")
 def sitl_binary() -> Path:
     """The SITL the envs fly (FLYLOOP_SITL, else cargo's release build), exported as
     FLYLOOP_SITL for the envs and the scripts' subprocesses."""
-    given = os.environ.get("FLYLOOP_SITL")
-    if given:
-        path = Path(given)
-    else:
-        subprocess.run(
-            ["cargo", "build", "--release", "-p", "flyloop-sitl", "--quiet"], cwd=REPO, check=True
-        )
-        path = _cargo_binary()
-    assert path.is_file(), f"no flyloop-sitl binary at {path}"
+    path = find_sitl_binary(build=True)
     os.environ["FLYLOOP_SITL"] = str(path)
     return path

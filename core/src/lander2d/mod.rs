@@ -13,6 +13,6 @@ pub mod world;
 
 pub use crate::snapshot::SnapshotError;
 pub use contact::{ContactState, wrap_angle};
-pub use model::{CommandError, Lander2d};
+pub use model::Lander2d;
 pub use params::{Lander2dInitial, Lander2dParams};
 pub use world::{DroneGeometry, DroneState};

@@ -4,7 +4,7 @@
 use super::contact::ContactState;
 use super::params::{Lander2dInitial, Lander2dParams};
 use super::world::{self, DroneGeometry, DroneState, Handles};
-use crate::error::ParamError;
+use crate::error::{InputError, ParamError, check_finite};
 use crate::params::Parameters;
 use crate::rng::SimRng;
 use crate::snapshot::{self, SnapshotError};
@@ -119,12 +119,8 @@ impl Lander2d {
 
     /// Sets the motor commands (left, right). Each must be finite; values are clamped into
     /// [-1, 1], which maps linearly onto [0, max_thrust].
-    pub fn set_command(&mut self, command: [f64; 2]) -> Result<(), CommandError> {
-        for (index, &value) in command.iter().enumerate() {
-            if !value.is_finite() {
-                return Err(CommandError { index, value });
-            }
-        }
+    pub fn set_command(&mut self, command: [f64; 2]) -> Result<(), InputError> {
+        check_finite("motor command", &command)?;
         self.command = command.map(|c| c.clamp(-1.0, 1.0));
         Ok(())
     }
@@ -135,12 +131,8 @@ impl Lander2d {
     }
 
     /// Sets the wind force added from outside, N. Each must be finite.
-    pub fn set_external_wind_force(&mut self, force: [f64; 2]) -> Result<(), CommandError> {
-        for (index, &value) in force.iter().enumerate() {
-            if !value.is_finite() {
-                return Err(CommandError { index, value });
-            }
-        }
+    pub fn set_external_wind_force(&mut self, force: [f64; 2]) -> Result<(), InputError> {
+        check_finite("wind force", &force)?;
         self.external_wind_force = force;
         Ok(())
     }
@@ -458,22 +450,3 @@ fn check_start(drone: &DroneState) -> Result<(), ParamError> {
     }
     Ok(())
 }
-
-/// A motor command or wind input that is not a finite number.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CommandError {
-    pub index: usize,
-    pub value: f64,
-}
-
-impl std::fmt::Display for CommandError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "input {} is {}, not a finite number",
-            self.index, self.value
-        )
-    }
-}
-
-impl std::error::Error for CommandError {}

@@ -3,321 +3,181 @@
 
 use super::model::Lander2d;
 use super::params::{Lander2dInitial, Lander2dParams};
-use crate::error::ParamError;
-use crate::params::{Parameters, ValueKind};
-use crate::variables::{
-    Causality, Variability, Variable, parameter_at, parameter_variables, vr_block,
-};
-
-type Getter = fn(&Lander2d) -> f64;
+use crate::error::{InputError, ParamError};
+use crate::variables::{InputRow, OutputRow, VariableTable};
 
 fn flag(b: bool) -> f64 {
     if b { 1.0 } else { 0.0 }
 }
 
-/// Outputs: (name, kind, unit, description, getter). Order fixes the value references.
-static OUTPUTS: &[(&str, ValueKind, &str, &str, Getter)] = &[
-    ("x", ValueKind::Real, "m", "Drone centre x", |l| l.drone().x),
-    (
+/// Outputs; their order fixes the value references.
+const OUTPUTS: &[OutputRow<Lander2d>] = &[
+    OutputRow::real("x", "m", "Drone centre x", |l| l.drone().x),
+    OutputRow::real(
         "y",
-        ValueKind::Real,
         "m",
         "Drone centre y (height; the ground is at ground_height)",
         |l| l.drone().y,
     ),
-    (
-        "vx",
-        ValueKind::Real,
-        "m/s",
-        "Drone velocity along x",
-        |l| l.drone().vx,
-    ),
-    (
-        "vy",
-        ValueKind::Real,
-        "m/s",
-        "Drone velocity along y",
-        |l| l.drone().vy,
-    ),
-    (
+    OutputRow::real("vx", "m/s", "Drone velocity along x", |l| l.drone().vx),
+    OutputRow::real("vy", "m/s", "Drone velocity along y", |l| l.drone().vy),
+    OutputRow::real(
         "ax",
-        ValueKind::Real,
         "m/s2",
         "Mean acceleration along x over the last control period",
         |l| l.acceleration()[0],
     ),
-    (
+    OutputRow::real(
         "ay",
-        ValueKind::Real,
         "m/s2",
         "Mean acceleration along y over the last control period",
         |l| l.acceleration()[1],
     ),
-    (
+    OutputRow::real(
         "angle",
-        ValueKind::Real,
         "rad",
         "Drone angle, counter-clockwise, in [-pi, pi)",
         |l| super::wrap_angle(l.drone().angle),
     ),
-    (
+    OutputRow::real(
         "angular_velocity",
-        ValueKind::Real,
         "rad/s",
         "Drone angular velocity, counter-clockwise",
         |l| l.drone().angular_velocity,
     ),
-    (
+    OutputRow::real(
         "thrust_left",
-        ValueKind::Real,
         "N",
         "Thrust of the left motor (noise and battery included)",
         |l| l.thrust()[0],
     ),
-    (
+    OutputRow::real(
         "thrust_right",
-        ValueKind::Real,
         "N",
         "Thrust of the right motor (noise and battery included)",
         |l| l.thrust()[1],
     ),
-    (
-        "battery",
-        ValueKind::Real,
-        "1",
-        "Remaining battery charge",
-        |l| l.battery(),
-    ),
-    (
+    OutputRow::real("battery", "1", "Remaining battery charge", |l| l.battery()),
+    OutputRow::flag(
         "landed",
-        ValueKind::Boolean,
-        "",
         "Touched down on the platform within the safe speed and angle",
         |l| flag(l.landed()),
     ),
-    (
+    OutputRow::flag(
         "crashed",
-        ValueKind::Boolean,
-        "",
         "Touched the ground, or the platform too fast or too tilted",
         |l| flag(l.crashed()),
     ),
-    (
-        "on_platform",
-        ValueKind::Boolean,
-        "",
-        "In contact with the platform now",
-        |l| flag(l.contact().on_platform),
-    ),
-    (
-        "on_ground",
-        ValueKind::Boolean,
-        "",
-        "In contact with the ground now",
-        |l| flag(l.contact().on_ground),
-    ),
-    (
-        "platform_x",
-        ValueKind::Real,
-        "m",
-        "Platform top centre x",
-        |l| l.platform_target().0,
-    ),
-    (
-        "platform_y",
-        ValueKind::Real,
-        "m",
-        "Platform top centre y",
-        |l| l.platform_target().1,
-    ),
-    (
-        "platform_vx",
-        ValueKind::Real,
-        "m/s",
-        "Platform velocity along x",
-        |l| l.platform_vx(),
-    ),
-    (
+    OutputRow::flag("on_platform", "In contact with the platform now", |l| {
+        flag(l.contact().on_platform)
+    }),
+    OutputRow::flag("on_ground", "In contact with the ground now", |l| {
+        flag(l.contact().on_ground)
+    }),
+    OutputRow::real("platform_x", "m", "Platform top centre x", |l| {
+        l.platform_target().0
+    }),
+    OutputRow::real("platform_y", "m", "Platform top centre y", |l| {
+        l.platform_target().1
+    }),
+    OutputRow::real("platform_vx", "m/s", "Platform velocity along x", |l| {
+        l.platform_vx()
+    }),
+    OutputRow::real(
         "wind_force_x",
-        ValueKind::Real,
         "N",
         "Wind force on the drone along x (episode wind + input)",
         |l| l.wind_force()[0],
     ),
-    (
+    OutputRow::real(
         "wind_force_y",
-        ValueKind::Real,
         "N",
         "Wind force on the drone along y (episode wind + input)",
         |l| l.wind_force()[1],
     ),
 ];
 
-/// Inputs: (name, unit, description, min, max, start).
-static INPUTS: &[(&str, &str, &str, f64, f64, f64)] = &[
-    (
+/// Inputs; their order fixes the value references.
+const INPUTS: &[InputRow<Lander2d>] = &[
+    motor::<0>(
         "motor_command_left",
-        "1",
         "Left motor command; [-1, 1] maps onto [0, max_thrust]",
-        -1.0,
-        1.0,
-        -1.0,
     ),
-    (
+    motor::<1>(
         "motor_command_right",
-        "1",
         "Right motor command; [-1, 1] maps onto [0, max_thrust]",
-        -1.0,
-        1.0,
-        -1.0,
     ),
-    (
+    wind::<0>(
         "wind_force_input_x",
-        "N",
         "External wind force along x, added to the episode wind",
-        -1e4,
-        1e4,
-        0.0,
     ),
-    (
+    wind::<1>(
         "wind_force_input_y",
-        "N",
         "External wind force along y, added to the episode wind",
-        -1e4,
-        1e4,
-        0.0,
     ),
 ];
 
-const PARAMETERS: u32 = vr_block::PARAMETER;
-const INITIAL: u32 = vr_block::INITIAL;
-const N_INPUTS: u32 = 4;
-
-/// Every variable of the Lander2D, in value-reference order.
-pub fn variables() -> Vec<Variable> {
-    let inputs = INPUTS.iter().zip(vr_block::INPUT..).map(
-        |(&(name, unit, description, min, max, start), vr)| Variable {
-            name,
-            value_reference: vr,
-            kind: ValueKind::Real,
-            causality: Causality::Input,
-            variability: Variability::Continuous,
-            unit,
-            description,
-            start: Some(start),
-            min: Some(min),
-            max: Some(max),
-        },
-    );
-    let outputs =
-        OUTPUTS
-            .iter()
-            .zip(vr_block::OUTPUT..)
-            .map(|(&(name, kind, unit, description, _), vr)| Variable {
-                name,
-                value_reference: vr,
-                kind,
-                causality: Causality::Output,
-                variability: if kind == ValueKind::Real {
-                    Variability::Continuous
-                } else {
-                    Variability::Discrete
-                },
-                unit,
-                description,
-                start: None,
-                min: None,
-                max: None,
-            });
-    inputs
-        .chain(outputs)
-        .chain(parameter_variables::<Lander2dParams>(
-            PARAMETERS,
-            Variability::Fixed,
-        ))
-        .chain(parameter_variables::<Lander2dInitial>(
-            INITIAL,
-            Variability::Fixed,
-        ))
-        .collect()
+/// Motor command `I` in [-1, 1], starting at -1 (off).
+const fn motor<const I: usize>(name: &'static str, text: &'static str) -> InputRow<Lander2d> {
+    InputRow::new(
+        name,
+        "1",
+        text,
+        [-1.0, 1.0, -1.0],
+        |l| l.command()[I],
+        set_motor::<I>,
+    )
 }
 
-fn output_at(
-    vr: u32,
-) -> Result<&'static (&'static str, ValueKind, &'static str, &'static str, Getter), ParamError> {
-    vr.checked_sub(vr_block::OUTPUT)
-        .and_then(|i| OUTPUTS.get(i as usize))
-        .ok_or(ParamError::UnknownValueReference(vr))
+/// External wind force component `I` in N.
+const fn wind<const I: usize>(name: &'static str, text: &'static str) -> InputRow<Lander2d> {
+    let range = [-1e4, 1e4, 0.0];
+    let get = |l: &Lander2d| l.external_wind_force()[I];
+    InputRow::new(name, "N", text, range, get, set_wind::<I>)
 }
 
-/// Reads variable `vr`.
-pub fn get(lander: &Lander2d, initial: &Lander2dInitial, vr: u32) -> Result<f64, ParamError> {
-    match vr {
-        0..=1 => Ok(lander.command()[vr as usize]),
-        2..=3 => Ok(lander.external_wind_force()[(vr - 2) as usize]),
-        _ if vr >= INITIAL => Ok((parameter_at::<Lander2dInitial>(vr, INITIAL)?.get)(initial)),
-        _ if vr >= PARAMETERS => Ok((parameter_at::<Lander2dParams>(vr, PARAMETERS)?.get)(
-            lander.params(),
-        )),
-        _ => Ok((output_at(vr)?.4)(lander)),
+fn set_motor<const I: usize>(lander: &mut Lander2d, value: f64) -> Result<(), InputError> {
+    let mut command = lander.command();
+    command[I] = value;
+    lander.set_command(command)
+}
+
+fn set_wind<const I: usize>(lander: &mut Lander2d, value: f64) -> Result<(), InputError> {
+    let mut force = lander.external_wind_force();
+    force[I] = value;
+    lander.set_external_wind_force(force)
+}
+
+impl VariableTable for Lander2d {
+    type Params = Lander2dParams;
+    type Initial = Lander2dInitial;
+    const INPUTS: &'static [InputRow<Self>] = INPUTS;
+    const OUTPUTS: &'static [OutputRow<Self>] = OUTPUTS;
+
+    fn params(&self) -> &Lander2dParams {
+        Lander2d::params(self)
     }
-}
 
-/// Writes variable `vr`; the value is checked against the variable's range and nothing
-/// changes when it is refused. A physical parameter rebuilds the scene around the current
-/// state (see [`Lander2d::set_parameter`]).
-pub fn set(
-    lander: &mut Lander2d,
-    initial: &mut Lander2dInitial,
-    vr: u32,
-    value: f64,
-) -> Result<(), ParamError> {
-    match vr {
-        _ if vr < N_INPUTS => {
-            let (name, unit, _, min, max, _) = INPUTS[vr as usize];
-            if !(value >= min && value <= max) {
-                return Err(ParamError::OutOfRange {
-                    name,
-                    value,
-                    min,
-                    max,
-                    unit,
-                });
-            }
-            // Finite and in range from here on: the setters cannot refuse it.
-            let refused = |_| ParamError::NotSettable(name);
-            if vr < 2 {
-                let mut command = lander.command();
-                command[vr as usize] = value;
-                lander.set_command(command).map_err(refused)
-            } else {
-                let mut force = lander.external_wind_force();
-                force[(vr - 2) as usize] = value;
-                lander.set_external_wind_force(force).map_err(refused)
-            }
-        }
-        _ if vr >= INITIAL => {
-            let name = parameter_at::<Lander2dInitial>(vr, INITIAL)?.name;
-            initial.set(name, value)
-        }
-        _ if vr >= PARAMETERS => {
-            let name = parameter_at::<Lander2dParams>(vr, PARAMETERS)?.name;
-            lander.set_parameter(name, value)
-        }
-        _ => Err(ParamError::NotSettable(output_at(vr)?.0)),
+    /// A physical parameter rebuilds the scene around the current state (see
+    /// [`Lander2d::set_parameter`]).
+    fn set_parameter(&mut self, name: &'static str, value: f64) -> Result<(), ParamError> {
+        Lander2d::set_parameter(self, name, value)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::params::ValueKind;
+    use crate::variables::Variability;
+    use crate::variables::{get, set, variables};
 
     fn lander() -> Lander2d {
         Lander2d::from_initial(Lander2dParams::default(), &Lander2dInitial::default()).unwrap()
     }
 
     fn vr(name: &str) -> u32 {
-        variables()
+        variables::<Lander2d>()
             .into_iter()
             .find(|v| v.name == name)
             .unwrap()
@@ -326,7 +186,7 @@ mod tests {
 
     #[test]
     fn names_and_value_references_are_unique_and_every_one_reads() {
-        let vars = variables();
+        let vars = variables::<Lander2d>();
         let l = lander();
         let init = Lander2dInitial::default();
         crate::variables::assert_names_and_value_references_are_unique(&vars);
@@ -371,7 +231,7 @@ mod tests {
             set(&mut l, &mut init, vr("crashed"), 1.0),
             Err(ParamError::NotSettable("crashed"))
         );
-        let landed = variables()
+        let landed = variables::<Lander2d>()
             .into_iter()
             .find(|v| v.name == "landed")
             .unwrap();

@@ -10,6 +10,6 @@ pub mod state;
 pub mod variables;
 pub mod wind;
 
-pub use model::{CommandError, Quadrotor};
+pub use model::Quadrotor;
 pub use params::{QuadrotorInitial, QuadrotorParams};
 pub use state::{BodyState, WindState};

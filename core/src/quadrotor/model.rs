@@ -5,7 +5,7 @@ use super::dynamics::{accelerations, integrate};
 use super::params::{QuadrotorInitial, QuadrotorParams};
 use super::state::{BodyState, WindState};
 use super::wind::{OuCache, apply_transition, reset_wind};
-use crate::error::ParamError;
+use crate::error::{InputError, ParamError, check_finite};
 use crate::params::Parameters;
 use crate::rng::SimRng;
 use crate::snapshot::{self, SnapshotError};
@@ -49,6 +49,20 @@ impl Quadrotor {
         })
     }
 
+    /// Starts a new episode in place: the vehicle at `body`, a fresh wind drawn from `rng`,
+    /// no external wind, the motors commanded to hold their state. The parameters stay as
+    /// they are (validated when the vehicle was built), so a restart cannot fail; the result
+    /// is the vehicle `new(params, body, rng)` with that command.
+    pub fn restart(&mut self, body: BodyState, mut rng: SimRng) {
+        self.wind = reset_wind(&self.params, &mut rng);
+        self.command = [body.motors[0].clamp(0.0, 1.0); 4];
+        self.body = body;
+        self.external_wind = Vector3::zeros();
+        self.grounded = false;
+        self.rng = rng;
+        self.ou_cache = OuCache::default();
+    }
+
     /// A vehicle from start values (the FMU's parameters), command = initial motor state.
     pub fn from_initial(
         params: QuadrotorParams,
@@ -71,12 +85,8 @@ impl Quadrotor {
     }
 
     /// Sets the motor commands. Each must be finite; values are clamped into [0, 1].
-    pub fn set_command(&mut self, command: [f64; 4]) -> Result<(), CommandError> {
-        for (index, &value) in command.iter().enumerate() {
-            if !value.is_finite() {
-                return Err(CommandError { index, value });
-            }
-        }
+    pub fn set_command(&mut self, command: [f64; 4]) -> Result<(), InputError> {
+        check_finite("motor command", &command)?;
         self.command = command.map(|c| c.clamp(0.0, 1.0));
         Ok(())
     }
@@ -164,22 +174,3 @@ impl Quadrotor {
 
 /// Format tag of a Quadrotor snapshot (name and version).
 const SNAPSHOT_TAG: &[u8; 8] = b"FLYQUA01";
-
-/// A motor command that is not a finite number.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CommandError {
-    pub index: usize,
-    pub value: f64,
-}
-
-impl std::fmt::Display for CommandError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "motor command {} is {}, not a finite number",
-            self.index, self.value
-        )
-    }
-}
-
-impl std::error::Error for CommandError {}

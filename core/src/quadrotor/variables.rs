@@ -3,294 +3,183 @@
 
 use super::model::Quadrotor;
 use super::params::{QuadrotorInitial, QuadrotorParams};
-use crate::error::ParamError;
-use crate::params::{Parameters, ValueKind};
-use crate::variables::{
-    Causality, Variability, Variable, parameter_at, parameter_variables, vr_block,
-};
+use crate::error::{InputError, ParamError, check_finite};
+use crate::params::Parameters;
+use crate::variables::{InputRow, OutputRow, VariableTable};
 
-type Getter = fn(&Quadrotor) -> f64;
-
-/// Outputs: (name, unit, description, getter). Order fixes the value references.
-static OUTPUTS: &[(&str, &str, &str, Getter)] = &[
-    ("x", "m", "Position east (world ENU)", |q| q.body.position.x),
-    ("y", "m", "Position north (world ENU)", |q| {
+/// Outputs; their order fixes the value references.
+const OUTPUTS: &[OutputRow<Quadrotor>] = &[
+    OutputRow::real("x", "m", "Position east (world ENU)", |q| q.body.position.x),
+    OutputRow::real("y", "m", "Position north (world ENU)", |q| {
         q.body.position.y
     }),
-    ("z", "m", "Height above ground (world ENU)", |q| {
+    OutputRow::real("z", "m", "Height above ground (world ENU)", |q| {
         q.body.position.z
     }),
-    ("vx", "m/s", "Velocity east", |q| q.body.velocity.x),
-    ("vy", "m/s", "Velocity north", |q| q.body.velocity.y),
-    ("vz", "m/s", "Velocity up", |q| q.body.velocity.z),
-    (
+    OutputRow::real("vx", "m/s", "Velocity east", |q| q.body.velocity.x),
+    OutputRow::real("vy", "m/s", "Velocity north", |q| q.body.velocity.y),
+    OutputRow::real("vz", "m/s", "Velocity up", |q| q.body.velocity.z),
+    OutputRow::real(
         "ax",
         "m/s2",
         "Acceleration east (total force / mass)",
         |q| q.accelerations().0.x,
     ),
-    (
+    OutputRow::real(
         "ay",
         "m/s2",
         "Acceleration north (total force / mass)",
         |q| q.accelerations().0.y,
     ),
-    (
+    OutputRow::real(
         "az",
         "m/s2",
         "Acceleration up (total force / mass; 0 in a hover)",
         |q| q.accelerations().0.z,
     ),
-    (
+    OutputRow::real(
         "qw",
         "1",
         "Attitude quaternion w (body FLU to world ENU)",
         |q| q.body.attitude.w,
     ),
-    ("qx", "1", "Attitude quaternion x", |q| q.body.attitude.i),
-    ("qy", "1", "Attitude quaternion y", |q| q.body.attitude.j),
-    ("qz", "1", "Attitude quaternion z", |q| q.body.attitude.k),
-    (
+    OutputRow::real("qx", "1", "Attitude quaternion x", |q| q.body.attitude.i),
+    OutputRow::real("qy", "1", "Attitude quaternion y", |q| q.body.attitude.j),
+    OutputRow::real("qz", "1", "Attitude quaternion z", |q| q.body.attitude.k),
+    OutputRow::real(
         "roll",
         "rad",
         "Roll (ZYX Euler, about body x forward)",
         |q| q.body.euler_angles().0,
     ),
-    (
+    OutputRow::real(
         "pitch",
         "rad",
         "Pitch (ZYX Euler, about body y left; nose down positive)",
         |q| q.body.euler_angles().1,
     ),
-    (
+    OutputRow::real(
         "yaw",
         "rad",
         "Yaw (ZYX Euler, from east toward north)",
         |q| q.body.euler_angles().2,
     ),
-    ("wx", "rad/s", "Body rate about x (forward)", |q| {
+    OutputRow::real("wx", "rad/s", "Body rate about x (forward)", |q| {
         q.body.body_rates.x
     }),
-    ("wy", "rad/s", "Body rate about y (left)", |q| {
+    OutputRow::real("wy", "rad/s", "Body rate about y (left)", |q| {
         q.body.body_rates.y
     }),
-    ("wz", "rad/s", "Body rate about z (up)", |q| {
+    OutputRow::real("wz", "rad/s", "Body rate about z (up)", |q| {
         q.body.body_rates.z
     }),
-    (
+    OutputRow::real(
         "motor_state_0",
         "1",
         "Lagged state of motor 0 (front-right, CCW)",
         |q| q.body.motors[0],
     ),
-    (
+    OutputRow::real(
         "motor_state_1",
         "1",
         "Lagged state of motor 1 (rear-left, CCW)",
         |q| q.body.motors[1],
     ),
-    (
+    OutputRow::real(
         "motor_state_2",
         "1",
         "Lagged state of motor 2 (front-left, CW)",
         |q| q.body.motors[2],
     ),
-    (
+    OutputRow::real(
         "motor_state_3",
         "1",
         "Lagged state of motor 3 (rear-right, CW)",
         |q| q.body.motors[3],
     ),
-    (
+    OutputRow::real(
         "wind_x",
         "m/s",
         "Wind at the vehicle, east (episode wind + turbulence + input)",
         |q| q.wind_velocity().x,
     ),
-    ("wind_y", "m/s", "Wind at the vehicle, north", |q| {
+    OutputRow::real("wind_y", "m/s", "Wind at the vehicle, north", |q| {
         q.wind_velocity().y
     }),
-    ("wind_z", "m/s", "Wind at the vehicle, up", |q| {
+    OutputRow::real("wind_z", "m/s", "Wind at the vehicle, up", |q| {
         q.wind_velocity().z
     }),
 ];
 
-/// Inputs: (name, unit, description, min, max).
-static INPUTS: &[(&str, &str, &str, f64, f64)] = &[
-    (
-        "motor_command_0",
-        "1",
-        "Command of motor 0 (front-right, CCW)",
-        0.0,
-        1.0,
-    ),
-    (
-        "motor_command_1",
-        "1",
-        "Command of motor 1 (rear-left, CCW)",
-        0.0,
-        1.0,
-    ),
-    (
-        "motor_command_2",
-        "1",
-        "Command of motor 2 (front-left, CW)",
-        0.0,
-        1.0,
-    ),
-    (
-        "motor_command_3",
-        "1",
-        "Command of motor 3 (rear-right, CW)",
-        0.0,
-        1.0,
-    ),
-    (
+/// Inputs; their order fixes the value references.
+const INPUTS: &[InputRow<Quadrotor>] = &[
+    motor::<0>("motor_command_0", "Command of motor 0 (front-right, CCW)"),
+    motor::<1>("motor_command_1", "Command of motor 1 (rear-left, CCW)"),
+    motor::<2>("motor_command_2", "Command of motor 2 (front-left, CW)"),
+    motor::<3>("motor_command_3", "Command of motor 3 (rear-right, CW)"),
+    wind::<0>(
         "wind_input_x",
-        "m/s",
         "External wind east, added to the model's wind",
-        -100.0,
-        100.0,
     ),
-    (
+    wind::<1>(
         "wind_input_y",
-        "m/s",
         "External wind north, added to the model's wind",
-        -100.0,
-        100.0,
     ),
-    (
+    wind::<2>(
         "wind_input_z",
-        "m/s",
         "External wind up, added to the model's wind",
-        -100.0,
-        100.0,
     ),
 ];
 
-const PARAMETERS: u32 = vr_block::PARAMETER;
-const INITIAL: u32 = vr_block::INITIAL;
-
-/// Every variable of the quadrotor, in value-reference order.
-pub fn variables() -> Vec<Variable> {
-    let inputs =
-        INPUTS
-            .iter()
-            .zip(vr_block::INPUT..)
-            .map(|(&(name, unit, description, min, max), vr)| Variable {
-                name,
-                value_reference: vr,
-                kind: ValueKind::Real,
-                causality: Causality::Input,
-                variability: Variability::Continuous,
-                unit,
-                description,
-                start: Some(0.0),
-                min: Some(min),
-                max: Some(max),
-            });
-    let outputs =
-        OUTPUTS
-            .iter()
-            .zip(vr_block::OUTPUT..)
-            .map(|(&(name, unit, description, _), vr)| Variable {
-                name,
-                value_reference: vr,
-                kind: ValueKind::Real,
-                causality: Causality::Output,
-                variability: Variability::Continuous,
-                unit,
-                description,
-                start: None,
-                min: None,
-                max: None,
-            });
-    inputs
-        .chain(outputs)
-        .chain(parameter_variables::<QuadrotorParams>(
-            PARAMETERS,
-            Variability::Fixed,
-        ))
-        .chain(parameter_variables::<QuadrotorInitial>(
-            INITIAL,
-            Variability::Fixed,
-        ))
-        .collect()
+/// Motor command `I` in [0, 1], starting at 0.
+const fn motor<const I: usize>(name: &'static str, text: &'static str) -> InputRow<Quadrotor> {
+    InputRow::new(
+        name,
+        "1",
+        text,
+        [0.0, 1.0, 0.0],
+        |q| q.command()[I],
+        set_motor::<I>,
+    )
 }
 
-/// Reads variable `vr`.
-pub fn get(quad: &Quadrotor, initial: &QuadrotorInitial, vr: u32) -> Result<f64, ParamError> {
-    let command = quad.command();
-    let external = quad.external_wind;
-    match vr {
-        0..=3 => Ok(command[vr as usize]),
-        4..=6 => Ok(external[(vr - 4) as usize]),
-        _ if vr >= INITIAL => Ok((parameter_at::<QuadrotorInitial>(vr, INITIAL)?.get)(
-            initial,
-        )),
-        _ if vr >= PARAMETERS => Ok((parameter_at::<QuadrotorParams>(vr, PARAMETERS)?.get)(
-            &quad.params,
-        )),
-        _ => {
-            let index = vr
-                .checked_sub(vr_block::OUTPUT)
-                .ok_or(ParamError::UnknownValueReference(vr))?;
-            let (_, _, _, getter) = OUTPUTS
-                .get(index as usize)
-                .ok_or(ParamError::UnknownValueReference(vr))?;
-            Ok(getter(quad))
-        }
+/// External wind component `I` in m/s.
+const fn wind<const I: usize>(name: &'static str, text: &'static str) -> InputRow<Quadrotor> {
+    let range = [-100.0, 100.0, 0.0];
+    InputRow::new(
+        name,
+        "m/s",
+        text,
+        range,
+        |q| q.external_wind[I],
+        set_wind::<I>,
+    )
+}
+
+fn set_motor<const I: usize>(quad: &mut Quadrotor, value: f64) -> Result<(), InputError> {
+    let mut command = quad.command();
+    command[I] = value;
+    quad.set_command(command)
+}
+
+fn set_wind<const I: usize>(quad: &mut Quadrotor, value: f64) -> Result<(), InputError> {
+    check_finite("wind input", &[value])?;
+    quad.external_wind[I] = value;
+    Ok(())
+}
+
+impl VariableTable for Quadrotor {
+    type Params = QuadrotorParams;
+    type Initial = QuadrotorInitial;
+    const INPUTS: &'static [InputRow<Self>] = INPUTS;
+    const OUTPUTS: &'static [OutputRow<Self>] = OUTPUTS;
+
+    fn params(&self) -> &QuadrotorParams {
+        &self.params
     }
-}
 
-/// Writes variable `vr`; the value is checked against the variable's range and nothing
-/// changes when it is refused.
-pub fn set(
-    quad: &mut Quadrotor,
-    initial: &mut QuadrotorInitial,
-    vr: u32,
-    value: f64,
-) -> Result<(), ParamError> {
-    match vr {
-        0..=6 => {
-            let (name, unit, _, min, max) = INPUTS[vr as usize];
-            if !(value >= min && value <= max) {
-                return Err(ParamError::OutOfRange {
-                    name,
-                    value,
-                    min,
-                    max,
-                    unit,
-                });
-            }
-            if vr < 4 {
-                let mut command = quad.command();
-                command[vr as usize] = value;
-                // Finite and in range: cannot fail.
-                quad.set_command(command)
-                    .map_err(|_| ParamError::NotSettable(name))?;
-            } else {
-                quad.external_wind[(vr - 4) as usize] = value;
-            }
-            Ok(())
-        }
-        _ if vr >= INITIAL => {
-            let name = parameter_at::<QuadrotorInitial>(vr, INITIAL)?.name;
-            initial.set(name, value)
-        }
-        _ if vr >= PARAMETERS => {
-            let name = parameter_at::<QuadrotorParams>(vr, PARAMETERS)?.name;
-            quad.params.set(name, value)
-        }
-        _ => {
-            let index = vr
-                .checked_sub(vr_block::OUTPUT)
-                .ok_or(ParamError::UnknownValueReference(vr))?;
-            let (name, ..) = OUTPUTS
-                .get(index as usize)
-                .ok_or(ParamError::UnknownValueReference(vr))?;
-            Err(ParamError::NotSettable(name))
-        }
+    fn set_parameter(&mut self, name: &'static str, value: f64) -> Result<(), ParamError> {
+        self.params.set(name, value)
     }
 }
 
@@ -299,6 +188,8 @@ mod tests {
     use super::*;
     use crate::quadrotor::BodyState;
     use crate::rng::SimRng;
+    use crate::variables::Causality;
+    use crate::variables::{get, set, variables};
     use nalgebra::Vector3;
 
     fn quad() -> Quadrotor {
@@ -308,7 +199,7 @@ mod tests {
 
     #[test]
     fn names_and_value_references_are_unique_and_every_one_reads() {
-        let vars = variables();
+        let vars = variables::<Quadrotor>();
         let q = quad();
         let init = QuadrotorInitial::default();
         crate::variables::assert_names_and_value_references_are_unique(&vars);
@@ -336,7 +227,7 @@ mod tests {
         let mut q = quad();
         let mut init = QuadrotorInitial::default();
         let vr = |name: &str| {
-            variables()
+            variables::<Quadrotor>()
                 .into_iter()
                 .find(|v| v.name == name)
                 .unwrap()
@@ -355,7 +246,7 @@ mod tests {
         let mut q = quad();
         let mut init = QuadrotorInitial::default();
         let vr = |name: &str| {
-            variables()
+            variables::<Quadrotor>()
                 .into_iter()
                 .find(|v| v.name == name)
                 .unwrap()

@@ -256,20 +256,6 @@ pub fn apply_action(quad: &mut Quadrotor, action: &[f64], dt: f64) -> Result<(),
     Ok(())
 }
 
-/// The episode's vehicle in its sampled start state, commanded to hold its motor state.
-/// `model` was validated when the task was built, so this only fails on a broken invariant.
-pub fn episode_vehicle(
-    model: QuadrotorParams,
-    body: BodyState,
-    rng: SimRng,
-) -> Result<Quadrotor, ParamError> {
-    let hold = body.motors[0];
-    let mut quad = Quadrotor::new(model, body, rng)?;
-    // A motor state is finite and in [0, 1], so the command is accepted.
-    let _ = quad.set_command([hold; 4]);
-    Ok(quad)
-}
-
 /// Episode bookkeeping shared by the flight tasks.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct FlightStatus {

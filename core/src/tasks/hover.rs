@@ -13,8 +13,8 @@
 
 use super::flight::{
     BASE_OBSERVATION_SIZE, FlightParams, FlightStatus, apply_action, base_bounds,
-    distance_and_direction, episode_vehicle, flight_info, is_crashed, sample_start, sample_target,
-    velocity_reward, write_base_observation,
+    distance_and_direction, flight_info, is_crashed, sample_start, sample_target, velocity_reward,
+    write_base_observation,
 };
 use super::{Info, StepOutcome, Task};
 use crate::error::ParamError;
@@ -115,12 +115,9 @@ impl Task for Hover {
 
     fn reset(&mut self, seed: u64) {
         let mut rng = SimRng::new(seed);
-        let model = self.quad.params.clone();
-        let body = sample_start(&self.params, &model, &mut rng);
+        let body = sample_start(&self.params, &self.quad.params, &mut rng);
         let target = sample_target(&self.params, &body.position, &mut rng);
-        if let Ok(quad) = episode_vehicle(model, body, rng) {
-            self.quad = quad;
-        }
+        self.quad.restart(body, rng);
         self.status = FlightStatus::default();
         self.set_target(target);
     }

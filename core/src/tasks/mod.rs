@@ -3,8 +3,6 @@
 //! Every front end (FMU, SITL, gymnasium adapter) drives a task through [`Task`]; none
 //! re-implements a reward or a termination.
 
-use std::fmt;
-
 /// One value of a task's info dictionary.
 #[derive(Debug, Clone, PartialEq)]
 pub enum InfoValue {
@@ -28,26 +26,13 @@ pub struct StepOutcome {
 }
 
 /// An action the task cannot take: wrong length or a non-finite entry.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ActionError {
+    #[error("action has {got} values, the task takes {expected}")]
     WrongLength { expected: usize, got: usize },
+    #[error("action value {index} is {value}, not a finite number")]
     NotFinite { index: usize, value: f64 },
 }
-
-impl fmt::Display for ActionError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ActionError::WrongLength { expected, got } => {
-                write!(f, "action has {got} values, the task takes {expected}")
-            }
-            ActionError::NotFinite { index, value } => {
-                write!(f, "action value {index} is {value}, not a finite number")
-            }
-        }
-    }
-}
-
-impl std::error::Error for ActionError {}
 
 /// Checks an action's length and that every entry is finite.
 pub fn check_action(action: &[f64], expected: usize) -> Result<(), ActionError> {

@@ -12,8 +12,8 @@
 
 use super::flight::{
     BASE_OBSERVATION_SIZE, FlightParams, FlightStatus, apply_action, base_bounds,
-    distance_and_direction, episode_vehicle, flight_info, is_crashed, sample_start, sample_target,
-    velocity_reward, write_base_observation,
+    distance_and_direction, flight_info, is_crashed, sample_start, sample_target, velocity_reward,
+    write_base_observation,
 };
 use super::{ActionError, Info, InfoValue, StepOutcome, Task, clip_f32};
 use crate::error::ParamError;
@@ -175,17 +175,14 @@ impl Task for Waypoints {
 
     fn reset(&mut self, seed: u64) {
         let mut rng = SimRng::new(seed);
-        let model = self.quad.params.clone();
-        let body = sample_start(&self.flight, &model, &mut rng);
+        let body = sample_start(&self.flight, &self.quad.params, &mut rng);
         let mut from = body.position;
         self.waypoints.clear();
         for _ in 0..self.params.max_num_waypoints {
             from = sample_target(&self.flight, &from, &mut rng);
             self.waypoints.push(from);
         }
-        if let Ok(quad) = episode_vehicle(model, body, rng) {
-            self.quad = quad;
-        }
+        self.quad.restart(body, rng);
         self.current = 0;
         self.reached = 0;
         self.steps_since_checkpoint = 0;

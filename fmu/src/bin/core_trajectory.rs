@@ -19,7 +19,7 @@
 use flyloop_core::Parameters;
 use flyloop_core::lander2d::{Lander2d, Lander2dInitial, Lander2dParams};
 use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial, QuadrotorParams};
-use flyloop_core::variables::Variable;
+use flyloop_core::variables::{self, Variable};
 use serde_json::{Map, Value, json};
 use std::io::Read;
 
@@ -36,13 +36,13 @@ struct Lander(Lander2d, Lander2dInitial);
 
 impl Core for Quad {
     fn variables() -> Vec<Variable> {
-        flyloop_core::quadrotor::variables::variables()
+        variables::variables::<Quadrotor>()
     }
     fn get(&self, vr: u32) -> f64 {
-        flyloop_core::quadrotor::variables::get(&self.0, &self.1, vr).unwrap()
+        variables::get(&self.0, &self.1, vr).unwrap()
     }
     fn set(&mut self, vr: u32, value: f64) {
-        flyloop_core::quadrotor::variables::set(&mut self.0, &mut self.1, vr, value).unwrap();
+        variables::set(&mut self.0, &mut self.1, vr, value).unwrap();
     }
     fn advance(&mut self, _end_time: f64, step_size: f64) {
         self.0.step(step_size);
@@ -51,13 +51,13 @@ impl Core for Quad {
 
 impl Core for Lander {
     fn variables() -> Vec<Variable> {
-        flyloop_core::lander2d::variables::variables()
+        variables::variables::<Lander2d>()
     }
     fn get(&self, vr: u32) -> f64 {
-        flyloop_core::lander2d::variables::get(&self.0, &self.1, vr).unwrap()
+        variables::get(&self.0, &self.1, vr).unwrap()
     }
     fn set(&mut self, vr: u32, value: f64) {
-        flyloop_core::lander2d::variables::set(&mut self.0, &mut self.1, vr, value).unwrap();
+        variables::set(&mut self.0, &mut self.1, vr, value).unwrap();
     }
     fn advance(&mut self, end_time: f64, _step_size: f64) {
         // Every whole control period that ends by end_time (the FMU's documented grid).

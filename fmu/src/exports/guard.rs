@@ -154,8 +154,7 @@ mod tests {
         unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
     }
 
-    /// Fixed-arity receiver of the FMU's one call shape (format, one string); see
-    /// tests/support/mod.rs.
+    /// Receiver of the FMU's one call shape (see [`crate::importer_logger`]).
     unsafe extern "C" fn record(
         _env: fmi2ComponentEnvironment,
         _name: fmi2String,
@@ -172,27 +171,7 @@ mod tests {
 
     #[test]
     fn a_panic_becomes_fatal_with_a_message_and_only_free_instance_remains() {
-        // SAFETY: same argument registers for the call shape the FMU uses.
-        let logger = unsafe {
-            std::mem::transmute::<
-                unsafe extern "C" fn(
-                    fmi2ComponentEnvironment,
-                    fmi2String,
-                    fmi2Status,
-                    fmi2String,
-                    fmi2String,
-                    fmi2String,
-                ),
-                fmi2CallbackLogger,
-            >(record)
-        };
-        let callbacks = fmi2CallbackFunctions {
-            logger: Some(logger),
-            allocateMemory: None,
-            freeMemory: None,
-            stepFinished: None,
-            componentEnvironment: std::ptr::null_mut(),
-        };
+        let callbacks = crate::importer_logger::callbacks(record, std::ptr::null_mut());
         let guid = crate::models::tables()[0].guid_c.clone();
         // SAFETY: valid strings and callbacks.
         let c = unsafe {

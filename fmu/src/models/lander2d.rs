@@ -5,7 +5,8 @@
 //! run no period at all; the outputs then stay as they are until the grid is reached.
 
 use crate::model::{FmuModel, ModelInfo, ModelTable, StepRequest};
-use flyloop_core::lander2d::{Lander2d, Lander2dInitial, variables};
+use flyloop_core::lander2d::{Lander2d, Lander2dInitial};
+use flyloop_core::variables;
 use flyloop_core::{ParamError, SnapshotError};
 use std::sync::OnceLock;
 
@@ -38,7 +39,7 @@ impl FmuModel for Lander2d {
 
     fn table() -> &'static ModelTable {
         static TABLE: OnceLock<ModelTable> = OnceLock::new();
-        TABLE.get_or_init(|| ModelTable::new(&INFO, variables::variables()))
+        TABLE.get_or_init(|| ModelTable::new(&INFO, variables::variables::<Lander2d>()))
     }
 
     fn build(previous: Option<&Self>, initial: &Lander2dInitial) -> Result<Self, ParamError> {

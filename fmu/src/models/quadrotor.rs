@@ -3,7 +3,8 @@
 //! the wind of the step's start.
 
 use crate::model::{FmuModel, ModelInfo, ModelTable, StepRequest};
-use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial, variables};
+use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial};
+use flyloop_core::variables;
 use flyloop_core::{ParamError, SnapshotError};
 use std::sync::OnceLock;
 
@@ -31,7 +32,7 @@ impl FmuModel for Quadrotor {
 
     fn table() -> &'static ModelTable {
         static TABLE: OnceLock<ModelTable> = OnceLock::new();
-        TABLE.get_or_init(|| ModelTable::new(&INFO, variables::variables()))
+        TABLE.get_or_init(|| ModelTable::new(&INFO, variables::variables::<Quadrotor>()))
     }
 
     fn build(previous: Option<&Self>, initial: &QuadrotorInitial) -> Result<Self, ParamError> {

@@ -4,6 +4,7 @@
 
 use flyloop_fmu::exports::*;
 use flyloop_fmu::fmi2_types::*;
+use flyloop_fmu::importer_logger;
 use flyloop_fmu::models::tables;
 use std::ffi::{CStr, CString, c_char, c_void};
 use std::sync::Mutex;
@@ -58,10 +59,8 @@ fn text(p: *const c_char) -> String {
     }
 }
 
-/// The logger, with the variadic part spelled out: the FMU always calls it with exactly one
-/// argument after the format ("%s", message). On x86-64 and AArch64 Linux a variadic call
-/// passes that argument where this fixed-arity function reads it. (Stable Rust cannot
-/// define a C-variadic function.)
+/// The recording receiver of the FMU's one logger call shape
+/// (see `flyloop_fmu::importer_logger`).
 unsafe extern "C" fn record(
     env: fmi2ComponentEnvironment,
     instance: fmi2String,
@@ -86,20 +85,7 @@ unsafe extern "C" fn record(
 
 /// The recording logger as the variadic callback type.
 pub fn recording_logger() -> fmi2CallbackLogger {
-    // SAFETY: see `record`: same argument registers for the one call shape the FMU uses.
-    unsafe {
-        std::mem::transmute::<
-            unsafe extern "C" fn(
-                fmi2ComponentEnvironment,
-                fmi2String,
-                fmi2Status,
-                fmi2String,
-                fmi2String,
-                fmi2String,
-            ),
-            fmi2CallbackLogger,
-        >(record)
-    }
+    importer_logger::variadic(record)
 }
 
 /// An instance with its recorder; freed on drop.
@@ -111,13 +97,10 @@ pub struct Fmu {
 }
 
 pub fn callbacks_for(recorder: &Recorder) -> Box<fmi2CallbackFunctions> {
-    Box::new(fmi2CallbackFunctions {
-        logger: Some(recording_logger()),
-        allocateMemory: None,
-        freeMemory: None,
-        stepFinished: None,
-        componentEnvironment: recorder as *const Recorder as *mut c_void,
-    })
+    Box::new(importer_logger::callbacks(
+        record,
+        recorder as *const Recorder as *mut c_void,
+    ))
 }
 
 impl Fmu {

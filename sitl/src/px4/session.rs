@@ -4,8 +4,7 @@
 use super::config::Px4Config;
 use super::messages;
 use super::track::Track;
-use crate::kinematics::Home;
-use crate::model::quadrotor_kinematics;
+use crate::kinematics::{Home, Kinematics};
 use crate::stats::Stats;
 use crate::telemetry;
 use crate::wire::{Encoder, StreamDecoder};
@@ -246,7 +245,7 @@ impl Session {
         }
         if let Some(interval) = self.state_interval_us {
             if self.time_us >= self.next_state_us {
-                let k = quadrotor_kinematics(&self.quad);
+                let k = Kinematics::of_quadrotor(&self.quad);
                 let state = telemetry::hil_state_quaternion_of(&k, &self.home, self.time_us);
                 self.encoder.push(out, SIMULATOR_SYSTEM, &state);
                 self.next_state_us += interval;
