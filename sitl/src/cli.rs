@@ -105,13 +105,23 @@ pub struct Args {
     #[arg(long)]
     pub track: Option<PathBuf>,
 
-    /// Print the parameter table (MAVLink ids, names, ranges, defaults) and exit.
-    #[arg(long)]
-    pub list_params: bool,
+    /// Print the task's parameters and exit: `table` (MAVLink ids, names, ranges, defaults;
+    /// the default) or `toml` (a starter file for --config, with --config's values if given).
+    #[arg(long, value_enum, num_args = 0..=1, default_missing_value = "table")]
+    pub list_params: Option<ListFormat>,
 
     /// Print the task frame layout (DEBUG_FLOAT_ARRAY indices) and exit.
     #[arg(long)]
     pub describe_frame: bool,
+}
+
+/// How `--list-params` prints.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ListFormat {
+    /// A Markdown table: MAVLink id, core name, set, type, unit, default, range.
+    Table,
+    /// A starter parameter file for `--config`.
+    Toml,
 }
 
 /// Where ground-station telemetry goes.

@@ -22,6 +22,7 @@ pub mod param_table;
 pub mod px4;
 pub mod server;
 pub mod sim;
+pub mod starter_config;
 pub mod stats;
 pub mod task_frame;
 pub mod telemetry;

@@ -2,7 +2,7 @@
 
 use clap::Parser;
 use flyloop_core::ParamError;
-use flyloop_sitl::cli::{Args, GcsTarget};
+use flyloop_sitl::cli::{Args, GcsTarget, ListFormat};
 use flyloop_sitl::config::{self, ConfigError};
 use flyloop_sitl::model::{ModelKind, TaskConfig, TaskInstance, TaskKind};
 use flyloop_sitl::px4;
@@ -12,7 +12,7 @@ use flyloop_sitl::px4::session::{Session, SessionOptions};
 use flyloop_sitl::px4::track::Track;
 use flyloop_sitl::server::{self, GcsLink};
 use flyloop_sitl::sim::{Sim, SimOptions};
-use flyloop_sitl::{param_table, task_frame};
+use flyloop_sitl::{param_table, starter_config, task_frame};
 use std::io::IsTerminal;
 use std::net::SocketAddr;
 use std::process::ExitCode;
@@ -177,9 +177,16 @@ fn start(args: Args) -> Result<(), StartError> {
         Some(path) => config::load(task, path)?,
         None => TaskConfig::default(),
     };
-    if args.list_params {
-        print!("{}", param_table::listing(task, &config));
-        return Ok(());
+    match args.list_params {
+        Some(ListFormat::Table) => {
+            print!("{}", param_table::listing(task, &config));
+            return Ok(());
+        }
+        Some(ListFormat::Toml) => {
+            print!("{}", starter_config::starter_toml(task, &config));
+            return Ok(());
+        }
+        None => {}
     }
     if args.describe_frame {
         print!("{}", describe_frame(task, &config)?);
