@@ -43,6 +43,10 @@ pub fn callbacks(
 }
 
 /// A receiver that drops every message (benchmarks).
+///
+/// # Safety
+///
+/// Nothing to uphold: it reads none of its arguments (`unsafe` only to have the logger's type).
 pub unsafe extern "C" fn quiet(
     _env: fmi2ComponentEnvironment,
     _name: fmi2String,
