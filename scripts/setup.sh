@@ -8,6 +8,19 @@ demo=1
 [[ "${1:-}" == "--no-demo" ]] && demo=0
 
 say() { printf '\n==> %s\n' "$*"; }
+fail() { printf '\nsetup.sh: %s\n' "$*" >&2; exit 1; }
+
+# The toolchains first, so a missing one is one clear line and not a failure 15 minutes in.
+# Rust: the workspace uses edition 2024 (rust-version in Cargo.toml), i.e. Rust >= 1.85.
+rust_min=$(sed -n 's/^rust-version = "\(.*\)"/\1/p' Cargo.toml)
+command -v cargo >/dev/null && command -v rustc >/dev/null ||
+    fail "cargo and rustc not found: install Rust >= $rust_min (e.g. with rustup), then re-run."
+rust_version=$(rustc --version | awk '{print $2}')
+[[ $(printf '%s\n%s\n' "$rust_min" "${rust_version%%-*}" | sort -V | head -1) == "$rust_min" ]] ||
+    fail "Rust $rust_version is too old: the workspace needs >= $rust_min (edition 2024); run 'rustup update stable'."
+command -v python3 >/dev/null || fail "python3 not found: install Python >= 3.10."
+python3 -c 'import sys; sys.exit(sys.version_info < (3, 10))' ||
+    fail "$(python3 --version) is too old: flyloop needs Python >= 3.10."
 
 packages=$(grep -v '^#' scripts/apt-packages.txt | xargs)
 missing=$(for p in $packages; do dpkg -s "$p" >/dev/null 2>&1 || echo "$p"; done | xargs)

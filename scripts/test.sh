@@ -10,8 +10,15 @@ say "cargo fmt --check"
 cargo fmt --all --check
 say "cargo clippy (all targets, warnings are errors)"
 cargo clippy --workspace --all-targets -- -D warnings
-say "Rust tests (cargo nextest)"
-cargo nextest run --workspace --release
+# cargo-nextest when it is installed (a process per test, faster); otherwise cargo's own
+# runner over the same targets (lib, bins, integration tests; doctests below).
+if cargo nextest --version >/dev/null 2>&1; then
+    say "Rust tests (cargo nextest)"
+    cargo nextest run --workspace --release
+else
+    say "Rust tests (cargo test; cargo-nextest is not installed)"
+    cargo test --workspace --release --lib --bins --tests
+fi
 say "Rust doctests"
 cargo test --workspace --release --doc
 say "ruff"
