@@ -1,28 +1,36 @@
-"""Throughput of the gymnasium adapter: env steps per second with random actions.
+"""Throughput of the gymnasium envs, native vs SITL backend in one run: env steps per second
+with random actions, and the memory of the native vector env.
 
-    cargo build --release -p flyloop-sitl
-    .venv/bin/python benchmarks/gym_throughput.py [--seconds 5] [--vehicles 16]
+    bash scripts/setup.sh --no-demo      # or: cargo build --release; pip install -e python
+    .venv/bin/python benchmarks/gym_throughput.py [--seconds 3] [--vehicles 16]
+        [--native-envs 1024] [--memory-envs 100000]
 
-For each env id: a single env made with gymnasium.make (the env checker wrappers included),
-stepping random actions and resetting when an episode ends, rendering off; then the vector
-env with --vehicles vehicles in one SITL (gymnasium.make_vec). Random actions are drawn from
-numpy in batches, so the figure is the env's own cost; --sample-actions calls
-action_space.sample() every step instead (flyloop's FastBox: ~5 µs, gymnasium's Box: ~35 µs).
-Wall-clock time, so run it on a quiet machine (`uptime` load < 1); the SITL runs in its own
-process, so one env keeps about two cores busy.
+For each env id:
+- single env made with gymnasium.make (env checker wrappers included), both backends,
+  stepping random actions and resetting when an episode ends, rendering off;
+- the SITL vector env with --vehicles vehicles in one SITL process;
+- the native vector env with --native-envs sub-envs (all CPUs), NEXT_STEP autoreset,
+  copy=False (the arrays a learner reads in place).
+Random actions are drawn from numpy in batches, so the figure is the env's own cost
+(--sample-actions calls action_space.sample() every step instead).
+Memory: resident-set growth of making the native vector env, per env, for QuadHover and
+Lander2D, and for --memory-envs QuadHover envs in one vector env (0 skips).
+Wall-clock time, so run it on a quiet machine (`uptime` load < 1).
 """
 
 from __future__ import annotations
 
 import argparse
+import gc
 import os
 import time
 
-import flyloop  # noqa: F401  (registers the env ids)
 import gymnasium as gym
 import numpy as np
 
-ENV_IDS = ["flyloop/QuadHover-v0", "flyloop/QuadWaypoints-v0", "flyloop/Lander2D-v0"]
+import flyloop  # noqa: F401  (registers the env ids)
+from flyloop.registration import ENVS
+
 BATCH = 4096
 
 
@@ -30,8 +38,8 @@ def _actions(space, rng, n):
     return rng.uniform(space.low, space.high, (n, *space.shape)).astype(np.float32)
 
 
-def single(env_id: str, seconds: float, sample: bool) -> float:
-    env = gym.make(env_id)
+def single(env_id: str, seconds: float, sample: bool, backend: str) -> float:
+    env = gym.make(env_id, backend=backend)
     rng = np.random.default_rng(0)
     env.reset(seed=0)
     steps, start = 0, time.perf_counter()
@@ -49,38 +57,79 @@ def single(env_id: str, seconds: float, sample: bool) -> float:
     return rate
 
 
-def vector(env_id: str, vehicles: int, seconds: float, sample: bool) -> float:
-    envs = gym.make_vec(env_id, num_envs=vehicles)
+def vector(env_id: str, n: int, seconds: float, sample: bool, **kwargs) -> float:
+    envs = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", **kwargs)
     rng = np.random.default_rng(0)
     envs.reset(seed=0)
+    rounds = max(1, min(256, 65536 // n))
     steps, start = 0, time.perf_counter()
     while time.perf_counter() - start < seconds:
-        actions = _actions(envs.single_action_space, rng, 256 * vehicles).reshape(256, vehicles, -1)
+        actions = _actions(envs.single_action_space, rng, rounds * n).reshape(rounds, n, -1)
         for a in actions:
             if sample:
                 a = envs.action_space.sample()
             envs.step(a)  # NEXT_STEP autoreset: no reset call needed
-        steps += 256 * vehicles
+        steps += rounds * n
     rate = steps / (time.perf_counter() - start)
     envs.close()
     return rate
 
 
+def _rss_bytes() -> int:
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+
+def memory_per_env(env_id: str, n: int) -> tuple[float, float]:
+    """(bytes per env, total MB) of a native vector env of `n` envs, after a reset."""
+    gc.collect()
+    before = _rss_bytes()
+    envs = gym.make_vec(
+        env_id, num_envs=n, vectorization_mode="vector_entry_point", backend="native", copy=False
+    )
+    envs.reset(seed=0)
+    grown = _rss_bytes() - before
+    envs.close()
+    del envs
+    gc.collect()
+    return grown / n, grown / 1e6
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seconds", type=float, default=5.0, help="per measurement")
-    parser.add_argument("--vehicles", type=int, default=16)
+    parser.add_argument("--seconds", type=float, default=3.0, help="per measurement")
+    parser.add_argument("--vehicles", type=int, default=16, help="SITL vector env size")
+    parser.add_argument("--native-envs", type=int, default=1024, help="native vector env size")
+    parser.add_argument("--memory-envs", type=int, default=100_000)
     parser.add_argument("--sample-actions", action="store_true")
-    parser.add_argument("--env", action="append", choices=ENV_IDS, help="default: all three")
+    parser.add_argument("--env", action="append", choices=sorted(ENVS), help="default: all")
     args = parser.parse_args()
     load = os.getloadavg()[0]
     print(f"load average {load:.2f}{'  (busy machine: figures are low)' if load > 1 else ''}")
-    print(f"| env | single env steps/s | vector env ({args.vehicles} vehicles) env-steps/s |")
-    print("|---|---|---|")
-    for env_id in args.env or ENV_IDS:
-        s = single(env_id, args.seconds, args.sample_actions)
-        v = vector(env_id, args.vehicles, args.seconds, args.sample_actions)
-        print(f"| {env_id} | {s:,.0f} | {v:,.0f} |", flush=True)
+    print(
+        f"| env | single SITL | single native | native/SITL | vector SITL ({args.vehicles}) "
+        f"| vector native ({args.native_envs}) | native/SITL |"
+    )
+    print("|---|---|---|---|---|---|---|")
+    t, s = args.seconds, args.sample_actions
+    for env_id in args.env or sorted(ENVS):
+        s_sitl = single(env_id, t, s, "sitl")
+        s_nat = single(env_id, t, s, "native")
+        v_sitl = vector(env_id, args.vehicles, t, s)
+        v_nat = vector(env_id, args.native_envs, t, s, backend="native", copy=False)
+        print(
+            f"| {env_id} | {s_sitl:,.0f} | {s_nat:,.0f} | {s_nat / s_sitl:.0f}x "
+            f"| {v_sitl:,.0f} | {v_nat:,.0f} | {v_nat / v_sitl:.0f}x |",
+            flush=True,
+        )
+    print("\n| native vector env | envs | memory per env | total |")
+    print("|---|---|---|---|")
+    sizes = [("flyloop/QuadHover-v0", 10_000), ("flyloop/Lander2D-v0", 1_000)]
+    if args.memory_envs:
+        sizes.append(("flyloop/QuadHover-v0", args.memory_envs))
+    for env_id, n in sizes:
+        per, total = memory_per_env(env_id, n)
+        print(f"| {env_id} | {n:,} | {per / 1024:,.1f} KiB | {total:,.0f} MB |", flush=True)
 
 
 if __name__ == "__main__":

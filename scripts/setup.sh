@@ -37,10 +37,15 @@ say "Python venv .venv (test peers: fmpy, libcosimpy, pymavlink, MAVProxy, pytes
 [[ -x .venv/bin/python ]] || python3 -m venv .venv
 .venv/bin/pip install -q --upgrade pip
 .venv/bin/pip install -q -r tests/requirements.txt
-.venv/bin/pip install -q -e python
 
 say "Rust build (release)"
 cargo build --release --workspace --all-targets
+
+say "Python package flyloop with its extension flyloop._native (editable, maturin)"
+# maturin builds the extension into the workspace's target/ with the release profile, so it
+# reuses what the cargo build above compiled. --no-build-isolation: maturin comes from
+# tests/requirements.txt (PATH lets pip's maturin hook find it).
+PATH="$PWD/.venv/bin:$PATH" .venv/bin/pip install -q --no-build-isolation -e python
 
 say "FMUs → dist/fmu/"
 bash scripts/pack-fmus.sh

@@ -5,17 +5,19 @@ from __future__ import annotations
 import gymnasium
 
 ENVS = {
-    "flyloop/QuadHover-v0": ("flyloop.envs:QuadHoverEnv", "flyloop.vector:QuadHoverVectorEnv"),
+    "flyloop/QuadHover-v0": ("flyloop.envs:QuadHoverEnv", "flyloop.vector:quad_hover_vector"),
     "flyloop/QuadWaypoints-v0": (
         "flyloop.envs:QuadWaypointsEnv",
-        "flyloop.vector:QuadWaypointsVectorEnv",
+        "flyloop.vector:quad_waypoints_vector",
     ),
-    "flyloop/Lander2D-v0": ("flyloop.envs:Lander2DEnv", "flyloop.vector:Lander2DVectorEnv"),
+    "flyloop/Lander2D-v0": ("flyloop.envs:Lander2DEnv", "flyloop.vector:lander2d_vector"),
 }
 
 
 def register_envs() -> None:
-    """Registers the three env ids (idempotent). No TimeLimit wrapper: the core truncates at
+    """Registers the env ids (idempotent). Each takes `backend="sitl"` (default) or
+    `"native"`, in `gymnasium.make` and in `gymnasium.make_vec(...,
+    vectorization_mode="vector_entry_point")`. No TimeLimit wrapper: the core truncates at
     `max_steps` itself; the env checker is left on (gymnasium's default)."""
     for env_id, (entry, vector_entry) in ENVS.items():
         if env_id in gymnasium.registry:

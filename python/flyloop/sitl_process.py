@@ -16,6 +16,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import sysconfig
 import tempfile
 import threading
 import time
@@ -55,6 +56,12 @@ def _workspace_binary() -> Path | None:
     return target / "release" / BINARY_NAME
 
 
+def _installed_command() -> Path:
+    """The `flyloop-sitl` console command the wheel installs beside this interpreter (found
+    even when the venv is not activated, i.e. not on PATH)."""
+    return Path(sysconfig.get_path("scripts")) / BINARY_NAME
+
+
 def _usable(path: Path) -> bool:
     return path.is_file() and os.access(path, os.X_OK)
 
@@ -69,7 +76,9 @@ def find_sitl_binary(
     3. `flyloop-sitl` on PATH,
     4. the workspace build: <repo>/target/release/flyloop-sitl, or
        $CARGO_TARGET_DIR/release/flyloop-sitl when CARGO_TARGET_DIR is set
-       (only when this package is used from the repository, e.g. `pip install -e python`).
+       (only when this package is used from the repository, e.g. `pip install -e python`),
+    5. the `flyloop-sitl` command installed with this package (the wheel's console script,
+       the SITL compiled into the extension) in this interpreter's scripts directory.
 
     With `build=True` (the test suites), 3 is skipped and 4 is first brought up to date
     with `cargo build --release -p flyloop-sitl`, so tests fly the code of the checkout.
@@ -95,6 +104,9 @@ def find_sitl_binary(
     workspace = _workspace_binary()
     if workspace is not None and _usable(workspace):
         return workspace
+    installed = _installed_command()
+    if _usable(installed):
+        return installed
     looked = [
         "the sitl_path argument (not given)",
         f"${ENV_VAR} (not set)",
@@ -102,6 +114,7 @@ def find_sitl_binary(
     ]
     if workspace is not None:
         looked.append(f"the workspace build {workspace} (missing)")
+    looked.append(f"the command installed with this package, {installed} (missing)")
     raise SitlNotFoundError(
         "cannot find the flyloop-sitl binary; looked at: "
         + "; ".join(looked)

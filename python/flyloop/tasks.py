@@ -1,16 +1,17 @@
 """What the adapter knows about each task: the one table that maps env arguments (the seeds'
-names) onto the core's parameters, the info layout of the task frame, and the observation
-and action bounds the core declares.
+names) onto the core's parameters. Everything else — parameter names, MAVLink param_ids,
+defaults, ranges, units and descriptions, the info layout, the control period and the
+observation and action bounds — is read from the core through the extension
+(`flyloop._native.describe`), for both backends.
 
 Nothing here computes a reward, a termination or an observation value: those come from the
-core through the SITL's task frame. The bounds below mirror the core's `observation_bounds`
-(core/src/tasks/flight.rs `base_bounds`/`wind_bound`, waypoints.rs, landing.rs) because the
-SITL does not send them; tests check every observation stays inside them.
+core, in-process (backend="native") or through the SITL's task frame (backend="sitl").
 """
 
 from __future__ import annotations
 
 import difflib
+import functools
 import math
 import numbers
 from collections.abc import Callable, Mapping
@@ -19,107 +20,8 @@ from typing import Any
 
 import numpy as np
 
+from . import _native
 from .errors import SitlParameterError
-
-# ---- the core's parameter names and their MAVLink param_ids (`flyloop-sitl --list-params`) ----
-
-QUADROTOR_PARAMS: dict[str, str] = {
-    "mass": "mass",
-    "arm_length": "arm_length",
-    "inertia_xx": "inertia_xx",
-    "inertia_yy": "inertia_yy",
-    "inertia_zz": "inertia_zz",
-    "gravity": "gravity",
-    "thrust_coefficient": "thrust_coef",
-    "motor_time_constant": "motor_time_const",
-    "yaw_torque_coefficient": "yaw_torque_coef",
-    "air_density": "air_density",
-    "drag_area": "drag_area",
-    "angular_damping_linear": "ang_damp_lin",
-    "angular_damping_quadratic": "ang_damp_quad",
-    "pendulum_coefficient": "pend_coef",
-    "max_substep": "max_substep",
-    "ground_enabled": "ground_enabled",
-    "wind_enabled": "wind_enabled",
-    "wind_speed_min": "wind_speed_min",
-    "wind_speed_max": "wind_speed_max",
-    "turbulence_theta": "turbulence_theta",
-    "turbulence_sigma": "turbulence_sigma",
-    "turbulence_vertical_ratio": "turb_vert_ratio",
-}
-FLIGHT_PARAMS: dict[str, str] = {
-    "dt": "dt",
-    "max_steps": "max_steps",
-    "target_change_interval": "tgt_chg_intv",
-    "space_side_length": "space_side_len",
-    "start_height": "start_height",
-    "start_attitude_range": "start_att_rng",
-    "min_target_distance": "min_tgt_dist",
-    "velocity_scale": "velocity_scale",
-    "enable_crash_detection": "en_crash_det",
-    "enable_out_of_bounds_detection": "en_oob_det",
-    "crash_z_vel_threshold": "crash_z_vel_thr",
-    "crash_tilt_threshold": "crash_tilt_thr",
-}
-WAYPOINT_PARAMS: dict[str, str] = {
-    "max_num_waypoints": "max_num_wps",
-    "waypoint_reach_threshold_m": "wp_reach_thr_m",
-    "checkpoint_bonus": "checkpoint_bonus",
-    "bonus_decay_rate_per_sec": "bonus_dcy_rt_p_s",
-}
-LANDER_PARAMS: dict[str, str] = {
-    "gravity": "gravity",
-    "world_width": "world_width",
-    "world_height": "world_height",
-    "ground_height": "ground_height",
-    "ground_friction": "ground_friction",
-    "drone_mass": "drone_mass",
-    "drone_width": "drone_width",
-    "drone_height": "drone_height",
-    "drone_friction": "drone_friction",
-    "max_thrust": "max_thrust",
-    "thrust_noise_std": "thrust_noise_std",
-    "initial_battery": "initial_battery",
-    "battery_consumption_rate": "batt_cons_rt",
-    "wind_enabled": "wind_enabled",
-    "wind_speed": "wind_speed",
-    "wind_force_coefficient": "wind_force_coef",
-    "wind_direction_random": "wind_dir_rnd",
-    "wind_direction": "wind_direction",
-    "platform_width": "platform_width",
-    "platform_height": "platform_height",
-    "platform_friction": "plat_fric",
-    "platform_start_x": "platform_start_x",
-    "platform_random_start_x": "plat_rnd_start_x",
-    "moving_platform": "moving_platform",
-    "platform_speed": "platform_speed",
-    "max_safe_landing_speed": "max_safe_lnd_spd",
-    "max_safe_landing_angle": "max_safe_lnd_ang",
-    "dt": "dt",
-    "physics_substeps": "physics_substeps",
-}
-LANDING_PARAMS: dict[str, str] = {
-    "max_steps": "max_steps",
-    "initial_pos_random_range_m": "ini_pos_rnd_rng",
-    "spawn_x": "spawn_x",
-    "spawn_y": "spawn_y",
-    "initial_angle_random_range_rad": "ini_ang_rnd_rng",
-    "max_allowed_tilt_angle_rad": "max_alw_tilt_ang",
-}
-
-# Core defaults the adapter needs to declare bounds and draw scenes (docs/parameters.md).
-CORE_DEFAULTS: dict[str, float] = {
-    "wind_enabled": True,
-    "wind_speed_max": 5.0,
-    "turbulence_theta": 0.5,
-    "turbulence_sigma": 1.0,
-    "arm_length": 0.1,
-    "space_side_length": 3.0,
-    "max_steps": 1000,
-    "dt": 0.01,
-    "moving_platform": False,
-}
-
 
 # ---- argument conversion: seed names and Python values -> core names and numbers ----
 
@@ -325,104 +227,74 @@ LANDING_ARGUMENTS: list[Argument] = [
 ]
 
 
-# ---- info layout of the task frame (docs/protocol.md, `flyloop-sitl --describe-frame`) ----
+# ---- the core's description of a task ----
 
 REAL, INTEGER, FLAG, VECTOR = "real", "integer", "flag", "vector"
 
-FLIGHT_INFO: list[tuple[str, str, int]] = [
-    ("distance_to_target", REAL, 1),
-    ("position", VECTOR, 3),
-    ("target_position", VECTOR, 3),
-    ("step_count", INTEGER, 1),
-    ("episode_time", REAL, 1),
-    ("distance_progress", REAL, 1),
-    ("crashed", FLAG, 1),
-    ("out_of_bounds", FLAG, 1),
-]
-WAYPOINT_INFO = FLIGHT_INFO + [
-    ("waypoints_reached", INTEGER, 1),
-    ("current_waypoint_pos", VECTOR, 3),
-    ("next_waypoint_pos", VECTOR, 3),
-    ("steps_since_checkpoint", REAL, 1),
-]
-LANDING_INFO: list[tuple[str, str, int]] = [
-    ("position", VECTOR, 2),
-    ("velocity", VECTOR, 2),
-    ("angle", REAL, 1),
-    ("angular_velocity", REAL, 1),
-    ("battery", REAL, 1),
-    ("thrust", VECTOR, 2),
-    ("wind_force", VECTOR, 2),
-    ("platform_position", VECTOR, 2),
-    ("distance", REAL, 1),
-    ("landed", FLAG, 1),
-    ("crashed", FLAG, 1),
-    ("lost_control", FLAG, 1),
-    ("out_of_bounds", FLAG, 1),
-    ("battery_empty", FLAG, 1),
-    ("time_limit", FLAG, 1),
-    ("platform_contact", FLAG, 1),
-    ("touchdown_speed", REAL, 1),
-    ("step", INTEGER, 1),
-]
+
+@functools.cache
+def _default_description(task: str) -> dict[str, Any]:
+    return _native.describe(task)
 
 
 @dataclass(frozen=True)
 class TaskSpec:
-    """A task as the adapter sees it."""
+    """A task as the adapter sees it: its env arguments; the rest comes from the core."""
 
-    name: str  # the SITL's --task and the frame's DEBUG_FLOAT_ARRAY name
+    name: str  # the core's task name: the SITL's --task and the frame's DEBUG_FLOAT_ARRAY name
     env_id: str
     arguments: tuple[Argument, ...]
-    model_params: Mapping[str, str]  # core name -> param_id of the model's set
-    task_params: Mapping[str, str]  # core name -> param_id of the task's sets
-    info: tuple[tuple[str, str, int], ...]
-    action_low: float
-    action_high: float
-    action_size: int
+
+    @property
+    def parameters(self) -> tuple[dict[str, Any], ...]:
+        """The core's parameter table of the task: dicts with name, id (MAVLink param_id),
+        group, kind, unit, min, max, default, description."""
+        return tuple(_default_description(self.name)["parameters"])
 
     @property
     def param_ids(self) -> dict[str, str]:
-        return {**self.model_params, **self.task_params}
+        """Core name -> MAVLink param_id, for every parameter of the task."""
+        return {p["name"]: p["id"] for p in self.parameters}
+
+    @property
+    def model_params(self) -> dict[str, str]:
+        """Core name -> param_id of the model's parameters (what `model_params` may set)."""
+        return {p["name"]: p["id"] for p in self.parameters if p["group"].startswith("model")}
+
+    @property
+    def defaults(self) -> dict[str, float]:
+        """Core name -> default value."""
+        return {p["name"]: p["default"] for p in self.parameters}
+
+    @property
+    def info(self) -> tuple[tuple[str, str, int], ...]:
+        """The info layout: (name, kind, number of values) in the task frame's order."""
+        return tuple(tuple(e) for e in _default_description(self.name)["info"])
 
     def info_size(self) -> int:
         return sum(n for _, _, n in self.info)
 
+    def describe(self, config: Mapping[str, Any]) -> dict[str, Any]:
+        """The core's description of the task built from `config` (core name -> value):
+        observation and action bounds, dt, info layout, parameters with their `value`.
+        A value the core refuses raises SitlParameterError naming the env argument."""
+        try:
+            return _native.describe(self.name, {k: float(v) for k, v in config.items()})
+        except ValueError as exc:
+            raise parameter_error(self, str(exc)) from None
 
-HOVER = TaskSpec(
-    "hover",
-    "flyloop/QuadHover-v0",
-    tuple(FLIGHT_ARGUMENTS),
-    QUADROTOR_PARAMS,
-    FLIGHT_PARAMS,
-    tuple(FLIGHT_INFO),
-    0.0,
-    1.0,
-    4,
-)
+
+HOVER = TaskSpec("hover", "flyloop/QuadHover-v0", tuple(FLIGHT_ARGUMENTS))
 WAYPOINTS = TaskSpec(
-    "waypoints",
-    "flyloop/QuadWaypoints-v0",
-    tuple(FLIGHT_ARGUMENTS + WAYPOINT_ARGUMENTS),
-    QUADROTOR_PARAMS,
-    {**FLIGHT_PARAMS, **WAYPOINT_PARAMS},
-    tuple(WAYPOINT_INFO),
-    0.0,
-    1.0,
-    4,
+    "waypoints", "flyloop/QuadWaypoints-v0", tuple(FLIGHT_ARGUMENTS + WAYPOINT_ARGUMENTS)
 )
-LANDING = TaskSpec(
-    "landing",
-    "flyloop/Lander2D-v0",
-    tuple(LANDING_ARGUMENTS),
-    {k: v for k, v in LANDER_PARAMS.items()},
-    LANDING_PARAMS,
-    tuple(LANDING_INFO),
-    -1.0,
-    1.0,
-    2,
-)
+LANDING = TaskSpec("landing", "flyloop/Lander2D-v0", tuple(LANDING_ARGUMENTS))
 TASKS = {t.name: t for t in (HOVER, WAYPOINTS, LANDING)}
+
+
+def parameter_values(description: Mapping[str, Any]) -> dict[str, float]:
+    """Core name -> value in effect, from a `TaskSpec.describe` result."""
+    return {p["name"]: p["value"] for p in description["parameters"]}
 
 
 def resolve_config(
@@ -493,50 +365,3 @@ def to_toml(config: Mapping[str, bool | int | float]) -> str:
             text = repr(float(v))
         lines.append(f"{name} = {text}")
     return "\n".join(lines) + "\n"
-
-
-# ---- bounds the core declares (see the module docstring) ----
-
-
-def _value(config: Mapping[str, Any], name: str) -> Any:
-    return config.get(name, CORE_DEFAULTS[name])
-
-
-def wind_bound(config: Mapping[str, Any]) -> float:
-    """core::tasks::flight::wind_bound."""
-    if not _value(config, "wind_enabled"):
-        return 1.0
-    theta = max(float(_value(config, "turbulence_theta")), 0.05)
-    stationary = float(_value(config, "turbulence_sigma")) / math.sqrt(2.0 * theta)
-    return max(float(_value(config, "wind_speed_max")) + 5.0 * stationary, 1.0)
-
-
-def observation_bounds(spec: TaskSpec, config: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
-    """Per-value inclusive bounds of the observation (float32), as the core declares them."""
-    if spec is LANDING:
-        n = 12 if _value(config, "moving_platform") else 11
-        low = np.full(n, -1.0, np.float32)
-        low[[6, 10]] = 0.0
-        return low, np.ones(n, np.float32)
-    side = float(_value(config, "space_side_length"))
-    position = math.sqrt(3.0) * side * (2.0 if spec is WAYPOINTS else 1.0)
-    wind = wind_bound(config)
-    groups = [
-        (3, position),
-        (3, 40.0),
-        (3, 50.0),
-        (4, 1.0),
-        (3, 10.0),
-        (3, 100.0),
-        (3, 1.0),
-        (3, wind),
-    ]
-    low = [-b for n, b in groups for _ in range(n)] + [0.0] * 8
-    high = [b for n, b in groups for _ in range(n)] + [1.0] * 8
-    if spec is WAYPOINTS:
-        max_time = float(_value(config, "max_steps")) * float(_value(config, "dt"))
-        low += [-position] * 3 + [0.0]
-        high += [position] * 3 + [max_time]
-    return np.array(low, np.float64).astype(np.float32), np.array(high, np.float64).astype(
-        np.float32
-    )

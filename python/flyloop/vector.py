@@ -1,4 +1,6 @@
-"""Vector envs: N vehicles of ONE SITL process, all stepped by one datagram exchange.
+"""Vector envs: N vehicles of ONE SITL process, all stepped by one datagram exchange
+(backend="sitl", the default), or N core instances in this process (backend="native", see
+flyloop.native_vector).
 
     envs = gymnasium.make_vec("flyloop/QuadHover-v0", num_envs=16)   # after `import flyloop`
     obs, infos = envs.reset(seed=42)          # vehicle i gets seed 42 + i
@@ -15,18 +17,25 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-import gymnasium as gym
 import numpy as np
 from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from .envs.base import check_seed, frame_array_count, start_sitl
+from .envs.base import (
+    as_actions,
+    check_backend,
+    check_seed,
+    frame_array_count,
+    spaces_of,
+    start_sitl,
+)
 from .envs.lander2d import Lander2DEnv
 from .envs.quad_hover import QuadHoverEnv
 from .envs.quad_waypoints import QuadWaypointsEnv
 from .errors import SitlError
 from .link import SitlLink
+from .native_vector import NativeVectorEnv
 from .protocol import (
     FRAME_HEADER_LEN,
     MAV_RESULT_ACCEPTED,
@@ -36,7 +45,8 @@ from .protocol import (
 )
 from .sitl_process import SitlProcess
 from .spaces import FastBox
-from .tasks import FLAG, INTEGER, REAL, TaskSpec, observation_bounds, resolve_config
+from .tasks import TaskSpec, resolve_config
+from .vector_infos import InfoColumns, task_arguments
 
 MAX_VEHICLES = 254
 
@@ -75,44 +85,26 @@ class FlyloopVectorEnv(VectorEnv):
             raise ValueError(
                 "the flyloop vector envs do not render; use a single env with render_mode"
             )
-        known = {a.name for a in spec.arguments}
-        unknown = set(arguments) - known - {"render_path", "render_shade", "shade_distance_m"}
-        if unknown:
-            raise TypeError(
-                f"{type(self).__name__}() got unexpected arguments {sorted(unknown)}; "
-                f"task arguments: {sorted(known)}"
-            )
         self._link: SitlLink | None = None
         self._process = None
-        # The single env's defaults, so both make the same episodes.
-        defaults = {name: p.default for name, p in _signature(self.SINGLE).items() if name in known}
-        task_args = {**defaults, **{k: v for k, v in arguments.items() if k in known}}
-        self.config = resolve_config(spec, task_args, model_params)
+        self.config = resolve_config(
+            spec, task_arguments(spec, self.SINGLE, arguments), model_params
+        )
+        self.core = spec.describe(self.config)
         self.num_envs = int(num_envs)
         self.render_mode = None
-        low, high = observation_bounds(spec, self.config)
-        self.single_observation_space = gym.spaces.Box(low, high, dtype=np.float32)
-        size = spec.action_size
-        self.single_action_space = FastBox(
-            np.full(size, spec.action_low, np.float32),
-            np.full(size, spec.action_high, np.float32),
-            dtype=np.float32,
-        )
+        self.backend = "sitl"
+        self.single_observation_space, self.single_action_space = spaces_of(self.core)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         batched = batch_space(self.single_action_space, self.num_envs)
         self.action_space = FastBox(batched.low, batched.high, dtype=np.float32)
-        self.dt = float(self.config.get("dt", 0.02 if spec.name == "landing" else 0.01))
+        self.dt = float(self.core["dt"])
         self.metadata = {**type(self).metadata, "render_fps": max(1, round(1.0 / self.dt))}
 
-        self._n_obs = low.size
+        self._n_obs = self.single_observation_space.shape[0]
         self._n_values = FRAME_HEADER_LEN + self._n_obs + spec.info_size()
         self._n_arrays = frame_array_count(self._n_values)
-        self._fields = []
-        at = FRAME_HEADER_LEN + self._n_obs
-        for name, kind, count in spec.info:
-            self._fields.append((name, kind, at, at + count))
-            at += count
-        self._masks = {f"_{name}": np.ones(self.num_envs, bool) for name, _, _ in spec.info}
+        self._columns = InfoColumns(spec.info, FRAME_HEADER_LEN + self._n_obs, self.num_envs)
         self._encoder = Encoder()
         self._generators: list[np.random.Generator] = [
             seeding.np_random()[0] for _ in range(self.num_envs)
@@ -158,19 +150,7 @@ class FlyloopVectorEnv(VectorEnv):
             )
 
     def _infos(self) -> dict[str, Any]:
-        values = self._values
-        infos: dict[str, Any] = {}
-        for name, kind, a, b in self._fields:
-            if kind == REAL:
-                infos[name] = values[:, a].astype(np.float64)
-            elif kind == FLAG:
-                infos[name] = values[:, a] != 0.0
-            elif kind == INTEGER:
-                infos[name] = values[:, a].astype(np.int64)
-            else:
-                infos[name] = values[:, a:b].astype(np.float64)
-        infos.update({k: m.copy() for k, m in self._masks.items()})
-        return infos
+        return self._columns.infos(self._values)
 
     def _link_ok(self) -> SitlLink:
         if self._link is None:
@@ -218,11 +198,9 @@ class FlyloopVectorEnv(VectorEnv):
         return int(self._generators[i].integers(0, 2**63))
 
     def step(self, actions):
-        a = np.asarray(actions, dtype=np.float32)
-        if a.shape != self.action_space.shape:
-            raise ValueError(f"actions must have shape {self.action_space.shape}, got {a.shape}")
+        a = as_actions(actions, self.action_space.shape, "actions")
         if not np.isfinite(a).all():
-            raise ValueError("actions must be finite")
+            raise ValueError("actions must be finite; step refused")
         resetting = self._autoreset.copy()
         enc = self._encoder
         if resetting.any():
@@ -264,12 +242,6 @@ class FlyloopVectorEnv(VectorEnv):
         return self._process
 
 
-def _signature(cls: type) -> dict[str, Any]:
-    import inspect
-
-    return dict(inspect.signature(cls.__init__).parameters)
-
-
 class QuadHoverVectorEnv(FlyloopVectorEnv):
     """`num_envs` QuadHover vehicles in one SITL (arguments as QuadHoverEnv)."""
 
@@ -289,3 +261,21 @@ class Lander2DVectorEnv(FlyloopVectorEnv):
 
     SPEC = Lander2DEnv.SPEC
     SINGLE = Lander2DEnv
+
+
+def _vector_entry(sitl_class: type[FlyloopVectorEnv]):
+    """The vector entry point of an env id: `backend="sitl"` (default) or `"native"`."""
+
+    def make(num_envs: int = 1, *, backend: str = "sitl", **kwargs: Any) -> VectorEnv:
+        if check_backend(backend, kwargs.get("sitl_path")) == "native":
+            return NativeVectorEnv(sitl_class.SPEC, sitl_class.SINGLE, num_envs, **kwargs)
+        return sitl_class(num_envs, **kwargs)
+
+    make.__name__ = make.__qualname__ = f"make_{sitl_class.SPEC.name}_vector"
+    make.__doc__ = f"{sitl_class.__doc__} With backend='native': NativeVectorEnv."
+    return make
+
+
+quad_hover_vector = _vector_entry(QuadHoverVectorEnv)
+quad_waypoints_vector = _vector_entry(QuadWaypointsVectorEnv)
+lander2d_vector = _vector_entry(Lander2DVectorEnv)

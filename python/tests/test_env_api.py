@@ -14,7 +14,7 @@ import pytest
 import flyloop
 from flyloop import SitlNotFoundError, SitlParameterError, find_sitl_binary
 from flyloop.envs import Lander2DEnv, QuadHoverEnv, QuadWaypointsEnv
-from flyloop.tasks import HOVER, LANDING, TASKS, WAYPOINTS, observation_bounds
+from flyloop.tasks import TASKS
 
 IDS = {
     "flyloop/QuadHover-v0": (QuadHoverEnv, 33, 4, 0.0),
@@ -143,12 +143,21 @@ def test_binary_discovery_order_and_the_missing_binary_message(tmp_path, monkeyp
         find_sitl_binary()
     monkeypatch.delenv("FLYLOOP_SITL")
     monkeypatch.setenv("PATH", str(tmp_path / "empty"))
+    # The wheel's console command beside the interpreter comes last.
+    scripts = tmp_path / "scripts"
+    monkeypatch.setattr(flyloop.sitl_process.sysconfig, "get_path", lambda name: str(scripts))
     with pytest.raises(SitlNotFoundError) as err:
         find_sitl_binary()
     text = str(err.value)
     assert "build it with: cargo build --release -p flyloop-sitl" in text.lower()
     assert str(tmp_path / "no-target" / "release" / "flyloop-sitl") in text
-    # The workspace build under CARGO_TARGET_DIR is found last.
+    assert str(scripts / "flyloop-sitl") in text
+    installed = scripts / "flyloop-sitl"
+    installed.parent.mkdir()
+    installed.write_text("#!/bin/sh\n")
+    installed.chmod(0o755)
+    assert find_sitl_binary() == installed
+    # The workspace build under CARGO_TARGET_DIR comes before it.
     built = tmp_path / "no-target" / "release" / "flyloop-sitl"
     built.parent.mkdir(parents=True)
     built.write_text("#!/bin/sh\n")
@@ -160,6 +169,7 @@ def test_a_missing_binary_stops_the_constructor_with_the_build_command(monkeypat
     monkeypatch.delenv("FLYLOOP_SITL", raising=False)
     monkeypatch.setenv("PATH", str(tmp_path))
     monkeypatch.setenv("CARGO_TARGET_DIR", str(tmp_path))
+    monkeypatch.setattr(flyloop.sitl_process.sysconfig, "get_path", lambda name: str(tmp_path))
     with pytest.raises(SitlNotFoundError, match="cargo build --release -p flyloop-sitl"):
         gym.make("flyloop/Lander2D-v0")
 
@@ -190,16 +200,7 @@ def test_the_info_layout_matches_the_sitls_frame_description(sitl_binary, task):
     ]
     assert got == [(name, n) for name, _, n in spec.info]
     n_obs = int(re.search(r"observation \((\d+) values\)", text).group(1))
-    assert n_obs == observation_bounds(spec, {})[0].size
-
-
-def test_default_observation_bounds_are_the_cores(sitl_binary):
-    low, high = observation_bounds(HOVER, {})
-    assert high[0] == np.float32(np.sqrt(3) * 3) and high[22] == 10.0
-    low, high = observation_bounds(WAYPOINTS, {})
-    assert high[0] == np.float32(2 * np.sqrt(3) * 3) and high[36] == np.float32(10.0)
-    low, high = observation_bounds(LANDING, {})
-    assert (low[[6, 10]] == 0).all() and low[0] == -1 and high.max() == 1
+    assert n_obs == spec.describe({})["observation_low"].size
 
 
 def test_package_exports():

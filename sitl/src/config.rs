@@ -24,27 +24,45 @@ pub enum ConfigError {
 /// checks that the task builds from them.
 pub fn parse(task: TaskKind, text: &str) -> Result<TaskConfig, ParamError> {
     let table: toml::Table = toml::from_str(text)?;
-    let entries = param_table::entries(task);
-    let mut values: Vec<(&ParamEntry, f64)> = Vec::with_capacity(table.len());
+    let mut values: Vec<(&str, f64)> = Vec::with_capacity(table.len());
     for (key, value) in &table {
-        let entry = entries
-            .iter()
-            .find(|e| e.name == key || e.id == *key)
-            .ok_or_else(|| {
-                ParamError::UnknownName(format!("{key}` for task `{}", task.frame_name()))
-            })?;
         let number = match value {
             toml::Value::Integer(i) => *i as f64,
             toml::Value::Float(x) => *x,
             toml::Value::Boolean(b) => f64::from(u8::from(*b)),
             _ => {
+                let entry = find_entry(&param_table::entries(task), task, key)?;
                 return Err(ParamError::Parse(format!(
                     "parameter `{}` must be a number or a boolean",
                     entry.name
                 )));
             }
         };
-        values.push((entry, number));
+        values.push((key.as_str(), number));
+    }
+    from_values(task, values)
+}
+
+fn find_entry(entries: &[ParamEntry], task: TaskKind, key: &str) -> Result<ParamEntry, ParamError> {
+    entries
+        .iter()
+        .find(|e| e.name == key || e.id == *key)
+        .cloned()
+        .ok_or_else(|| ParamError::UnknownName(format!("{key}` for task `{}", task.frame_name())))
+}
+
+/// The parameter sets of `task` from `(name or param_id, value)` pairs (other parameters keep
+/// their defaults), each checked against its row, the sets' relations checked once all are
+/// applied, and the task built once to check it. The config file and the Python extension
+/// both come through here.
+pub fn from_values<'a>(
+    task: TaskKind,
+    pairs: impl IntoIterator<Item = (&'a str, f64)>,
+) -> Result<TaskConfig, ParamError> {
+    let entries = param_table::entries(task);
+    let mut values: Vec<(ParamEntry, f64)> = Vec::new();
+    for (key, value) in pairs {
+        values.push((find_entry(&entries, task, key)?, value));
     }
     let pick = |group: Group| {
         values
@@ -66,7 +84,6 @@ pub fn parse(task: TaskKind, text: &str) -> Result<TaskConfig, ParamError> {
     Ok(config)
 }
 
-/// Reads and parses the config file at `path`.
 pub fn load(task: TaskKind, path: &Path) -> Result<TaskConfig, ConfigError> {
     let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
         path: path.to_path_buf(),

@@ -10,6 +10,7 @@
 //! - [`param_table`], [`param_protocol`], [`config`]: parameters over MAVLink and from TOML,
 //! - [`px4`]: PX4 mode, flyloop as PX4's simulator over TCP.
 
+pub mod app;
 pub mod cli;
 pub mod commands;
 pub mod config;

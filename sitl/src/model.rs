@@ -139,6 +139,11 @@ impl TaskInstance {
         self.task().observation_size()
     }
 
+    /// Inclusive per-value observation bounds, as the core declares them.
+    pub fn observation_bounds(&self) -> (Vec<f32>, Vec<f32>) {
+        self.task().observation_bounds()
+    }
+
     pub fn write_observation(&self, out: &mut [f32]) {
         self.task().write_observation(out);
     }

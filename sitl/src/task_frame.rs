@@ -39,12 +39,20 @@ fn flag(b: bool) -> f32 {
 }
 
 /// Appends one info value's numbers to `out`.
-fn push_info(out: &mut Vec<f32>, value: &InfoValue) {
+pub fn push_info(out: &mut Vec<f32>, value: &InfoValue) {
     match value {
         InfoValue::Real(x) => out.push(*x as f32),
         InfoValue::Integer(i) => out.push(*i as f32),
         InfoValue::Flag(b) => out.push(flag(*b)),
         InfoValue::Vector(v) => out.extend(v.iter().map(|x| *x as f32)),
+    }
+}
+
+/// Appends every info value of `task`, flattened in the task's info order, as the frame
+/// carries them (float32).
+pub fn push_infos(task: &TaskInstance, out: &mut Vec<f32>) {
+    for (_, value) in task.info() {
+        push_info(out, &value);
     }
 }
 
@@ -62,9 +70,7 @@ pub fn values(task: &TaskInstance, header: &FrameHeader, out: &mut Vec<f32>) {
     ]);
     out.resize(HEADER_LEN + n_obs, 0.0);
     task.write_observation(&mut out[HEADER_LEN..]);
-    for (_, value) in task.info() {
-        push_info(out, &value);
-    }
+    push_infos(task, out);
     out[5] = (out.len() - HEADER_LEN - n_obs) as f32;
 }
 

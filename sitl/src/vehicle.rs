@@ -20,6 +20,36 @@ pub fn next_seed(seed: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// Checks `controls` (the first `lo.len()` channels are used, missing ones are 0; each used
+/// one must be finite) and writes them clamped into [lo, hi] to `command`; returns whether any
+/// was clamped. On error `command` is unchanged. The SITL and the Python extension both
+/// treat actions through here.
+pub fn clamp_controls(
+    controls: &[f32],
+    lo: &[f64],
+    hi: &[f64],
+    command: &mut Vec<f64>,
+) -> Result<bool, ControlError> {
+    let n = lo.len();
+    if let Some((channel, &value)) = controls
+        .iter()
+        .take(n)
+        .enumerate()
+        .find(|(_, c)| !c.is_finite())
+    {
+        return Err(ControlError::NotFinite { channel, value });
+    }
+    let mut clamped = false;
+    command.clear();
+    for i in 0..n {
+        let c = controls.get(i).map_or(0.0, |&c| f64::from(c));
+        let v = c.clamp(lo[i], hi[i]);
+        clamped |= v != c;
+        command.push(v);
+    }
+    Ok(clamped)
+}
+
 /// A vehicle of the simulation.
 #[derive(Debug)]
 pub struct Vehicle {
@@ -101,23 +131,7 @@ impl Vehicle {
     /// and clamps them into the action bounds as the command in effect.
     pub fn set_controls(&mut self, controls: &[f32]) -> Result<StepReport, ControlError> {
         let (lo, hi) = &self.bounds;
-        let n = lo.len();
-        if let Some((channel, &value)) = controls
-            .iter()
-            .take(n)
-            .enumerate()
-            .find(|(_, c)| !c.is_finite())
-        {
-            return Err(ControlError::NotFinite { channel, value });
-        }
-        let mut clamped = false;
-        self.command.clear();
-        for i in 0..n {
-            let c = controls.get(i).map_or(0.0, |&c| f64::from(c));
-            let v = c.clamp(lo[i], hi[i]);
-            clamped |= v != c;
-            self.command.push(v);
-        }
+        let clamped = clamp_controls(controls, lo, hi, &mut self.command)?;
         Ok(StepReport { clamped })
     }
 

@@ -1,5 +1,5 @@
-"""FlyloopEnv: what the three envs share — a SITL of their own (or one they attach to), the
-lockstep exchange of one datagram per step, seeding, the info dict and rendering."""
+"""FlyloopEnv: what the envs share — the backend (a SITL of their own or one they attach to,
+one datagram per step; or the core in-process), seeding, the info dict and rendering."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from .. import _native
 from ..errors import SitlError, SitlParameterError
 from ..link import SitlLink
 from ..protocol import (
@@ -32,13 +33,13 @@ from ..tasks import (
     INTEGER,
     REAL,
     TaskSpec,
-    observation_bounds,
     parameter_error,
     resolve_config,
     to_toml,
 )
 
 SEED_LIMIT = 2**64
+BACKENDS = ("sitl", "native")
 _HIL_STATE_QUATERNION = mavlink2.MAVLINK_MSG_ID_HIL_STATE_QUATERNION
 
 
@@ -52,6 +53,45 @@ def check_seed(seed: Any) -> int:
     if not 0 <= int(seed) < SEED_LIMIT:
         raise ValueError(f"seed must be in [0, 2**64), got {seed}")
     return int(seed)
+
+
+def as_actions(actions: Any, shape: tuple[int, ...], what: str) -> np.ndarray:
+    """`actions` as a C-contiguous float32 array of `shape` (the wire's type: float64 input
+    is rounded to float32 on both backends); a single env also takes any array of the same
+    size. Non-numbers raise TypeError, other shapes ValueError, both naming the shape."""
+    a = np.asarray(actions)
+    if a.dtype.kind not in "biuf":
+        raise TypeError(f"{what} must be a float array of shape {shape}, got dtype {a.dtype}")
+    a = np.ascontiguousarray(a, dtype=np.float32)
+    if a.shape != shape and len(shape) == 1 and a.size == shape[0]:
+        a = a.reshape(shape)
+    if a.shape != shape:
+        raise ValueError(f"{what} must have shape {shape}, got {a.shape}")
+    return a
+
+
+def check_backend(backend: Any, sitl_path: Any, sitl_address: Any = None) -> str:
+    """`backend` checked; the SITL's own arguments are refused with the native backend."""
+    if backend not in BACKENDS:
+        raise ValueError(f"backend must be 'sitl' or 'native', got {backend!r}")
+    if backend == "native":
+        for name, value in (("sitl_path", sitl_path), ("sitl_address", sitl_address)):
+            if value is not None:
+                raise ValueError(f"{name} applies to backend='sitl' only, got {value!r}")
+    return backend
+
+
+def spaces_of(description: Mapping[str, Any]) -> tuple[gym.spaces.Box, FastBox]:
+    """The observation and action spaces the core declares (float32)."""
+    observation = gym.spaces.Box(
+        description["observation_low"], description["observation_high"], dtype=np.float32
+    )
+    action = FastBox(
+        description["action_low"].astype(np.float32),
+        description["action_high"].astype(np.float32),
+        dtype=np.float32,
+    )
+    return observation, action
 
 
 def info_reader(spec: TaskSpec, n_obs: int):
@@ -168,6 +208,7 @@ class FlyloopEnv(gym.Env):
     # Set before __init__ can fail, so close() (and VectorEnv.__del__) always work.
     _link: SitlLink | None = None
     _process: SitlProcess | None = None
+    _native = None
     _view = None
 
     def __init__(
@@ -180,6 +221,7 @@ class FlyloopEnv(gym.Env):
         sitl_address: Any,
         vehicle: int,
         timeout: float,
+        backend: str = "sitl",
     ) -> None:
         spec = self.SPEC
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -195,18 +237,28 @@ class FlyloopEnv(gym.Env):
         self._view = None
         self.render_mode = render_mode
         self.config = resolve_config(spec, arguments, model_params)
-        self.dt = float(self.config.get("dt", 0.02 if spec.name == "landing" else 0.01))
+        self.backend = check_backend(backend, sitl_path, sitl_address)
+        self.core = spec.describe(self.config)
+        self.dt = float(self.core["dt"])
         self.metadata = {**type(self).metadata, "render_fps": max(1, round(1.0 / self.dt))}
+        self.observation_space, self.action_space = spaces_of(self.core)
+        self._native = None
+        if self.backend == "native":
+            self._native = _native.Batch(spec.name, self.config, 1, 1)
+        else:
+            self._start_sitl(sitl_path, sitl_address, vehicle, timeout)
+        self._episode_return = 0.0
+        self._last: tuple[np.ndarray, dict[str, Any], float | None] | None = None
+        if render_mode is not None:
+            try:
+                self._view = self._make_view(render_mode)
+            except BaseException:
+                self.close()
+                raise
 
-        low, high = observation_bounds(spec, self.config)
-        self.observation_space = gym.spaces.Box(low, high, dtype=np.float32)
-        size = spec.action_size
-        self.action_space = FastBox(
-            np.full(size, spec.action_low, np.float32),
-            np.full(size, spec.action_high, np.float32),
-            dtype=np.float32,
-        )
-        self._n_obs = low.size
+    def _start_sitl(self, sitl_path: Any, sitl_address: Any, vehicle: int, timeout: float) -> None:
+        spec = self.SPEC
+        self._n_obs = self.observation_space.shape[0]
         self._n_values = FRAME_HEADER_LEN + self._n_obs + spec.info_size()
         self._n_arrays = frame_array_count(self._n_values)
         self._read_info = info_reader(spec, self._n_obs)
@@ -227,15 +279,6 @@ class FlyloopEnv(gym.Env):
                 configure_attached(self._link, self._encoder, spec, self.config, self.vehicle)
             except (SitlError, SitlParameterError):
                 self._link.close()
-                raise
-
-        self._episode_return = 0.0
-        self._last: tuple[np.ndarray, dict[str, Any], float | None] | None = None
-        if render_mode is not None:
-            try:
-                self._view = self._make_view(render_mode)
-            except BaseException:
-                self.close()
                 raise
 
     # ---- SITL exchange ----
@@ -272,6 +315,19 @@ class FlyloopEnv(gym.Env):
         if seed is None:
             seed = int(self.np_random.integers(0, 2**63))
         self.episode_seed = seed
+        if self.backend == "native":
+            obs, info = self._native_ok().reset_one(seed)
+        else:
+            obs, info = self._sitl_reset(seed)
+        self._episode_return = 0.0
+        self._last = (obs, info, None)
+        if self._view is not None:
+            self._view.reset()
+            if self.render_mode == "human":
+                self.render()
+        return obs, info
+
+    def _sitl_reset(self, seed: int):
         link = self._link_ok()
         d = link.exchange(
             self._encoder.reset(seed, self.vehicle),
@@ -287,23 +343,23 @@ class FlyloopEnv(gym.Env):
             raise SitlError(f"the SITL refused the reset (result {ack.result}): {texts}")
         values = self._frame_values()
         obs = values[FRAME_HEADER_LEN : FRAME_HEADER_LEN + self._n_obs].copy()
-        info = self._read_info(values)
-        self._episode_return = 0.0
-        self._last = (obs, info, None)
-        if self._view is not None:
-            self._view.reset()
-            if self.render_mode == "human":
-                self.render()
-        return obs, info
+        return obs, self._read_info(values)
 
     def step(self, action):
-        a = np.asarray(action, dtype=np.float32)
-        if a.shape != self.action_space.shape:
-            a = a.reshape(-1)
-            if a.shape != self.action_space.shape:
-                raise ValueError(
-                    f"action must have shape {self.action_space.shape}, got {np.shape(action)}"
-                )
+        a = as_actions(action, self.action_space.shape, "action")
+        if self.backend == "native":
+            # The core refuses NaN / ±inf with ValueError and changes nothing, like the SITL.
+            obs, reward, terminated, truncated, info = self._native_ok().step_one(a)
+        else:
+            obs, reward, terminated, truncated, info = self._sitl_step(a, action)
+        if self._view is not None:
+            self._episode_return += reward
+            self._last = (obs, info, reward)
+            if self.render_mode == "human":
+                self.render()
+        return obs, reward, terminated, truncated, info
+
+    def _sitl_step(self, a: np.ndarray, action: Any):
         values = a.tolist()
         # NaN and ±inf survive a sum of float32 values (whose sum cannot overflow a double).
         if not math.isfinite(sum(values)):
@@ -321,12 +377,12 @@ class FlyloopEnv(gym.Env):
         reward = float(values[0])
         terminated = bool(values[1] != 0.0)
         truncated = bool(values[2] != 0.0)
-        if self._view is not None:
-            self._episode_return += reward
-            self._last = (obs, info, reward)
-            if self.render_mode == "human":
-                self.render()
         return obs, reward, terminated, truncated, info
+
+    def _native_ok(self):
+        if self._native is None or self._native.closed:
+            raise RuntimeError("this env is closed; make a new one to go on")
+        return self._native
 
     # ---- rendering ----
 
@@ -358,6 +414,9 @@ class FlyloopEnv(gym.Env):
         view, self._view = self._view, None
         if view is not None:
             view.close()
+        native, self._native = self._native, None
+        if native is not None:
+            native.close()
         link, self._link = self._link, None
         if link is not None:
             link.close()

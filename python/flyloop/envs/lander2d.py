@@ -5,11 +5,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from ..tasks import LANDING
+from ..tasks import LANDING, parameter_values
 from .base import FlyloopEnv
-
-# Landing-task parameters the scene draws, with the core's defaults (docs/parameters.md).
-_SCENE_DEFAULTS = {"platform_speed": 1.5, "initial_pos_random_range_m": 5.0}
 
 
 class Lander2DEnv(FlyloopEnv):
@@ -135,6 +132,7 @@ class Lander2DEnv(FlyloopEnv):
         sitl_address: Any = None,
         vehicle: int = 1,
         timeout: float = 5.0,
+        backend: str = "sitl",
     ) -> None:
         self._render_options = dict(
             show_path=bool(render_path),
@@ -164,6 +162,7 @@ class Lander2DEnv(FlyloopEnv):
             sitl_address=sitl_address,
             vehicle=vehicle,
             timeout=timeout,
+            backend=backend,
         )
 
     def _make_view(self, render_mode: str):
@@ -174,12 +173,13 @@ class Lander2DEnv(FlyloopEnv):
     def _scene(self, obs, info, reward):
         from ..rendering import lander_scene
 
+        values = parameter_values(self.core)
         return lander_scene(
             info,
             obs,
             dt=self.dt,
             reward=reward,
             episode_return=self._episode_return,
-            max_steps=int(self.config["max_steps"]),
-            params={**_SCENE_DEFAULTS, **self.config},
+            max_steps=int(values["max_steps"]),
+            params=values,
         )

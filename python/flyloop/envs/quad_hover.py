@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from ..tasks import CORE_DEFAULTS, HOVER
+from ..tasks import HOVER, parameter_values
 from .base import FlyloopEnv
 
 
@@ -95,6 +95,9 @@ class QuadHoverEnv(FlyloopEnv):
     - ``sitl_address=None``: ``"host:port"`` of a running SITL to use instead of starting one
       (parameters are then set over MAVLink as float32); ``vehicle=1``: its system id there.
     - ``timeout=5.0``: seconds to wait for any SITL reply before raising ``SitlError``.
+    - ``backend="sitl"``: ``"native"`` runs the same core task in this process through the
+      extension ``flyloop._native`` instead (no SITL, no sockets; same observations bit for
+      bit, same rewards, flags and info); ``sitl_path`` and ``sitl_address`` are then refused.
 
     Out-of-range values are refused by the core's parameter table: ``SitlParameterError``
     (a ``ValueError``) naming the argument and its bound; wrong types raise ``TypeError``.
@@ -138,6 +141,7 @@ class QuadHoverEnv(FlyloopEnv):
         sitl_address: Any = None,
         vehicle: int = 1,
         timeout: float = 5.0,
+        backend: str = "sitl",
         **task_arguments: Any,
     ) -> None:
         arguments = dict(
@@ -172,6 +176,7 @@ class QuadHoverEnv(FlyloopEnv):
             sitl_address=sitl_address,
             vehicle=vehicle,
             timeout=timeout,
+            backend=backend,
         )
 
     def _make_view(self, render_mode: str):
@@ -182,8 +187,9 @@ class QuadHoverEnv(FlyloopEnv):
     def _scene(self, obs, info, reward):
         from ..rendering import quad_scene
 
-        side = float(self.config.get("space_side_length", CORE_DEFAULTS["space_side_length"]))
-        arm = float(self.config.get("arm_length", CORE_DEFAULTS["arm_length"]))
+        values = parameter_values(self.core)
+        side = float(values["space_side_length"])
+        arm = float(values["arm_length"])
         return quad_scene(
             obs,
             info,

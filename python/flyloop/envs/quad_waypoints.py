@@ -90,6 +90,7 @@ class QuadWaypointsEnv(QuadHoverEnv):
         sitl_address: Any = None,
         vehicle: int = 1,
         timeout: float = 5.0,
+        backend: str = "sitl",
     ) -> None:
         super().__init__(
             max_steps=max_steps,

@@ -1,0 +1,59 @@
+"""What both vector envs (SITL and native) share: the task arguments with the single env's
+defaults, and the batched info dict built from a (N, values) float32 array in the task
+frame's info layout."""
+
+from __future__ import annotations
+
+import inspect
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from .tasks import FLAG, INTEGER, REAL, TaskSpec
+
+# Single-env arguments a vector env accepts and ignores (they only change drawing).
+RENDER_ARGUMENTS = {"render_path", "render_shade", "shade_distance_m"}
+
+
+def task_arguments(spec: TaskSpec, single: type, arguments: Mapping[str, Any]) -> dict[str, Any]:
+    """The task arguments of a vector env: the single env's defaults, then `arguments`
+    (unknown names raise TypeError), so both make the same episodes."""
+    known = {a.name for a in spec.arguments}
+    unknown = set(arguments) - known - RENDER_ARGUMENTS
+    if unknown:
+        raise TypeError(
+            f"the {spec.env_id} vector env got unexpected arguments {sorted(unknown)}; "
+            f"task arguments: {sorted(known)}"
+        )
+    params = inspect.signature(single.__init__).parameters
+    defaults = {name: p.default for name, p in params.items() if name in known}
+    return {**defaults, **{k: v for k, v in arguments.items() if k in known}}
+
+
+class InfoColumns:
+    """Builds the batched info dict from the info values of N envs (one row each)."""
+
+    def __init__(self, layout: Sequence[Sequence[Any]], start: int, num_envs: int) -> None:
+        self.fields = []
+        at = start
+        for name, kind, count in layout:
+            self.fields.append((name, kind, at, at + count))
+            at += count
+        self.masks = {f"_{name}": np.ones(num_envs, bool) for name, _, _ in layout}
+
+    def infos(self, values: np.ndarray) -> dict[str, Any]:
+        """Every key as an array over the envs: reals float64, flags bool, integers int64,
+        vectors (N, k) float64; plus gymnasium's `_key` masks (all True)."""
+        infos: dict[str, Any] = {}
+        for name, kind, a, b in self.fields:
+            if kind == REAL:
+                infos[name] = values[:, a].astype(np.float64)
+            elif kind == FLAG:
+                infos[name] = values[:, a] != 0.0
+            elif kind == INTEGER:
+                infos[name] = values[:, a].astype(np.int64)
+            else:
+                infos[name] = values[:, a:b].astype(np.float64)
+        infos.update({k: m.copy() for k, m in self.masks.items()})
+        return infos

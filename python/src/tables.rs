@@ -1,0 +1,118 @@
+//! The core's tables for Python: task names, parameter sets built from `{name: value}`, and
+//! [`describe`], everything the Python package needs to declare spaces and check arguments.
+
+use flyloop_core::params::ValueKind;
+use flyloop_core::tasks::InfoValue;
+use flyloop_sitl::config;
+use flyloop_sitl::model::{TaskConfig, TaskInstance, TaskKind};
+use flyloop_sitl::param_table;
+use numpy::PyArray1;
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+/// The task named `name` (the SITL's `--task`).
+pub fn task_kind(name: &str) -> PyResult<TaskKind> {
+    match name {
+        "hover" => Ok(TaskKind::Hover),
+        "waypoints" => Ok(TaskKind::Waypoints),
+        "landing" => Ok(TaskKind::Landing),
+        _ => Err(PyValueError::new_err(format!(
+            "task must be 'hover', 'waypoints' or 'landing', got {name:?}"
+        ))),
+    }
+}
+
+/// The parameter sets of `task` from `{core name or param_id: number}`, checked by the core
+/// exactly as the SITL checks its config file; errors are ValueErrors carrying the core's
+/// message (it names the parameter and its bound).
+pub fn task_config(task: TaskKind, params: Option<&Bound<'_, PyDict>>) -> PyResult<TaskConfig> {
+    let mut pairs: Vec<(String, f64)> = Vec::new();
+    if let Some(params) = params {
+        for (key, value) in params.iter() {
+            let name: String = key.extract().map_err(|_| {
+                PyTypeError::new_err(format!("parameter names are strings, got {key}"))
+            })?;
+            let number: f64 = value.extract().map_err(|_| {
+                PyTypeError::new_err(format!(
+                    "parameter `{name}` must be a number or a boolean, got {value}"
+                ))
+            })?;
+            pairs.push((name, number));
+        }
+    }
+    config::from_values(task, pairs.iter().map(|(k, v)| (k.as_str(), *v)))
+        .map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+fn kind_name(kind: ValueKind) -> &'static str {
+    match kind {
+        ValueKind::Real => "real",
+        ValueKind::Integer => "integer",
+        ValueKind::Boolean => "boolean",
+    }
+}
+
+/// The info layout of a task: (name, kind, number of values), kinds "real", "integer",
+/// "flag", "vector".
+pub fn info_layout(task: &TaskInstance) -> Vec<(&'static str, &'static str, usize)> {
+    task.info()
+        .into_iter()
+        .map(|(name, value)| match value {
+            InfoValue::Real(_) => (name, "real", 1),
+            InfoValue::Integer(_) => (name, "integer", 1),
+            InfoValue::Flag(_) => (name, "flag", 1),
+            InfoValue::Vector(v) => (name, "vector", v.len()),
+        })
+        .collect()
+}
+
+/// Everything Python declares about `task` with parameters `params`: a dict with
+/// `observation_low`/`observation_high` (float32 arrays), `action_low`/`action_high`
+/// (float64), `dt` (s), `info` (list of (name, kind, count)), `parameters` (list of dicts:
+/// name, id, group, kind, unit, min, max, default, value, description), `model`, `task`.
+#[pyfunction]
+#[pyo3(signature = (task, params=None))]
+pub fn describe<'py>(
+    py: Python<'py>,
+    task: &str,
+    params: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let kind = task_kind(task)?;
+    let config = task_config(kind, params)?;
+    let instance =
+        TaskInstance::build(kind, &config).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let out = PyDict::new(py);
+    out.set_item("task", kind.frame_name())?;
+    out.set_item("model", kind.model().name())?;
+    let (lo, hi) = instance.observation_bounds();
+    out.set_item("observation_low", PyArray1::from_slice(py, &lo))?;
+    out.set_item("observation_high", PyArray1::from_slice(py, &hi))?;
+    let (lo, hi) = instance.action_bounds();
+    out.set_item("action_low", PyArray1::from_slice(py, &lo))?;
+    out.set_item("action_high", PyArray1::from_slice(py, &hi))?;
+    out.set_item("dt", instance.dt())?;
+    out.set_item("info", info_layout(&instance))?;
+    let defaults = TaskConfig::default();
+    let rows = PyList::empty(py);
+    for e in param_table::entries(kind) {
+        let row = PyDict::new(py);
+        row.set_item("name", e.name)?;
+        row.set_item("id", &e.id)?;
+        row.set_item("group", e.group.label())?;
+        row.set_item("kind", kind_name(e.kind))?;
+        row.set_item("unit", e.unit)?;
+        row.set_item("min", e.min)?;
+        row.set_item("max", e.max)?;
+        let get = |c: &TaskConfig| {
+            param_table::get(c, e.group, e.name)
+                .map_err(|err| PyValueError::new_err(err.to_string()))
+        };
+        row.set_item("default", get(&defaults)?)?;
+        row.set_item("value", get(&config)?)?;
+        row.set_item("description", e.description)?;
+        rows.append(row)?;
+    }
+    out.set_item("parameters", rows)?;
+    Ok(out)
+}

@@ -1,0 +1,276 @@
+//! The `flyloop-sitl` program: options, sockets, then the server loop until SIGINT / SIGTERM.
+//! A library function so the binary and the Python wheel's `flyloop-sitl` command share it.
+
+use crate::cli::{Args, GcsTarget, ListFormat};
+use crate::config::{self, ConfigError};
+use crate::model::{ModelKind, TaskConfig, TaskInstance, TaskKind};
+use crate::px4;
+use crate::px4::config::Px4Config;
+use crate::px4::server::Pacing;
+use crate::px4::session::{Session, SessionOptions};
+use crate::px4::track::Track;
+use crate::server::{self, GcsLink};
+use crate::sim::{Sim, SimOptions};
+use crate::{param_table, starter_config, task_frame};
+use clap::Parser;
+use flyloop_core::ParamError;
+use std::io::IsTerminal;
+use std::net::SocketAddr;
+use std::time::Instant;
+
+/// Why the SITL could not start (printed as one line, exit code 1).
+#[derive(Debug, thiserror::Error)]
+enum StartError {
+    #[error("{0}")]
+    Options(String),
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    #[error("{0}")]
+    Parameters(#[from] ParamError),
+    #[error("cannot bind the {link} socket to {addr}: {source}")]
+    Bind {
+        link: &'static str,
+        addr: SocketAddr,
+        source: std::io::Error,
+    },
+    #[error("cannot write the track file {path}: {source}")]
+    Track {
+        path: std::path::PathBuf,
+        source: std::io::Error,
+    },
+    #[error("cannot start the runtime: {0}")]
+    Runtime(#[from] std::io::Error),
+}
+
+fn bind(link: &'static str, addr: SocketAddr) -> Result<std::net::UdpSocket, StartError> {
+    let socket = std::net::UdpSocket::bind(addr).map_err(|source| StartError::Bind {
+        link,
+        addr,
+        source,
+    })?;
+    socket
+        .set_nonblocking(true)
+        .map_err(|source| StartError::Bind { link, addr, source })?;
+    Ok(socket)
+}
+
+fn describe_frame(task: TaskKind, config: &TaskConfig) -> Result<String, ParamError> {
+    let t = TaskInstance::build(task, config)?;
+    let n = t.observation_size();
+    let mut out = format!(
+        "task frame of `{}` (DEBUG_FLOAT_ARRAY name \"{}\", {} values over {} array(s) of {})\n",
+        task.frame_name(),
+        task.frame_name(),
+        task_frame::HEADER_LEN
+            + n
+            + task_frame::info_layout(&t)
+                .iter()
+                .map(|e| e.2)
+                .sum::<usize>(),
+        1 + (task_frame::HEADER_LEN
+            + n
+            + task_frame::info_layout(&t)
+                .iter()
+                .map(|e| e.2)
+                .sum::<usize>()
+            - 1)
+            / task_frame::ARRAY_LEN,
+        task_frame::ARRAY_LEN
+    );
+    out.push_str("0 reward\n1 terminated\n2 truncated\n3 step\n4 n_obs\n5 n_info\n");
+    out.push_str(&format!(
+        "{}..{} observation ({n} values)\n",
+        task_frame::HEADER_LEN,
+        task_frame::HEADER_LEN + n
+    ));
+    for (name, at, count) in task_frame::info_layout(&t) {
+        if count == 1 {
+            out.push_str(&format!("{at} info.{name}\n"));
+        } else {
+            out.push_str(&format!(
+                "{at}..{} info.{name} ({count} values)\n",
+                at + count
+            ));
+        }
+    }
+    Ok(out)
+}
+
+/// PX4 mode: the vehicle and sensor parameters, the TCP listener, then PX4 connections until
+/// a signal.
+fn start_px4(args: Args) -> Result<(), StartError> {
+    if args.model() != ModelKind::Quadrotor {
+        return Err(StartError::Options(
+            "--px4 flies the quadrotor only".to_string(),
+        ));
+    }
+    let mut config = match &args.config {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+                path: path.clone(),
+                source,
+            })?;
+            Px4Config::parse(&text).map_err(|source| ConfigError::Invalid {
+                path: path.clone(),
+                source,
+            })?
+        }
+        None => Px4Config::iris(),
+    };
+    config.sensors.home_latitude = args.home.latitude_deg;
+    config.sensors.home_longitude = args.home.longitude_deg;
+    config.sensors.home_altitude = args.home.altitude_m;
+    let step_us = (args.px4_step * 1e6).round() as u64;
+    let mut session = Session::new(&SessionOptions {
+        config,
+        step_us,
+        seed: args.seed,
+    })?;
+    if let Some(path) = &args.track {
+        let track = Track::create(path).map_err(|source| StartError::Track {
+            path: path.clone(),
+            source,
+        })?;
+        session.set_track(track);
+    }
+    let listener =
+        std::net::TcpListener::bind(args.px4_listen).map_err(|source| StartError::Bind {
+            link: "PX4",
+            addr: args.px4_listen,
+            source,
+        })?;
+    listener.set_nonblocking(true)?;
+    let listen = listener.local_addr()?;
+    let speed = args.speed_factor;
+    let ready = format!(
+        "flyloop-sitl ready px4={listen} mode=px4 model=quadrotor step_us={step_us} speed_factor={speed} seed={}",
+        args.seed
+    );
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()?;
+    let session = runtime.block_on(async move {
+        let shutdown = server::Shutdown::install()?;
+        let listener = tokio::net::TcpListener::from_std(listener)?;
+        println!("{ready}");
+        tracing::info!(%listen, speed_factor = speed, "flyloop-sitl waiting for PX4");
+        px4::server::run(
+            session,
+            listener,
+            Pacing {
+                speed_factor: speed,
+            },
+            shutdown,
+        )
+        .await
+    })?;
+    tracing::info!("stopped: {}", session.stats);
+    Ok(())
+}
+
+fn start(args: Args) -> Result<(), StartError> {
+    if args.px4 {
+        return start_px4(args);
+    }
+    let task = args.task().map_err(StartError::Options)?;
+    let config = match &args.config {
+        Some(path) => config::load(task, path)?,
+        None => TaskConfig::default(),
+    };
+    match args.list_params {
+        Some(ListFormat::Table) => {
+            print!("{}", param_table::listing(task, &config));
+            return Ok(());
+        }
+        Some(ListFormat::Toml) => {
+            print!("{}", starter_config::starter_toml(task, &config));
+            return Ok(());
+        }
+        None => {}
+    }
+    if args.describe_frame {
+        print!("{}", describe_frame(task, &config)?);
+        return Ok(());
+    }
+    let mut options = SimOptions::new(task);
+    options.vehicles = args.vehicles;
+    options.seed = args.seed;
+    options.config = config;
+    options.mode = args.mode();
+    options.home = args.home;
+    options.state_in_reply = !args.no_state_reply;
+    options.failsafe_timeout = args.failsafe_timeout();
+    options.state_rate_hz = args.state_rate;
+    let sim = Sim::new(options, Instant::now())?;
+
+    let controller = bind("controller", args.listen)?;
+    let gcs = match args.gcs {
+        GcsTarget::Off => None,
+        GcsTarget::At(target) => Some((bind("ground-station", args.gcs_bind)?, target)),
+    };
+    let listen = controller.local_addr()?;
+    let gcs_text = match &gcs {
+        Some((socket, target)) => format!("{}->{}", socket.local_addr()?, target),
+        None => "off".to_string(),
+    };
+    let ready = format!(
+        "flyloop-sitl ready listen={listen} gcs={gcs_text} mode={} model={} task={} vehicles={} seed={}",
+        args.mode().name(),
+        args.model().name(),
+        task.frame_name(),
+        args.vehicles,
+        args.seed
+    );
+
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()?;
+    let stats = runtime.block_on(async move {
+        let shutdown = server::Shutdown::install()?;
+        let controller = tokio::net::UdpSocket::from_std(controller)?;
+        let gcs = match gcs {
+            Some((socket, target)) => Some(GcsLink {
+                socket: tokio::net::UdpSocket::from_std(socket)?,
+                target,
+            }),
+            None => None,
+        };
+        // Announced only once the sockets and the signal handlers are in place.
+        println!("{ready}");
+        tracing::info!(%listen, gcs = %gcs_text, "flyloop-sitl running");
+        server::run(sim, controller, gcs, shutdown).await
+    })?;
+    tracing::info!("stopped: {stats}");
+    Ok(())
+}
+
+/// Runs the SITL with command-line `args` (the program name first) until SIGINT / SIGTERM;
+/// returns the process exit code (0, 1 on a start error, 2 on bad options).
+pub fn main_with_args<I, T>(args: I) -> u8
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let args = match Args::try_parse_from(args) {
+        Ok(args) => args,
+        Err(e) => {
+            // --help and --version print and succeed; bad options print and exit 2.
+            let _ = e.print();
+            return u8::try_from(e.exit_code()).unwrap_or(2);
+        }
+    };
+    // try_init: a host process (the Python extension) may have installed one already.
+    let _ = tracing_subscriber::fmt()
+        .with_writer(std::io::stderr)
+        .with_max_level(args.log_level)
+        .with_target(false)
+        .with_ansi(std::io::stderr().is_terminal())
+        .try_init();
+    match start(args) {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("flyloop-sitl: error: {e}");
+            1
+        }
+    }
+}
