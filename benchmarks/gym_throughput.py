@@ -25,10 +25,9 @@ import gc
 import os
 import time
 
+import flyloop  # noqa: F401  (registers the env ids)
 import gymnasium as gym
 import numpy as np
-
-import flyloop  # noqa: F401  (registers the env ids)
 from flyloop.registration import ENVS
 
 BATCH = 4096
