@@ -24,5 +24,7 @@ cargo test --workspace --release --doc
 say "ruff"
 .venv/bin/ruff check .
 .venv/bin/ruff format --check .
+say "Wheel: pip wheel ./python in a fresh venv, every env id with both backends"
+bash scripts/wheel-smoke.sh
 say "Python system tests (pytest)"
 .venv/bin/pytest -q
