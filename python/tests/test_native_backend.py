@@ -6,7 +6,6 @@ thread count; bad input refused with clear errors."""
 from __future__ import annotations
 
 import warnings
-from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -233,14 +232,3 @@ def test_a_rust_panic_becomes_a_python_exception():
     assert type(caught.value).__name__ == "PanicException"
     # The interpreter goes on: the extension still works.
     assert _native.describe("hover")["dt"] == 0.01
-
-
-def test_the_readme_snippet_runs():
-    text = (Path(__file__).resolve().parents[2] / "README.md").read_text()
-    section = text.split("### Native backend", 1)[1]
-    code = section.split("```python\n", 1)[1].split("```", 1)[0]
-    scope: dict = {}
-    exec(compile(code, "README.md", "exec"), scope)
-    assert scope["obs"].shape == (1024, 33) and scope["rewards"].shape == (1024,)
-    scope["envs"].close()
-    scope["env"].close()
