@@ -1,5 +1,6 @@
-//! One 10 ms control step of the quadrotor (default substep: one RK4 step), and one Hover
-//! task step (physics + reward + termination + 33-value observation).
+//! One 10 ms control step of the quadrotor (default substep: one RK4 step) in flight and
+//! resting on the ground, and one Hover task step (physics + reward + termination + 33-value
+//! observation).
 //!
 //! cargo bench -p flyloop-core --bench quadrotor_step
 
@@ -36,6 +37,16 @@ fn quadrotor_step(c: &mut Criterion) {
     c.bench_function("quadrotor_control_step_10ms_no_wind", |b| {
         b.iter(|| {
             calm.step(black_box(0.01));
+        })
+    });
+    // Resting on the landing gear in wind: the contact path (5 substeps of 2 ms).
+    let rest = flyloop_core::quadrotor::contact::rest_height(&QuadrotorParams::default());
+    let standing = BodyState::at_rest(Vector3::new(0.0, 0.0, rest), 0.0, 0.0, 0.1, 0.0);
+    let mut ground =
+        Quadrotor::new(QuadrotorParams::default(), standing, SimRng::new(1)).expect("valid");
+    c.bench_function("quadrotor_control_step_10ms_on_ground", |b| {
+        b.iter(|| {
+            ground.step(black_box(0.01));
         })
     });
     let mut rng = SimRng::new(3);

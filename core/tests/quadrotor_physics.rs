@@ -1,5 +1,5 @@
 //! Analytic checks of the quadrotor dynamics: equilibrium, free fall, torque signs, motor
-//! lag, conservation laws, ground contact, drag, determinism.
+//! lag, conservation laws, drag, determinism (ground contact: quadrotor_ground.rs).
 
 // Helpers are test code too: a failed setup is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -250,23 +250,6 @@ fn finer_substeps_converge_to_the_same_trajectory() {
     let fine = run(0.001);
     assert!((coarse.position - fine.position).norm() < 1e-6);
     assert!((coarse.body_rates - fine.body_rates).norm() < 1e-6);
-}
-
-#[test]
-fn the_vehicle_rests_on_the_ground_and_lifts_off_with_thrust() {
-    let params = still_air();
-    let mut quad = vehicle(
-        params,
-        BodyState::at_rest(Vector3::new(1.0, 1.0, 0.0), 0.0, 0.0, 0.0, 0.0),
-    );
-    fly(&mut quad, [0.0; 4], 2.0);
-    assert_eq!(quad.body.position, Vector3::new(1.0, 1.0, 0.0));
-    assert_eq!(quad.body.velocity, Vector3::zeros());
-    assert!(quad.is_grounded());
-    assert_eq!(quad.accelerations().0, Vector3::zeros());
-    fly(&mut quad, [0.8; 4], 1.0);
-    assert!(quad.body.position.z > 0.5, "{}", quad.body.position.z);
-    assert!(!quad.is_grounded());
 }
 
 #[test]

@@ -57,7 +57,7 @@ fn direct_feedthrough_is_declared_exactly() {
             .filter(|v| v.causality == Causality::Input)
             .collect();
         // Near hover (the quadrotor must stay airborne: on the ground its acceleration is
-        // held at zero), a little asymmetric, with some wind from outside.
+        // the contact's), a little asymmetric, with some wind from outside.
         for (i, input) in inputs.iter().enumerate() {
             let value = if input.name.starts_with("motor") {
                 0.5

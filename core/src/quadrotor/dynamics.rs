@@ -4,7 +4,9 @@
 //! 1 rear-left CCW, 2 front-left CW, 3 rear-right CW. Thrust T_i = k m_i² along body +z;
 //! torques are r_i × F_i plus the spin reaction (a CCW rotor pushes the body toward −z).
 //! Body rates are integrated as body rates: q̇ = ½ q ⊗ (0, ω), I ω̇ = τ − ω × I ω.
+//! The ground pushes on four landing-gear feet ([`super::contact`]).
 
+use super::contact::{CONTACT_LEN, Gear, STRETCH, gear_reach};
 use super::params::QuadrotorParams;
 use super::state::BodyState;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -14,7 +16,7 @@ pub const ROTOR_SPIN: [f64; 4] = [-1.0, -1.0, 1.0, 1.0];
 /// Rotor position signs (forward, left), multiplied by L/√2.
 pub const ROTOR_POSITION: [(f64, f64); 4] = [(1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (-1.0, -1.0)];
 
-/// Time derivative of a [`BodyState`] (same shape: velocity, acceleration, q̇, ω̇, ṁ).
+/// Time derivative of a [`BodyState`] (same shape: velocity, acceleration, q̇, ω̇, ṁ, ṡ).
 #[derive(Debug, Clone, Copy)]
 pub struct Derivative {
     pub velocity: Vector3<f64>,
@@ -22,6 +24,7 @@ pub struct Derivative {
     pub attitude_rate: Quaternion<f64>,
     pub angular_acceleration: Vector3<f64>,
     pub motor_rates: [f64; 4],
+    pub gear_stretch_rates: [[f64; 2]; 4],
 }
 
 /// Constants of the equations that depend only on the parameters, computed once per step.
@@ -57,26 +60,37 @@ impl Coefficients {
     }
 }
 
-/// The state derivative for motor commands `command` (in [0, 1]) and air velocity `wind`.
+/// The state derivative for motor commands `command` (in [0, 1]) and air velocity `wind`,
+/// ground contact included: a pure function of the state.
 pub fn derivatives(
     params: &QuadrotorParams,
     state: &BodyState,
     command: &[f64; 4],
     wind: &Vector3<f64>,
 ) -> Derivative {
-    let d = rates(
-        params,
-        &Coefficients::new(params),
-        &flatten(state),
-        command,
-        wind,
-    );
+    let c = Coefficients::new(params);
+    let d = if params.ground_enabled {
+        contact_rates(
+            params,
+            &c,
+            &Gear::new(params),
+            &flatten_contact(state),
+            command,
+            wind,
+        )
+    } else {
+        let mut d = [0.0; CONTACT_LEN];
+        d[..STRETCH].copy_from_slice(&rates(params, &c, &flatten(state), command, wind));
+        d
+    };
+    let s = &d[STRETCH..];
     Derivative {
         velocity: Vector3::new(d[0], d[1], d[2]),
         acceleration: Vector3::new(d[3], d[4], d[5]),
         attitude_rate: Quaternion::new(d[6], d[7], d[8], d[9]),
         angular_acceleration: Vector3::new(d[10], d[11], d[12]),
         motor_rates: [d[13], d[14], d[15], d[16]],
+        gear_stretch_rates: [[s[0], s[1]], [s[2], s[3]], [s[4], s[5]], [s[6], s[7]]],
     }
 }
 
@@ -93,14 +107,38 @@ fn flatten(s: &BodyState) -> Flat {
     ]
 }
 
+/// Writes a flat state back into `s` (the bristles are left alone).
 #[inline(always)]
-fn unflatten(x: &Flat) -> BodyState {
-    BodyState {
-        position: Vector3::new(x[0], x[1], x[2]),
-        velocity: Vector3::new(x[3], x[4], x[5]),
-        attitude: Quaternion::new(x[6], x[7], x[8], x[9]),
-        body_rates: Vector3::new(x[10], x[11], x[12]),
-        motors: [x[13], x[14], x[15], x[16]],
+fn unflatten_into(x: &Flat, s: &mut BodyState) {
+    s.position = Vector3::new(x[0], x[1], x[2]);
+    s.velocity = Vector3::new(x[3], x[4], x[5]);
+    s.attitude = Quaternion::new(x[6], x[7], x[8], x[9]);
+    s.body_rates = Vector3::new(x[10], x[11], x[12]);
+    s.motors = [x[13], x[14], x[15], x[16]];
+}
+
+/// The state of a step that may touch the ground: [`Flat`] followed by the four bristles
+/// (x, y each).
+type ContactFlat = [f64; CONTACT_LEN];
+
+#[inline(always)]
+fn flatten_contact(s: &BodyState) -> ContactFlat {
+    let mut x = [0.0; CONTACT_LEN];
+    x[..STRETCH].copy_from_slice(&flatten(s));
+    for (i, stretch) in s.gear_stretch.iter().enumerate() {
+        x[STRETCH + 2 * i] = stretch[0];
+        x[STRETCH + 2 * i + 1] = stretch[1];
+    }
+    x
+}
+
+#[inline(always)]
+fn unflatten_contact(x: &ContactFlat, s: &mut BodyState) {
+    let mut body = [0.0; STRETCH];
+    body.copy_from_slice(&x[..STRETCH]);
+    unflatten_into(&body, s);
+    for (i, stretch) in s.gear_stretch.iter_mut().enumerate() {
+        *stretch = [x[STRETCH + 2 * i], x[STRETCH + 2 * i + 1]];
     }
 }
 
@@ -177,9 +215,27 @@ fn rates(
     ]
 }
 
+/// The equations of motion with the ground contact ([`super::contact`]).
+#[inline(always)]
+fn contact_rates(
+    p: &QuadrotorParams,
+    c: &Coefficients,
+    gear: &Gear,
+    x: &ContactFlat,
+    command: &[f64; 4],
+    wind: &Vector3<f64>,
+) -> ContactFlat {
+    let mut body = [0.0; STRETCH];
+    body.copy_from_slice(&x[..STRETCH]);
+    let mut d = [0.0; CONTACT_LEN];
+    d[..STRETCH].copy_from_slice(&rates(p, c, &body, command, wind));
+    gear.add_rates(x, &mut d);
+    d
+}
+
 /// x + h·d, component-wise.
 #[inline(always)]
-fn advanced(x: &Flat, d: &Flat, h: f64) -> Flat {
+fn advanced<const N: usize>(x: &[f64; N], d: &[f64; N], h: f64) -> [f64; N] {
     let mut out = *x;
     for (o, r) in out.iter_mut().zip(d) {
         *o += h * r;
@@ -187,20 +243,14 @@ fn advanced(x: &Flat, d: &Flat, h: f64) -> Flat {
     out
 }
 
-/// One classical RK4 step of length `h`; the quaternion is renormalised afterwards.
+/// One classical RK4 step of length `h` of ẋ = f(x); the quaternion (x[6..10]) is
+/// renormalised afterwards.
 #[inline(always)]
-fn rk4(
-    p: &QuadrotorParams,
-    c: &Coefficients,
-    x: &Flat,
-    command: &[f64; 4],
-    wind: &Vector3<f64>,
-    h: f64,
-) -> Flat {
-    let k1 = rates(p, c, x, command, wind);
-    let k2 = rates(p, c, &advanced(x, &k1, 0.5 * h), command, wind);
-    let k3 = rates(p, c, &advanced(x, &k2, 0.5 * h), command, wind);
-    let k4 = rates(p, c, &advanced(x, &k3, h), command, wind);
+fn rk4<const N: usize>(x: &[f64; N], h: f64, f: impl Fn(&[f64; N]) -> [f64; N]) -> [f64; N] {
+    let k1 = f(x);
+    let k2 = f(&advanced(x, &k1, 0.5 * h));
+    let k3 = f(&advanced(x, &k2, 0.5 * h));
+    let k4 = f(&advanced(x, &k3, h));
     let sixth = h / 6.0;
     let mut out = *x;
     for i in 0..out.len() {
@@ -221,28 +271,16 @@ fn rk4(
     out
 }
 
-/// Ground plane z = 0: an inelastic, non-sliding contact. A vehicle that reaches it stops
-/// sinking, stops sliding and stops turning; it lifts off as soon as thrust exceeds weight.
-#[inline(always)]
-fn apply_ground(s: &mut BodyState) -> bool {
-    if s.position.z > 0.0 {
-        return false;
-    }
-    s.position.z = 0.0;
-    s.velocity = Vector3::new(0.0, 0.0, s.velocity.z.max(0.0));
-    s.body_rates = Vector3::zeros();
-    true
-}
-
 /// Advances `state` by `dt` under constant `command` and `wind`, in ceil(dt / max_substep)
-/// equal RK4 substeps. Returns whether the vehicle ends the step on the ground.
+/// equal RK4 substeps — ceil(dt / min(max_substep, contact_substep)) when a foot may touch
+/// the ground during the step.
 pub fn integrate(
     params: &QuadrotorParams,
     state: &mut BodyState,
     command: &[f64; 4],
     wind: &Vector3<f64>,
     dt: f64,
-) -> bool {
+) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx") {
         // SAFETY: the CPU supports AVX, checked just above.
@@ -262,7 +300,7 @@ fn integrate_avx(
     command: &[f64; 4],
     wind: &Vector3<f64>,
     dt: f64,
-) -> bool {
+) {
     integrate_portable(params, state, command, wind, dt)
 }
 
@@ -277,6 +315,26 @@ pub fn substep_count(dt: f64, max_substep: f64) -> f64 {
     (ratio - ratio * 1e-9).ceil().max(1.0)
 }
 
+/// Whether a foot may reach the ground within `dt`: the centre of mass may come closer to
+/// the ground than the gear's reach. The bound on the fall is loose on purpose (twice the
+/// largest acceleration's ½·a·dt², the speed it can gain included), so a step judged
+/// airborne never touches; it costs a few operations and spares a flight the contact.
+#[inline(always)]
+fn may_touch(
+    p: &QuadrotorParams,
+    c: &Coefficients,
+    s: &BodyState,
+    wind: &Vector3<f64>,
+    dt: f64,
+) -> bool {
+    let v = &s.velocity;
+    let thrust_and_gravity = c.gravity + 4.0 * c.thrust_per_mass;
+    let speed = v.x.abs() + v.y.abs() + v.z.abs() + thrust_and_gravity * dt;
+    let air = speed + wind.x.abs() + wind.y.abs() + wind.z.abs();
+    let acceleration = thrust_and_gravity + c.drag_per_mass * air * air;
+    s.position.z - speed * dt - acceleration * dt * dt < gear_reach(p)
+}
+
 #[inline(always)]
 fn integrate_portable(
     params: &QuadrotorParams,
@@ -284,36 +342,43 @@ fn integrate_portable(
     command: &[f64; 4],
     wind: &Vector3<f64>,
     dt: f64,
-) -> bool {
+) {
     let c = Coefficients::new(params);
+    if params.ground_enabled && may_touch(params, &c, state, wind, dt) {
+        let gear = Gear::new(params);
+        let substeps = substep_count(dt, params.max_substep.min(params.contact_substep));
+        let h = if substeps == 1.0 { dt } else { dt / substeps };
+        let mut x = flatten_contact(state);
+        for _ in 0..substeps as u64 {
+            x = rk4(&x, h, |y| {
+                contact_rates(params, &c, &gear, y, command, wind)
+            });
+            gear.release_lifted_feet(&mut x);
+        }
+        unflatten_contact(&x, state);
+        return;
+    }
     let substeps = substep_count(dt, params.max_substep);
     let h = if substeps == 1.0 { dt } else { dt / substeps };
-    let mut grounded = false;
+    let mut x = flatten(state);
     for _ in 0..substeps as u64 {
-        *state = unflatten(&rk4(params, &c, &flatten(state), command, wind, h));
-        grounded = params.ground_enabled && apply_ground(state);
+        x = rk4(&x, h, |y| rates(params, &c, y, command, wind));
     }
-    grounded
+    unflatten_into(&x, state);
+    // No foot reached the ground: every bristle is released.
+    state.gear_stretch = [[0.0; 2]; 4];
 }
 
 /// Accelerations at the current state: linear (world, m/s², total force / mass, so 0 in a
-/// hover) and angular (body, rad/s²). On the ground the contact force is included.
+/// hover or at rest on the ground) and angular (body, rad/s²), ground contact included.
 pub fn accelerations(
     params: &QuadrotorParams,
     state: &BodyState,
     command: &[f64; 4],
     wind: &Vector3<f64>,
-    grounded: bool,
 ) -> (Vector3<f64>, Vector3<f64>) {
     let d = derivatives(params, state, command, wind);
-    if grounded {
-        (
-            Vector3::new(0.0, 0.0, d.acceleration.z.max(0.0)),
-            Vector3::zeros(),
-        )
-    } else {
-        (d.acceleration, d.angular_acceleration)
-    }
+    (d.acceleration, d.angular_acceleration)
 }
 
 #[cfg(test)]
@@ -371,14 +436,27 @@ mod tests {
             let m = 0.3 + 0.4 * ((i % 7) as f64 / 7.0);
             let command = [m, 0.9 - m, 0.5, 0.45];
             let dt = if i % 3 == 0 { 0.025 } else { 0.01 };
-            let ga = integrate_portable(&p, &mut a, &command, &wind, dt);
+            integrate_portable(&p, &mut a, &command, &wind, dt);
             // SAFETY: AVX support was checked at the top of the test.
-            let gb = unsafe { integrate_avx(&p, &mut b, &command, &wind, dt) };
-            assert_eq!(ga, gb);
+            unsafe { integrate_avx(&p, &mut b, &command, &wind, dt) };
         }
-        let bits = |s: &BodyState| flatten(s).map(f64::to_bits);
+        let bits = |s: &BodyState| flatten_contact(s).map(f64::to_bits);
         assert_eq!(bits(&a), bits(&b));
         assert_ne!(bits(&a), bits(&start));
+        // The contact path too: a tilted, sliding touchdown that bounces and settles.
+        let touchdown = BodyState {
+            velocity: Vector3::new(1.0, -0.5, -2.0),
+            body_rates: Vector3::new(1.0, 0.5, -2.0),
+            ..BodyState::at_rest(Vector3::new(0.0, 0.0, 0.3), 0.4, -0.2, 0.5, 0.0)
+        };
+        let (mut a, mut b) = (touchdown, touchdown);
+        for _ in 0..200 {
+            integrate_portable(&p, &mut a, &[0.1; 4], &wind, 0.01);
+            // SAFETY: AVX support was checked at the top of the test.
+            unsafe { integrate_avx(&p, &mut b, &[0.1; 4], &wind, 0.01) };
+        }
+        assert_eq!(bits(&a), bits(&b));
+        assert!(a.position.z < 0.1, "{}", a.position.z);
     }
 
     /// Regression: 0.07 s at 0.01 s substeps took 8 substeps (0.07 / 0.01 = 7.000000000000001).

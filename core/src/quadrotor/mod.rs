@@ -3,6 +3,7 @@
 //! See [`dynamics`] for the equations, [`params`] for the parameter table, [`variables`] for
 //! the table the FMU and the SITL read.
 
+pub mod contact;
 pub mod dynamics;
 pub mod model;
 pub mod params;

@@ -1,6 +1,7 @@
 //! A quadrotor instance: parameters, state, command, wind and its random generator — what
 //! an FMU instance or a SITL vehicle holds.
 
+use super::contact::foot_heights;
 use super::dynamics::{accelerations, integrate};
 use super::params::{QuadrotorInitial, QuadrotorParams};
 use super::state::{BodyState, WindState};
@@ -22,7 +23,6 @@ pub struct Quadrotor {
     pub external_wind: Vector3<f64>,
     /// Motor commands in [0, 1], held until changed.
     command: [f64; 4],
-    grounded: bool,
     rng: SimRng,
     #[serde(skip)]
     ou_cache: OuCache,
@@ -43,7 +43,6 @@ impl Quadrotor {
             wind,
             external_wind: Vector3::zeros(),
             command: [0.0; 4],
-            grounded: false,
             rng,
             ou_cache: OuCache::default(),
         })
@@ -58,7 +57,6 @@ impl Quadrotor {
         self.command = [body.motors[0].clamp(0.0, 1.0); 4];
         self.body = body;
         self.external_wind = Vector3::zeros();
-        self.grounded = false;
         self.rng = rng;
         self.ou_cache = OuCache::default();
     }
@@ -100,7 +98,7 @@ impl Quadrotor {
     /// the turbulence moves on by `dt`.
     pub fn step(&mut self, dt: f64) {
         let wind = self.wind_velocity();
-        self.grounded = integrate(&self.params, &mut self.body, &self.command, &wind, dt);
+        integrate(&self.params, &mut self.body, &self.command, &wind, dt);
         if self.params.wind_enabled {
             let transition = self.ou_cache.get(&self.params, dt);
             apply_transition(&transition, &mut self.wind, &mut self.rng);
@@ -112,9 +110,15 @@ impl Quadrotor {
         self.wind.velocity() + self.external_wind
     }
 
-    /// Whether the last step ended resting on the ground plane.
+    /// Whether a foot touches the ground (ground enabled and a foot height ≤ 0).
     pub fn is_grounded(&self) -> bool {
-        self.grounded
+        self.params.ground_enabled && self.foot_heights().iter().any(|&h| h <= 0.0)
+    }
+
+    /// Height of each landing-gear foot above the ground, m, in rotor order (the contact's
+    /// event indicators).
+    pub fn foot_heights(&self) -> [f64; 4] {
+        foot_heights(&self.params, &self.body)
     }
 
     /// Linear acceleration (world, total force / mass) and angular acceleration (body) now.
@@ -124,7 +128,6 @@ impl Quadrotor {
             &self.body,
             &self.command,
             &self.wind_velocity(),
-            self.grounded,
         )
     }
 
@@ -162,7 +165,8 @@ impl Quadrotor {
             && b.body_rates.iter().all(|v| v.is_finite())
             && b.attitude.coords.iter().all(|v| v.is_finite())
             && b.attitude.norm() > 0.0
-            && b.motors.iter().chain(&quad.command).all(|v| v.is_finite());
+            && b.motors.iter().chain(&quad.command).all(|v| v.is_finite())
+            && b.gear_stretch.iter().flatten().all(|v| v.is_finite());
         if !finite {
             return Err(SnapshotError::Invalid(
                 "state holds a non-finite value or a zero quaternion".into(),
@@ -172,5 +176,5 @@ impl Quadrotor {
     }
 }
 
-/// Format tag of a Quadrotor snapshot (name and version).
-const SNAPSHOT_TAG: &[u8; 8] = b"FLYQUA01";
+/// Format tag of a Quadrotor snapshot (name and version; 02 added the gear's bristles).
+const SNAPSHOT_TAG: &[u8; 8] = b"FLYQUA02";

@@ -44,8 +44,27 @@ pub struct QuadrotorParams {
     /// Largest RK4 substep, s. A step of length h uses ceil(h / max_substep) equal substeps.
     /// Default 0.01.
     pub max_substep: f64,
-    /// Whether the ground plane z = 0 holds the vehicle. Default true.
+    /// Whether the ground plane z = 0 holds the vehicle (on its four landing-gear feet).
+    /// Default true.
     pub ground_enabled: bool,
+    /// Feet at body x = ±gear_x (forward), m. Default 0.07 (under the default rotors).
+    pub gear_x: f64,
+    /// Feet at body y = ±gear_y (left), m. Default 0.07.
+    pub gear_y: f64,
+    /// Feet at body z = gear_z (up; negative = below the centre of mass), m. Default −0.05.
+    pub gear_z: f64,
+    /// Normal (and tangential bristle) stiffness of each foot, N/m. Default 3000: a 1 kg
+    /// vehicle sags 0.8 mm, a 1.5 kg one 1.2 mm; its bounce frequency (90–110 rad/s) is
+    /// resolved by `contact_substep`.
+    pub gear_stiffness: f64,
+    /// Normal (and tangential bristle) damping of each foot, N·s/m. Default 20 (damping ratio
+    /// 0.37 at 1 kg, 0.30 at 1.5 kg: a 1 m drop bounces ~8 cm, then ~1 cm).
+    pub gear_damping: f64,
+    /// Coulomb friction coefficient between a foot and the ground, 1. Default 0.5.
+    pub gear_friction: f64,
+    /// Largest RK4 substep while a foot may touch the ground, s. Default 0.002 (ω·h ≤ 0.25
+    /// for the default gear on a 1 kg vehicle).
+    pub contact_substep: f64,
     /// Whether wind blows at all. Default true.
     pub wind_enabled: bool,
     /// Lower end of the per-episode mean wind speed, m/s. Default 0.
@@ -79,6 +98,13 @@ impl Default for QuadrotorParams {
             pendulum_coefficient: 0.0,
             max_substep: 0.01,
             ground_enabled: true,
+            gear_x: 0.07,
+            gear_y: 0.07,
+            gear_z: -0.05,
+            gear_stiffness: 3000.0,
+            gear_damping: 20.0,
+            gear_friction: 0.5,
+            contact_substep: 0.002,
             wind_enabled: true,
             wind_speed_min: 0.0,
             wind_speed_max: 5.0,
@@ -89,7 +115,7 @@ impl Default for QuadrotorParams {
     }
 }
 
-static QUADROTOR_SPECS: [ParamSpec<QuadrotorParams>; 22] = [
+static QUADROTOR_SPECS: [ParamSpec<QuadrotorParams>; 29] = [
     param!(real mass, "kg", 1e-3, 1e4, "Vehicle mass"),
     param!(real arm_length, "m", 1e-3, 100.0, "Distance from the centre to each rotor"),
     param!(real inertia_xx, "kg.m2", 1e-7, 1e4, "Moment of inertia about body x (forward)"),
@@ -105,13 +131,20 @@ static QUADROTOR_SPECS: [ParamSpec<QuadrotorParams>; 22] = [
     param!(real angular_damping_quadratic, "N.m.s2/rad2", 0.0, 1e3, "Quadratic angular damping"),
     param!(real pendulum_coefficient, "m", 0.0, 10.0, "Non-physical restoring torque -c m g sin(roll|pitch); 0 = off"),
     param!(real max_substep, "s", 1e-6, 1.0, "Largest RK4 substep"),
-    param!(boolean ground_enabled, "Ground plane z = 0 holds the vehicle"),
+    param!(boolean ground_enabled, "Ground plane z = 0 holds the vehicle on its four feet"),
     param!(boolean wind_enabled, "Wind (mean + turbulence) blows"),
     param!(real wind_speed_min, "m/s", 0.0, 100.0, "Lower end of the per-episode mean wind speed"),
     param!(real wind_speed_max, "m/s", 0.0, 100.0, "Upper end of the per-episode mean wind speed"),
     param!(real turbulence_theta, "1/s", 0.0, 100.0, "Ornstein-Uhlenbeck mean reversion rate"),
     param!(real turbulence_sigma, "m/s/s0.5", 0.0, 100.0, "Ornstein-Uhlenbeck diffusion (horizontal)"),
     param!(real turbulence_vertical_ratio, "1", 0.0, 10.0, "Vertical turbulence sigma / horizontal sigma"),
+    param!(real gear_x, "m", 1e-3, 100.0, "Feet at body x = +-gear_x (forward)"),
+    param!(real gear_y, "m", 1e-3, 100.0, "Feet at body y = +-gear_y (left)"),
+    param!(real gear_z, "m", -100.0, 0.0, "Feet at body z = gear_z (up; below the centre of mass < 0)"),
+    param!(real gear_stiffness, "N/m", 1.0, 1e9, "Normal and tangential stiffness of each foot"),
+    param!(real gear_damping, "N.s/m", 1e-3, 1e9, "Normal and tangential damping of each foot"),
+    param!(real gear_friction, "1", 0.0, 10.0, "Coulomb friction coefficient foot-ground"),
+    param!(real contact_substep, "s", 1e-6, 1.0, "Largest RK4 substep while a foot may touch the ground"),
 ];
 
 impl Parameters for QuadrotorParams {

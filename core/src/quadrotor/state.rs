@@ -16,6 +16,9 @@ pub struct BodyState {
     pub body_rates: Vector3<f64>,
     /// Lagged motor states in [0, 1], PX4 quad-X order (front-right, rear-left, front-left, rear-right).
     pub motors: [f64; 4],
+    /// Stretch of each foot's friction bristle along the ground (world x, y), m: the
+    /// stick-slip state of Coulomb friction (see `contact`). Zero for a foot off the ground.
+    pub gear_stretch: [[f64; 2]; 4],
 }
 
 impl BodyState {
@@ -27,6 +30,7 @@ impl BodyState {
             attitude: *UnitQuaternion::from_euler_angles(roll, pitch, yaw).quaternion(),
             body_rates: Vector3::zeros(),
             motors: [motor; 4],
+            gear_stretch: [[0.0; 2]; 4],
         }
     }
 

@@ -4,6 +4,7 @@
 use crate::error::ParamError;
 use crate::param;
 use crate::params::{ParamSpec, Parameters};
+use crate::quadrotor::contact::foot_heights;
 use crate::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
 use crate::rng::SimRng;
 use crate::tasks::{ActionError, Info, InfoValue, check_action, clip_f32};
@@ -142,12 +143,14 @@ pub fn sample_target(task: &FlightParams, from: &Vector3<f64>, rng: &mut SimRng)
     target
 }
 
-/// The seed's crash test: on or below the ground, falling faster than the threshold, or
-/// tilted beyond the threshold in roll or pitch.
-pub fn is_crashed(task: &FlightParams, body: &BodyState) -> bool {
+/// The seed's crash test: on or below the ground (the centre of mass or, since the vehicle
+/// stands on landing gear, any foot), falling faster than the threshold, or tilted beyond
+/// the threshold in roll or pitch.
+pub fn is_crashed(task: &FlightParams, model: &QuadrotorParams, body: &BodyState) -> bool {
     let (roll, pitch, _) = body.euler_angles();
     let tilt = task.crash_tilt_threshold.to_radians();
     body.position.z <= 0.0
+        || foot_heights(model, body).iter().any(|&h| h <= 0.0)
         || body.velocity.z < task.crash_z_vel_threshold
         || roll.abs() > tilt
         || pitch.abs() > tilt

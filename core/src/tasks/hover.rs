@@ -129,7 +129,8 @@ impl Task for Hover {
         let body = &self.quad.body;
         let reward = hover_reward(&self.params, body, &self.target);
         let status = &mut self.status;
-        status.crashed = self.params.enable_crash_detection && is_crashed(&self.params, body);
+        status.crashed =
+            self.params.enable_crash_detection && is_crashed(&self.params, &self.quad.params, body);
         status.out_of_bounds = self.params.enable_out_of_bounds_detection
             && (self.target - body.position).norm() > out_of_bounds_distance(&self.params);
         let terminated = status.crashed || status.out_of_bounds;

@@ -219,8 +219,8 @@ impl Task for Waypoints {
 
         let d_now = (self.current_waypoint() - self.quad.body.position).norm();
         let status = &mut self.status;
-        status.crashed =
-            self.flight.enable_crash_detection && is_crashed(&self.flight, &self.quad.body);
+        status.crashed = self.flight.enable_crash_detection
+            && is_crashed(&self.flight, &self.quad.params, &self.quad.body);
         status.out_of_bounds = self.flight.enable_out_of_bounds_detection
             && d_now > waypoint_out_of_bounds_distance(&self.flight);
         let truncated = status.step_count >= self.flight.max_steps
