@@ -160,7 +160,9 @@ fn a_new_connection_starts_from_the_start_state() {
     s.connect(0, &mut out);
     assert_eq!(s.time_us(), 4000);
     assert!(!s.is_lockstep());
-    assert_eq!(s.quadrotor().body.position, Vector3::zeros());
+    // Standing on its landing gear again: the centre of mass at the rest height.
+    let standing = Vector3::new(0.0, 0.0, rest_height(&s.quadrotor().params));
+    assert!((s.quadrotor().body.position - standing).norm() < 1e-12);
     assert_eq!(s.quadrotor().command(), [0.0; 4]);
 }
 
