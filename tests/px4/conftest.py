@@ -7,15 +7,15 @@ import sys
 from pathlib import Path
 
 import pytest
+from flyloop import find_sitl_binary
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "sitl"))
 from px4_support import Flyloop, Px4, free_instance, fresh_dir, px4_root  # noqa: E402
-from sitl_client import build_binary  # noqa: E402
 
 
 @pytest.fixture(scope="session")
 def sitl_binary():
-    return build_binary()
+    return find_sitl_binary(build=True)
 
 
 @pytest.fixture(scope="session")
