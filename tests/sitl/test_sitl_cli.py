@@ -73,7 +73,8 @@ def test_listings_print_and_exit(sitl_binary):
     assert params.returncode == 0
     rows = [ln for ln in params.stdout.splitlines() if ln.startswith("| `")]
     ids = [r.split("`")[1] for r in rows]
-    assert len(ids) == 38 and len(set(ids)) == 38 and max(map(len, ids)) <= 16
+    # 29 quadrotor parameters (22 + the 7 of the landing gear), 12 flight, 4 waypoints.
+    assert len(ids) == 45 and len(set(ids)) == 45 and max(map(len, ids)) <= 16
     assert "| `en_oob_det` | `enable_out_of_bounds_detection` |" in params.stdout
     frame = run(sitl_binary, "--task", "hover", "--describe-frame")
     assert frame.returncode == 0
