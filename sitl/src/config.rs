@@ -26,21 +26,27 @@ pub fn parse(task: TaskKind, text: &str) -> Result<TaskConfig, ParamError> {
     let table: toml::Table = toml::from_str(text)?;
     let mut values: Vec<(&str, f64)> = Vec::with_capacity(table.len());
     for (key, value) in &table {
-        let number = match value {
-            toml::Value::Integer(i) => *i as f64,
-            toml::Value::Float(x) => *x,
-            toml::Value::Boolean(b) => f64::from(u8::from(*b)),
-            _ => {
-                let entry = find_entry(&param_table::entries(task), task, key)?;
-                return Err(ParamError::Parse(format!(
-                    "parameter `{}` must be a number or a boolean",
-                    entry.name
-                )));
-            }
+        let Some(number) = toml_number(value) else {
+            let entry = find_entry(&param_table::entries(task), task, key)?;
+            return Err(ParamError::Parse(format!(
+                "parameter `{}` must be a number or a boolean",
+                entry.name
+            )));
         };
         values.push((key.as_str(), number));
     }
     from_values(task, values)
+}
+
+/// A parameter file's value as a number: integers, floats, and booleans as 0/1; `None` for
+/// anything else (the caller names the parameter in its error).
+pub(crate) fn toml_number(value: &toml::Value) -> Option<f64> {
+    match value {
+        toml::Value::Integer(i) => Some(*i as f64),
+        toml::Value::Float(x) => Some(*x),
+        toml::Value::Boolean(b) => Some(f64::from(u8::from(*b))),
+        _ => None,
+    }
 }
 
 fn find_entry(entries: &[ParamEntry], task: TaskKind, key: &str) -> Result<ParamEntry, ParamError> {

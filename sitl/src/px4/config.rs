@@ -1,6 +1,7 @@
 //! The parameters of PX4 mode: the quadrotor's and the sensors' in one flat TOML table, each
 //! key by its core name. Without `--config`, the Iris preset is used.
 
+use crate::config::toml_number;
 use flyloop_core::ParamError;
 use flyloop_core::params::Parameters;
 use flyloop_core::quadrotor::QuadrotorParams;
@@ -30,16 +31,9 @@ impl Px4Config {
         let mut quad = Vec::new();
         let mut sensors = Vec::new();
         for (key, value) in &table {
-            let number = match value {
-                toml::Value::Integer(i) => *i as f64,
-                toml::Value::Float(x) => *x,
-                toml::Value::Boolean(b) => f64::from(u8::from(*b)),
-                _ => {
-                    return Err(ParamError::Parse(format!(
-                        "parameter `{key}` must be a number or a boolean"
-                    )));
-                }
-            };
+            let number = toml_number(value).ok_or_else(|| {
+                ParamError::Parse(format!("parameter `{key}` must be a number or a boolean"))
+            })?;
             if QuadrotorParams::spec(key).is_ok() {
                 quad.push((key.as_str(), number));
             } else if SensorParams::spec(key).is_ok() {
