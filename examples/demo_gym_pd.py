@@ -1,5 +1,6 @@
 """A scripted PD controller flies flyloop/QuadHover-v0 through the gym env and the SITL, and
-the flight is written to docs/img/quadhover_demo.gif.
+the flight is written to runs/demo/quadhover_demo.gif (the README's GIF is drawn with
+``--out docs/img/quadhover_demo.gif``).
 
     cargo build --release -p flyloop-sitl && .venv/bin/python examples/demo_gym_pd.py
 
@@ -23,7 +24,8 @@ import gymnasium as gym
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-DEFAULT_GIF = ROOT / "docs" / "img" / "quadhover_demo.gif"
+# runs/ is git-ignored: running the demo leaves the checkout clean.
+DEFAULT_GIF = ROOT / "runs" / "demo" / "quadhover_demo.gif"
 
 # The core's default quadrotor (docs/parameters.md).
 MASS = 1.0

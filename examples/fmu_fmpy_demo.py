@@ -1,9 +1,10 @@
 """Quadrotor.fmu in fmpy: hover for 2 s, then all four motors 0.03 above hover; plots the
-result to docs/img/fmu_hover.png.
+result to runs/demo/fmu_hover.png (the README's figure: ``--out docs/img/fmu_hover.png``).
 
     bash scripts/pack-fmus.sh && .venv/bin/python examples/fmu_fmpy_demo.py
 """
 
+import argparse
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +15,11 @@ ROOT = Path(__file__).resolve().parents[1]
 HOVER = (9.81 / 40) ** 0.5  # motor state that carries 1 kg with k = 10 N per motor
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    # runs/ is git-ignored: running the demo leaves the checkout clean.
+    parser.add_argument("--out", type=Path, default=ROOT / "runs" / "demo" / "fmu_hover.png")
+    args = parser.parse_args(argv)
     # Motor commands, and no external wind (the model's own wind still blows).
     names = [f"motor_command_{i}" for i in range(4)] + [f"wind_input_{a}" for a in "xyz"]
     rows = [(0, *[HOVER] * 4), (2, *[HOVER] * 4), (2, *[HOVER + 0.03] * 4)]
@@ -49,9 +54,9 @@ def main() -> None:
         ax.legend(loc="upper left", fontsize=8)
     fig.suptitle("Quadrotor.fmu in fmpy: hover, then +0.03 on every motor at t = 2 s")
     fig.tight_layout()
-    out = ROOT / "docs" / "img" / "fmu_hover.png"
-    fig.savefig(out, dpi=100)
-    print(out)
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(args.out, dpi=100)
+    print(args.out)
 
 
 if __name__ == "__main__":

@@ -12,8 +12,9 @@ A fenced block is checked when the line before it is a marker comment:
   ``cargo test --doc``), line for line.
 - ``<!-- check: tested-by PATH -->``: the commands run in the tests under PATH (too long
   for this file); every script the block names must appear there.
+- ``<!-- check: ci -->``: the README's two top commands; ``.ci/run`` runs each line as written.
 
-Blocks without a marker (sections added later) are listed, not failed.
+Every fenced block carries a marker: a block without one fails.
 """
 
 from __future__ import annotations
@@ -105,10 +106,10 @@ def environment(sitl: Path) -> dict[str, str]:
 
 
 def test_the_markers_are_known_and_the_core_blocks_are_checked():
-    known = {"run", "python", "python-sitl", "sitl-commands", "doctest", "tested-by"}
+    known = {"run", "python", "python-sitl", "sitl-commands", "doctest", "tested-by", "ci"}
     assert {b.kind for b in ALL if b.kind} <= known
     unchecked = [f"README.md:{b.line} ({b.language})" for b in ALL if b.kind is None]
-    print("blocks without a check marker:", unchecked or "none")
+    assert not unchecked, f"README blocks that no test or CI step runs: {unchecked}"
     # The snippets the README has always had stay checked.
     assert len(of_kind("python", "python-sitl")) >= 3
     assert of_kind("doctest") and of_kind("sitl-commands") and of_kind("run")
@@ -211,6 +212,13 @@ def test_rust_snippets_are_doc_examples(block: Block):
     doc = [ln for ln in doc if not ln.startswith("# ")]
     text = "\n".join(doc)
     assert block.text.strip() in text, f"README.md:{block.line} differs from {block.argument}"
+
+
+@pytest.mark.parametrize("block", of_kind("ci"), ids=lambda b: b.id)
+def test_the_top_commands_are_what_ci_runs(block: Block):
+    ci = [line.strip() for line in (REPO / ".ci" / "run").read_text().splitlines()]
+    for command in commands(block):
+        assert command in ci, f"{command!r} is not a line of .ci/run"
 
 
 @pytest.mark.parametrize("block", of_kind("tested-by"), ids=lambda b: b.id)
