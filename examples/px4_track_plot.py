@@ -32,7 +32,8 @@ def plot(rows: list[dict[str, float]], out: Path) -> None:
         t = [r["time_us"] * 1e-6 for r in flight]
         side.plot(t, [-r["down"] for r in flight], label=f"height ({label})")
         side.plot(t, [r["m0"] for r in flight], alpha=0.5, label="motor 0 state")
-    top.set(xlabel="east (m)", ylabel="north (m)", title="path from above", aspect="equal")
+    top.set(xlabel="east (m)", ylabel="north (m)", title="path from above")
+    top.set_aspect("equal", adjustable="datalim")
     top.grid(True)
     side.set(xlabel="simulation time (s)", ylabel="m / motor state", title="height above home")
     side.grid(True)

@@ -18,7 +18,8 @@ fn still_air() -> QuadrotorParams {
     }
 }
 
-/// Mass, inertia and arm close to PX4's iris (airframe 10016), thrust for a 0.6 hover.
+/// Mass, inertia and arm close to PX4's iris (airframe 10016), thrust for a 0.6 hover, feet
+/// under the rotors as in sitl/presets/px4_iris.toml.
 fn iris() -> QuadrotorParams {
     QuadrotorParams {
         mass: 1.5,
@@ -27,6 +28,9 @@ fn iris() -> QuadrotorParams {
         inertia_yy: 0.029,
         inertia_zz: 0.055,
         thrust_coefficient: 10.2,
+        gear_x: 0.177,
+        gear_y: 0.177,
+        gear_z: -0.055,
         ..still_air()
     }
 }

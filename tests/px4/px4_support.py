@@ -30,6 +30,7 @@ HOW_TO_GET_PX4 = (
     "and set FLYLOOP_PX4 to its build/px4_sitl_default directory (or to a SITL tarball)"
 )
 EARTH_RADIUS = 6_378_137.0
+# flyloop's home (the sensor defaults of the Iris preset): latitude, longitude (deg), altitude (m).
 HOME = (47.397742, 8.545594, 488.0)
 # Simulation seconds per wall second for flyloop and PX4 in the tests.
 SPEED = 4
@@ -93,7 +94,7 @@ def stop(proc: subprocess.Popen, sig: int = signal.SIGTERM, timeout: float = 10)
 class Flyloop:
     """flyloop-sitl in PX4 mode, writing its ground-truth track."""
 
-    def __init__(self, binary: Path, instance: int, workdir: Path, *args: str):
+    def __init__(self, binary: Path, instance: int, workdir: Path, *args: str, speed=None):
         self.track = workdir / "track.csv"
         self.log = open(workdir / "flyloop.log", "w+")
         self.proc = subprocess.Popen(
@@ -103,7 +104,7 @@ class Flyloop:
                 "--px4-listen",
                 f"127.0.0.1:{4560 + instance}",
                 "--speed-factor",
-                str(SPEED),
+                str(SPEED if speed is None else speed),
                 "--track",
                 str(self.track),
                 *args,
@@ -129,6 +130,40 @@ class Flyloop:
     def stop(self) -> int:
         stop(self.proc)
         return self.proc.returncode
+
+
+@dataclass(frozen=True)
+class LocalFrame:
+    """PX4's local NED frame: its origin in degrees and metres above MSL. flyloop's truth is
+    NED from flyloop's home (the centre of mass, m); the same point in PX4's frame is what
+    PX4's estimate must match."""
+
+    latitude: float
+    longitude: float
+    altitude: float
+
+    def _scale(self) -> tuple[float, float]:
+        """Metres per radian north and east around the origin (flat earth: the projection
+        error is far below a millimetre over the tests' tens of metres)."""
+        return EARTH_RADIUS, EARTH_RADIUS * math.cos(math.radians(self.latitude))
+
+    def from_flyloop(self, ned: tuple[float, float, float]) -> tuple[float, float, float]:
+        """flyloop's NED from its home → PX4's local NED."""
+        north, east = self._scale()
+        return (
+            ned[0] + north * math.radians(HOME[0] - self.latitude),
+            ned[1] + east * math.radians(HOME[1] - self.longitude),
+            ned[2] + self.altitude - HOME[2],
+        )
+
+    def to_global(self, ned: tuple[float, float, float]) -> tuple[float, float, float]:
+        """A point of PX4's local frame → latitude, longitude (deg), altitude MSL (m)."""
+        north, east = self._scale()
+        return (
+            self.latitude + math.degrees(ned[0] / north),
+            self.longitude + math.degrees(ned[1] / east),
+            self.altitude - ned[2],
+        )
 
 
 class Px4:
@@ -216,53 +251,88 @@ class Px4:
         self.target = hb.get_srcSystem()
         return hb
 
-    def arm_when_ready(self, timeout: float) -> None:
-        """Arms as soon as PX4 accepts (its estimator needs GPS and a few seconds)."""
+    def accepted(self, command: int, send, timeout: float) -> None:
+        """Sends a command (again every second) until PX4 acknowledges it as accepted: a
+        datagram can be lost, and PX4 refuses some commands until its estimator is ready."""
         end = time.monotonic() + timeout
         while time.monotonic() < end:
-            self.command(mavutil.mavlink.MAV_CMD_COMPONENT_ARM_DISARM, 1)
+            send()
             try:
                 self.wait_for(
-                    "arming",
-                    lambda m: (
-                        m.command == mavutil.mavlink.MAV_CMD_COMPONENT_ARM_DISARM and m.result == 0
-                    ),
+                    f"command {command} accepted",
+                    lambda m: m.command == command and m.result == 0,
                     1.0,
                     "COMMAND_ACK",
                 )
                 return
             except AssertionError:
-                time.sleep(0.5)
-        raise AssertionError(f"PX4 did not arm:\n{self.output()[-3000:]}")
+                pass
+        raise AssertionError(f"PX4 did not accept command {command}:\n{self.output()[-3000:]}")
+
+    def arm_when_ready(self, timeout: float) -> None:
+        """Arms as soon as PX4 accepts (its estimator needs GPS and a few seconds)."""
+        arm = mavutil.mavlink.MAV_CMD_COMPONENT_ARM_DISARM
+        self.accepted(arm, lambda: self.command(arm, 1), timeout)
 
     def takeoff(self) -> None:
         """Takeoff to MIS_TAKEOFF_ALT above home, here."""
         nan = float("nan")
-        self.command(mavutil.mavlink.MAV_CMD_NAV_TAKEOFF, -1, 0, 0, nan, nan, nan, nan)
+        takeoff = mavutil.mavlink.MAV_CMD_NAV_TAKEOFF
+        self.accepted(takeoff, lambda: self.command(takeoff, -1, 0, 0, nan, nan, nan, nan), 30)
 
-    def reposition(self, north: float, east: float) -> None:
-        """Go to a point `north`, `east` metres from home at the current altitude (COMMAND_INT
-        keeps degE7 exact; altitude NaN keeps the current one)."""
-        lat = HOME[0] + math.degrees(north / EARTH_RADIUS)
-        lon = HOME[1] + math.degrees(east / (EARTH_RADIUS * math.cos(math.radians(HOME[0]))))
-        self.link.mav.command_int_send(
-            self.target,
-            1,
-            mavutil.mavlink.MAV_FRAME_GLOBAL,
-            mavutil.mavlink.MAV_CMD_DO_REPOSITION,
-            0,
-            0,
-            -1,
-            1,
-            0,
-            float("nan"),
-            round(lat * 1e7),
-            round(lon * 1e7),
-            float("nan"),
+    def request(self, message_id: int, what: str, timeout: float = 30):
+        """One message PX4 sends on request (MAV_CMD_REQUEST_MESSAGE, asked again every
+        second: a datagram can be lost)."""
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            self.command(mavutil.mavlink.MAV_CMD_REQUEST_MESSAGE, message_id)
+            try:
+                return self.wait_for(what, lambda m: True, 1.0, what)
+            except AssertionError:
+                pass
+        raise AssertionError(f"PX4 did not send {what}:\n{self.output()[-3000:]}")
+
+    def frame(self) -> LocalFrame:
+        """PX4's local frame: its estimator set the origin from the GPS fixes it had when it
+        started (noise included), so it is not flyloop's home, and it does not move after."""
+        o = self.request(mavutil.mavlink.MAVLINK_MSG_ID_GPS_GLOBAL_ORIGIN, "GPS_GLOBAL_ORIGIN")
+        return LocalFrame(o.latitude * 1e-7, o.longitude * 1e-7, o.altitude * 1e-3)
+
+    def home(self) -> tuple[float, float, float]:
+        """PX4's home (set when it armed) in its local frame, m north, east, down: takeoff
+        and landing heights count from here."""
+        h = self.request(mavutil.mavlink.MAVLINK_MSG_ID_HOME_POSITION, "HOME_POSITION")
+        return (h.x, h.y, h.z)
+
+    def goto(self, frame: LocalFrame, target: tuple[float, float, float]) -> None:
+        """Fly to `target` (north, east, down in PX4's local frame `frame`, m): a
+        DO_REPOSITION to the same point in global coordinates (COMMAND_INT keeps degE7
+        exact)."""
+        lat, lon, alt = frame.to_global(target)
+        reposition = mavutil.mavlink.MAV_CMD_DO_REPOSITION
+        self.accepted(
+            reposition,
+            lambda: self.link.mav.command_int_send(
+                self.target,
+                1,
+                mavutil.mavlink.MAV_FRAME_GLOBAL,
+                reposition,
+                0,
+                0,
+                -1,
+                1,
+                0,
+                float("nan"),
+                round(lat * 1e7),
+                round(lon * 1e7),
+                alt,
+            ),
+            30,
         )
 
     def land(self) -> None:
-        self.command(mavutil.mavlink.MAV_CMD_NAV_LAND)
+        land = mavutil.mavlink.MAV_CMD_NAV_LAND
+        self.accepted(land, lambda: self.command(land), 30)
 
 
 @dataclass
@@ -301,20 +371,27 @@ def settle(px4: Px4, target: tuple[float, float, float], tolerance: float, timeo
     try:
         px4.wait_for(f"arrival at {target}", arrived, timeout, "LOCAL_POSITION_NED")
     except AssertionError as e:
-        raise AssertionError(f"last estimate {last}: {e}") from None
+        raise AssertionError(f"last estimate {last[0] if last else None}: {e}") from None
 
 
-def truth_vs_estimate(rows: list[dict[str, float]], hold: Hold, connection: int) -> float:
-    """Largest distance between PX4's estimate and flyloop's ground truth at the same time
-    (PX4's clock is flyloop's simulation time; the truth is interpolated between rows)."""
+def truth_vs_estimate(
+    rows: list[dict[str, float]], hold: Hold, connection: int, frame: LocalFrame
+) -> float:
+    """Largest distance between PX4's estimate and flyloop's ground truth at the same time, in
+    PX4's local frame (PX4's clock is flyloop's simulation time; the truth is interpolated
+    between rows; estimates after the last row, written before PX4 went away, are left out)."""
     rows = [r for r in rows if r["connection"] == connection]
     times = [r["time_us"] / 1000 for r in rows]
+    compared = [s for s in hold.estimate if s[0] <= times[-1]]
+    assert len(compared) > len(hold.estimate) / 2, f"the track ends at {times[-1]} ms"
     worst = 0.0
-    for t, n, e, d in hold.estimate:
+    for t, n, e, d in compared:
         i = next(k for k in range(1, len(times)) if times[k] >= t)
         a, b = rows[i - 1], rows[i]
         w = (t - times[i - 1]) / (times[i] - times[i - 1])
-        truth = [a[k] + w * (b[k] - a[k]) for k in ("north", "east", "down")]
+        truth = frame.from_flyloop(
+            tuple(a[k] + w * (b[k] - a[k]) for k in ("north", "east", "down"))
+        )
         worst = max(worst, math.dist(truth, (n, e, d)))
     return worst
 

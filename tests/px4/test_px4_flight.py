@@ -1,5 +1,9 @@
 """The real PX4 autopilot flies flyloop's quadrotor: a mission with takeoff, hold, a 10 m
-leg and an automatic landing, and a PX4 killed in flight and replaced by a new one."""
+leg and an automatic landing, and a PX4 killed in flight and replaced by a new one.
+
+Targets are in PX4's local frame, relative to PX4's home (where it armed), as a ground
+station gives them; flyloop's truth is carried into that frame through the origin PX4 reports
+(GPS_GLOBAL_ORIGIN), which PX4 took from its first GPS fixes, noise included."""
 
 from __future__ import annotations
 
@@ -15,21 +19,30 @@ ALT = TAKEOFF_ALT
 
 
 def launch(px4):
-    """Waits for PX4, arms it as soon as it is ready and commands the takeoff."""
+    """Waits for PX4, arms it as soon as it is ready and commands the takeoff; returns PX4's
+    local frame and the takeoff target in it."""
     px4.heartbeat(60)
     px4.arm_when_ready(60)
     px4.takeoff()
-    return px4
+    frame = px4.frame()
+    home = px4.home()
+    return frame, (home[0], home[1], home[2] - ALT)
+
+
+def offset(point, north=0.0, east=0.0):
+    return (point[0] + north, point[1] + east, point[2])
 
 
 def test_px4_takes_off_holds_flies_10_m_and_lands_on_flyloop(pair):
     flyloop = pair.flyloop()
-    px4 = launch(pair.px4())
-    settle(px4, (0.0, 0.0, -ALT), 0.15, 60)
+    px4 = pair.px4()
+    frame, hover_target = launch(px4)
+    settle(px4, hover_target, 0.25, 60)
     collect(px4, 2.0)  # let the climb's overshoot die out
     hover = collect(px4, 3.0)
-    px4.reposition(10.0, 0.0)
-    settle(px4, (10.0, 0.0, -ALT), 0.15, 60)
+    away_target = offset(hover_target, north=10.0)
+    px4.goto(frame, away_target)
+    settle(px4, away_target, 0.25, 60)
     collect(px4, 2.0)
     away = collect(px4, 3.0)
     px4.land()
@@ -43,19 +56,22 @@ def test_px4_takes_off_holds_flies_10_m_and_lands_on_flyloop(pair):
     flyloop.stop()
     rows = flyloop.rows()
 
-    # PX4's own estimate against the targets.
-    for hold, target in ((hover, (0.0, 0.0, -ALT)), (away, (10.0, 0.0, -ALT))):
+    for hold, target in ((hover, hover_target), (away, away_target)):
+        # PX4's own estimate against the targets.
         horizontal, vertical = hold.worst(target)
         assert vertical < 0.3, f"altitude error {vertical:.3f} m at {target}"
         assert horizontal < 0.5, f"position error {horizontal:.3f} m at {target}"
         # flyloop's ground truth against PX4's estimate, at the same instants.
-        assert truth_vs_estimate(rows, hold, 1) < 0.5
-    # At rest, level, on the ground, motors off.
-    last = rows[-1]
-    assert last["grounded"] == 1.0
-    assert abs(last["roll"]) < 0.02 and abs(last["pitch"]) < 0.02, last
-    assert abs(last["down"]) < 0.05
-    assert math.hypot(last["north"] - 10.0, last["east"]) < 1.0, last
+        error = truth_vs_estimate(rows, hold, 1, frame)
+        assert error < 0.5, f"truth vs estimate {error:.3f} m at {target}"
+    # At rest, level, on its feet (the centre of mass at the start height), motors off,
+    # below the away point.
+    first, last = rows[0], rows[-1]
+    assert last["grounded"] == 1.0 and max(last[f"m{i}"] for i in range(4)) < 0.01, last
+    assert abs(last["roll"]) < 0.01 and abs(last["pitch"]) < 0.01, last
+    assert abs(last["down"] - first["down"]) < 0.002, (first, last)
+    north, east, _ = frame.from_flyloop((last["north"], last["east"], last["down"]))
+    assert math.hypot(north - away_target[0], east - away_target[1]) < 1.0, last
 
     # The README's plot script draws this track.
     png = flyloop.track.with_suffix(".png")
@@ -66,8 +82,10 @@ def test_px4_takes_off_holds_flies_10_m_and_lands_on_flyloop(pair):
 
 def test_flyloop_survives_a_killed_px4_and_flies_the_next_one(pair):
     flyloop = pair.flyloop()
-    first = launch(pair.px4())
-    first.wait_for("climbing past 1.5 m", lambda m: m.z < -1.5, 60, "LOCAL_POSITION_NED")
+    first = pair.px4()
+    _, target = launch(first)
+    climbed = target[2] + ALT - 2.0  # 2 m above PX4's home
+    first.wait_for("climbing past 2 m", lambda m: m.z < climbed, 60, "LOCAL_POSITION_NED")
     first.kill()  # mid-flight
     deadline = time.monotonic() + 10
     while "PX4 disconnected" not in flyloop.stderr() and time.monotonic() < deadline:
@@ -75,13 +93,19 @@ def test_flyloop_survives_a_killed_px4_and_flies_the_next_one(pair):
     assert "PX4 disconnected" in flyloop.stderr()
     assert flyloop.proc.poll() is None, "flyloop-sitl died with PX4"
 
-    second = launch(pair.px4())
-    settle(second, (0.0, 0.0, -ALT), 0.5, 60)
+    second = pair.px4()
+    frame, target = launch(second)
+    settle(second, target, 0.5, 60)
+    hold = collect(second, 1.0)
     second.kill()
     flyloop.stop()
     rows = flyloop.rows()
-    # The second flight started from the start state, on the ground at home.
-    restart = next(r for r in rows if r["connection"] == 2)
-    assert restart["down"] == 0.0 and restart["north"] == 0.0 and restart["grounded"] == 1.0
-    assert min(r["down"] for r in rows if r["connection"] == 1) < -1.5
-    assert min(r["down"] for r in rows if r["connection"] == 2) < -ALT + 0.5
+    # The second flight started from the start state of the first: on its feet at home.
+    starts = [next(r for r in rows if r["connection"] == c) for c in (1, 2)]
+    assert starts[0] == {**starts[1], "connection": 1.0}, starts
+    assert starts[1]["grounded"] == 1.0 and starts[1]["north"] == 0.0
+    # Killed in the air.
+    assert min(r["down"] for r in rows if r["connection"] == 1) < starts[0]["down"] - 1.5
+    # The second PX4 flew it to the takeoff height: truth where PX4 believes it is.
+    error = truth_vs_estimate(rows, hold, 2, frame)
+    assert error < 0.5, f"truth vs estimate {error:.3f} m"

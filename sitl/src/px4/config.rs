@@ -63,6 +63,12 @@ mod tests {
         let hover = c.quadrotor.hover_motor_state().unwrap();
         assert!((hover - 0.6066).abs() < 1e-3, "{hover}");
         assert_eq!(c.sensors, SensorParams::default());
+        // Feet under the rotors; standing, the centre of mass is 5.4 cm up.
+        let q = &c.quadrotor;
+        assert!((q.gear_x - q.arm_length / 2f64.sqrt()).abs() < 1e-3);
+        assert_eq!(q.gear_x, q.gear_y);
+        let rest = flyloop_core::quadrotor::contact::rest_height(q);
+        assert!((rest - 0.0538).abs() < 1e-4, "{rest}");
     }
 
     #[test]
