@@ -133,6 +133,16 @@ class Flyloop:
 
 
 @dataclass(frozen=True)
+class Estimate:
+    """PX4's position estimate at `time_ms` (PX4's clock = flyloop's simulation time):
+    north, east, down in some local frame (m) and its speed (m/s)."""
+
+    time_ms: int
+    position: tuple[float, float, float]
+    speed: float
+
+
+@dataclass(frozen=True)
 class LocalFrame:
     """PX4's local NED frame: its origin in degrees and metres above MSL. flyloop's truth is
     NED from flyloop's home (the centre of mass, m); the same point in PX4's frame is what
@@ -154,6 +164,15 @@ class LocalFrame:
             ned[0] + north * math.radians(HOME[0] - self.latitude),
             ned[1] + east * math.radians(HOME[1] - self.longitude),
             ned[2] + self.altitude - HOME[2],
+        )
+
+    def from_global(self, lat: float, lon: float, alt: float) -> tuple[float, float, float]:
+        """Latitude, longitude (deg), altitude MSL (m) → a point of this frame."""
+        north, east = self._scale()
+        return (
+            north * math.radians(lat - self.latitude),
+            east * math.radians(lon - self.longitude),
+            self.altitude - alt,
         )
 
     def to_global(self, ned: tuple[float, float, float]) -> tuple[float, float, float]:
@@ -292,6 +311,11 @@ class Px4:
                 pass
         raise AssertionError(f"PX4 did not send {what}:\n{self.output()[-3000:]}")
 
+    def estimate(self) -> Estimate:
+        """PX4's next LOCAL_POSITION_NED (its own local frame)."""
+        m = self.wait_for("a position estimate", lambda m: True, 30, "LOCAL_POSITION_NED")
+        return Estimate(m.time_boot_ms, (m.x, m.y, m.z), math.hypot(m.vx, m.vy, m.vz))
+
     def frame(self) -> LocalFrame:
         """PX4's local frame: its estimator set the origin from the GPS fixes it had when it
         started (noise included), so it is not flyloop's home, and it does not move after."""
@@ -348,30 +372,23 @@ class Hold:
         return h, v
 
 
-def collect(px4: Px4, seconds: float) -> Hold:
-    """PX4's LOCAL_POSITION_NED over `seconds` of PX4 time."""
-    samples: list[tuple[int, float, float, float]] = []
-    start = None
-    while True:
-        m = px4.wait_for("position estimates", lambda m: True, 30, "LOCAL_POSITION_NED")
-        start = m.time_boot_ms if start is None else start
-        samples.append((m.time_boot_ms, m.x, m.y, m.z))
-        if m.time_boot_ms - start >= seconds * 1000:
-            return Hold(samples)
+def collect(source, seconds: float) -> Hold:
+    """`source`'s estimates (its `estimate()`) over `seconds` of PX4 time."""
+    first = source.estimate()
+    samples = [first]
+    while samples[-1].time_ms - first.time_ms < seconds * 1000:
+        samples.append(source.estimate())
+    return Hold([(e.time_ms, *e.position) for e in samples])
 
 
-def settle(px4: Px4, target: tuple[float, float, float], tolerance: float, timeout: float) -> None:
-    """Waits until PX4's estimate is within `tolerance` of `target` and nearly still."""
-    last = []
-
-    def arrived(m) -> bool:
-        last[:] = [m]
-        return math.dist((m.x, m.y, m.z), target) < tolerance and math.hypot(m.vx, m.vy, m.vz) < 0.2
-
-    try:
-        px4.wait_for(f"arrival at {target}", arrived, timeout, "LOCAL_POSITION_NED")
-    except AssertionError as e:
-        raise AssertionError(f"last estimate {last[0] if last else None}: {e}") from None
+def settle(source, target: tuple[float, float, float], tolerance: float, timeout: float) -> None:
+    """Waits until `source`'s estimate is within `tolerance` of `target` and nearly still."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        e = source.estimate()
+        if math.dist(e.position, target) < tolerance and e.speed < 0.2:
+            return
+    raise AssertionError(f"no arrival at {target} within {timeout} s: last estimate {e}")
 
 
 def truth_vs_estimate(
@@ -394,6 +411,27 @@ def truth_vs_estimate(
         )
         worst = max(worst, math.dist(truth, (n, e, d)))
     return worst
+
+
+def check_mission(rows, holds, frame: LocalFrame) -> None:
+    """The checks of a flown mission, on flyloop's track `rows` (first connection) and PX4's
+    estimates `holds` (a Hold and its target in `frame`, each): PX4's estimate against the
+    targets (altitude < 0.3 m, position < 0.5 m), flyloop's truth against PX4's estimate at
+    the same instants (< 0.5 m), and at the end: at rest level on its feet (the centre of
+    mass at the start height), motors off, below the last target (< 1 m)."""
+    for hold, target in holds:
+        horizontal, vertical = hold.worst(target)
+        assert vertical < 0.3, f"altitude error {vertical:.3f} m at {target}"
+        assert horizontal < 0.5, f"position error {horizontal:.3f} m at {target}"
+        error = truth_vs_estimate(rows, hold, 1, frame)
+        assert error < 0.5, f"truth vs estimate {error:.3f} m at {target}"
+    first, last = rows[0], rows[-1]
+    assert last["grounded"] == 1.0 and max(last[f"m{i}"] for i in range(4)) < 0.01, last
+    assert abs(last["roll"]) < 0.01 and abs(last["pitch"]) < 0.01, last
+    assert abs(last["down"] - first["down"]) < 0.002, (first, last)
+    north, east, _ = frame.from_flyloop((last["north"], last["east"], last["down"]))
+    target = holds[-1][1]
+    assert math.hypot(north - target[0], east - target[1]) < 1.0, (target, last)
 
 
 def fresh_dir(prefix: str) -> Path:

@@ -7,13 +7,12 @@ station gives them; flyloop's truth is carried into that frame through the origi
 
 from __future__ import annotations
 
-import math
 import subprocess
 import sys
 import time
 from pathlib import Path
 
-from px4_support import TAKEOFF_ALT, collect, settle, truth_vs_estimate
+from px4_support import TAKEOFF_ALT, check_mission, collect, settle, truth_vs_estimate
 
 ALT = TAKEOFF_ALT
 
@@ -56,22 +55,7 @@ def test_px4_takes_off_holds_flies_10_m_and_lands_on_flyloop(pair):
     flyloop.stop()
     rows = flyloop.rows()
 
-    for hold, target in ((hover, hover_target), (away, away_target)):
-        # PX4's own estimate against the targets.
-        horizontal, vertical = hold.worst(target)
-        assert vertical < 0.3, f"altitude error {vertical:.3f} m at {target}"
-        assert horizontal < 0.5, f"position error {horizontal:.3f} m at {target}"
-        # flyloop's ground truth against PX4's estimate, at the same instants.
-        error = truth_vs_estimate(rows, hold, 1, frame)
-        assert error < 0.5, f"truth vs estimate {error:.3f} m at {target}"
-    # At rest, level, on its feet (the centre of mass at the start height), motors off,
-    # below the away point.
-    first, last = rows[0], rows[-1]
-    assert last["grounded"] == 1.0 and max(last[f"m{i}"] for i in range(4)) < 0.01, last
-    assert abs(last["roll"]) < 0.01 and abs(last["pitch"]) < 0.01, last
-    assert abs(last["down"] - first["down"]) < 0.002, (first, last)
-    north, east, _ = frame.from_flyloop((last["north"], last["east"], last["down"]))
-    assert math.hypot(north - away_target[0], east - away_target[1]) < 1.0, last
+    check_mission(rows, [(hover, hover_target), (away, away_target)], frame)
 
     # The README's plot script draws this track.
     png = flyloop.track.with_suffix(".png")

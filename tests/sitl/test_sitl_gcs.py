@@ -4,15 +4,10 @@ that detects the vehicle and shows its attitude."""
 from __future__ import annotations
 
 import math
-import os
-import queue
 import socket
-import subprocess
-import sys
-import threading
 import time
-from pathlib import Path
 
+from mavproxy_peer import MavProxy
 from sitl_client import decode_frame, mavlink2, of_type
 
 
@@ -106,58 +101,20 @@ def free_udp_port() -> int:
         return s.getsockname()[1]
 
 
-class Lines:
-    """A process's stdout lines, read by a thread so the test can wait for one with a timeout."""
-
-    def __init__(self, stream):
-        self.queue: queue.Queue[str] = queue.Queue()
-        self.seen: list[str] = []
-        threading.Thread(target=self._read, args=(stream,), daemon=True).start()
-
-    def _read(self, stream):
-        for line in stream:
-            self.queue.put(line)
-
-    def wait_for(self, text: str, timeout: float) -> str:
-        end = time.monotonic() + timeout
-        while (left := end - time.monotonic()) > 0:
-            try:
-                line = self.queue.get(timeout=left)
-            except queue.Empty:
-                break
-            self.seen.append(line)
-            if text in line:
-                return line
-        raise AssertionError(f"no {text!r} within {timeout} s in:\n{''.join(self.seen)}")
-
-
 def test_mavproxy_detects_the_vehicle_and_shows_its_attitude(start_sitl, client_for, tmp_path):
     port = free_udp_port()
-    mavproxy = Path(sys.executable).parent / "mavproxy.py"
-    proc = subprocess.Popen(
-        [sys.executable, str(mavproxy), f"--master=udpin:127.0.0.1:{port}", "--nowait"],
-        stdin=subprocess.PIPE,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-        cwd=tmp_path,  # its logs (mav.tlog, mav.parm) go there
-        env={**os.environ, "MAVLINK20": "1"},
-    )
-    lines = Lines(proc.stdout)
+    mavproxy = MavProxy(tmp_path, f"--master=udpin:127.0.0.1:{port}", "--nowait")
     try:
-        lines.wait_for("Connect udpin", timeout=30)
+        mavproxy.wait_for("Connect udpin", timeout=30)
         sitl = start_sitl("--seed", "6", gcs=f"127.0.0.1:{port}")
         frame = decode_frame(client_for(sitl).reset(6), 1)
-        lines.wait_for("Detected vehicle 1:1 on link 0", timeout=30)
-        lines.wait_for("online system 1", timeout=30)
+        mavproxy.wait_for("Detected vehicle 1:1 on link 0", timeout=30)
+        mavproxy.wait_for("online system 1", timeout=30)
         time.sleep(0.5)  # a few ATTITUDE messages at 10 Hz
-        proc.stdin.write("status ATTITUDE\n")
-        proc.stdin.flush()
-        line = lines.wait_for("ATTITUDE {", timeout=10)
+        mavproxy.type("status ATTITUDE")
+        line = mavproxy.wait_for("ATTITUDE {", timeout=10)
     finally:
-        # MAVProxy's own shutdown can take long; what we needed is already read.
-        proc.kill()
-        proc.wait()
+        mavproxy.kill()
     fields = dict(
         kv.split(" : ") for kv in line.split("ATTITUDE {", 1)[1].strip().rstrip("}").split(", ")
     )
