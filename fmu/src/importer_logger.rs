@@ -9,6 +9,8 @@
 use crate::fmi2_types::{
     fmi2CallbackFunctions, fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status, fmi2String,
 };
+use std::ffi::{CStr, c_char, c_void};
+use std::sync::Mutex;
 
 /// The logger's one call shape: environment, instance name, status, category, format
 /// ("%s") and the message.
@@ -55,4 +57,74 @@ pub unsafe extern "C" fn quiet(
     _format: fmi2String,
     _message: fmi2String,
 ) {
+}
+
+/// One message the FMU logged.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Entry {
+    pub instance: String,
+    pub status: fmi2Status,
+    pub category: String,
+    pub message: String,
+}
+
+/// A receiver's memory: everything the FMU logged to it (tests).
+#[derive(Debug, Default)]
+pub struct Recorder {
+    pub entries: Mutex<Vec<Entry>>,
+    /// Formats other than "%s" (must stay empty: the FMU never passes a raw message).
+    pub bad_formats: Mutex<Vec<String>>,
+}
+
+impl Recorder {
+    /// Callbacks whose logger records into this recorder, which must outlive every instance
+    /// they are given to.
+    pub fn callbacks(&self) -> fmi2CallbackFunctions {
+        callbacks(record, self as *const Recorder as *mut c_void)
+    }
+
+    /// The last message logged, if any.
+    pub fn last(&self) -> Option<Entry> {
+        self.entries.lock().ok()?.last().cloned()
+    }
+}
+
+fn text(p: *const c_char) -> String {
+    if p.is_null() {
+        "<NULL>".into()
+    } else {
+        // SAFETY: the FMU passes NUL-terminated strings valid for the call.
+        unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
+    }
+}
+
+/// The receiver behind [`Recorder::callbacks`].
+///
+/// # Safety
+///
+/// `env` must be a live [`Recorder`] and the strings NUL-terminated or NULL.
+pub unsafe extern "C" fn record(
+    env: fmi2ComponentEnvironment,
+    instance: fmi2String,
+    status: fmi2Status,
+    category: fmi2String,
+    format: fmi2String,
+    message: fmi2String,
+) {
+    // SAFETY: the caller's contract (env is a Recorder).
+    let recorder = unsafe { &*(env as *const Recorder) };
+    let format = text(format);
+    if format != "%s" {
+        if let Ok(mut bad) = recorder.bad_formats.lock() {
+            bad.push(format);
+        }
+    }
+    if let Ok(mut entries) = recorder.entries.lock() {
+        entries.push(Entry {
+            instance: text(instance),
+            status,
+            category: text(category),
+            message: text(message),
+        });
+    }
 }

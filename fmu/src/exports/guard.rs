@@ -144,34 +144,11 @@ mod tests {
     use crate::exports::{fmi2DoStep, fmi2FreeInstance, fmi2GetReal, fmi2Instantiate};
     use crate::fmi2_types::*;
     use crate::instance::masks;
-    use std::ffi::{CStr, c_char};
-    use std::sync::Mutex;
-
-    static LOG: Mutex<Vec<(fmi2Status, String, String)>> = Mutex::new(Vec::new());
-
-    fn text(p: *const c_char) -> String {
-        // SAFETY: the FMU passes NUL-terminated strings.
-        unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
-    }
-
-    /// Receiver of the FMU's one call shape (see [`crate::importer_logger`]).
-    unsafe extern "C" fn record(
-        _env: fmi2ComponentEnvironment,
-        _name: fmi2String,
-        status: fmi2Status,
-        category: fmi2String,
-        format: fmi2String,
-        message: fmi2String,
-    ) {
-        assert_eq!(text(format), "%s");
-        LOG.lock()
-            .unwrap()
-            .push((status, text(category), text(message)));
-    }
 
     #[test]
     fn a_panic_becomes_fatal_with_a_message_and_only_free_instance_remains() {
-        let callbacks = crate::importer_logger::callbacks(record, std::ptr::null_mut());
+        let recorder = crate::importer_logger::Recorder::default();
+        let callbacks = recorder.callbacks();
         let guid = crate::models::tables()[0].guid_c.clone();
         // SAFETY: valid strings and callbacks.
         let c = unsafe {
@@ -190,11 +167,12 @@ mod tests {
             panic!("100% broken");
         });
         assert_eq!(status, fmi2Status::fmi2Fatal);
-        let (status, category, message) = LOG.lock().unwrap().last().cloned().unwrap();
+        let last = recorder.last().unwrap();
         assert_eq!(
-            (status, category.as_str()),
+            (last.status, last.category.as_str()),
             (fmi2Status::fmi2Fatal, "logStatusFatal")
         );
+        let message = last.message;
         assert!(
             message.starts_with("fmi2Probe: internal error (panic: 100% broken)"),
             "{message}"
@@ -208,8 +186,9 @@ mod tests {
             );
             fmi2FreeInstance(c);
         }
-        let log = LOG.lock().unwrap();
-        assert!(log[log.len() - 1].2.contains("stage Fatal"), "{log:?}");
+        let last = recorder.last().unwrap();
+        assert!(last.message.contains("stage Fatal"), "{last:?}");
+        assert!(recorder.bad_formats.lock().unwrap().is_empty());
     }
 
     #[test]

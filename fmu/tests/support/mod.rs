@@ -6,8 +6,7 @@ use flyloop_fmu::exports::*;
 use flyloop_fmu::fmi2_types::*;
 use flyloop_fmu::importer_logger;
 use flyloop_fmu::models::tables;
-use std::ffi::{CStr, CString, c_char, c_void};
-use std::sync::Mutex;
+use std::ffi::CString;
 
 /// Which FMU.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -33,59 +32,11 @@ impl Model {
     }
 }
 
-/// One message the FMU logged.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Entry {
-    pub instance: String,
-    pub status: fmi2Status,
-    pub category: String,
-    pub message: String,
-}
-
-/// Everything the logger received.
-#[derive(Debug, Default)]
-pub struct Recorder {
-    pub entries: Mutex<Vec<Entry>>,
-    /// Formats other than "%s" (must stay empty: the FMU never passes a raw message).
-    pub bad_formats: Mutex<Vec<String>>,
-}
-
-fn text(p: *const c_char) -> String {
-    if p.is_null() {
-        "<NULL>".into()
-    } else {
-        // SAFETY: the FMU passes NUL-terminated strings valid for the call.
-        unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
-    }
-}
-
-/// The recording receiver of the FMU's one logger call shape
-/// (see `flyloop_fmu::importer_logger`).
-unsafe extern "C" fn record(
-    env: fmi2ComponentEnvironment,
-    instance: fmi2String,
-    status: fmi2Status,
-    category: fmi2String,
-    format: fmi2String,
-    message: fmi2String,
-) {
-    // SAFETY: env is the Recorder this test put into the callbacks.
-    let recorder = unsafe { &*(env as *const Recorder) };
-    let format = text(format);
-    if format != "%s" {
-        recorder.bad_formats.lock().unwrap().push(format);
-    }
-    recorder.entries.lock().unwrap().push(Entry {
-        instance: text(instance),
-        status,
-        category: text(category),
-        message: text(message),
-    });
-}
+pub use flyloop_fmu::importer_logger::{Entry, Recorder};
 
 /// The recording logger as the variadic callback type.
 pub fn recording_logger() -> fmi2CallbackLogger {
-    importer_logger::variadic(record)
+    importer_logger::variadic(importer_logger::record)
 }
 
 /// An instance with its recorder; freed on drop.
@@ -97,10 +48,7 @@ pub struct Fmu {
 }
 
 pub fn callbacks_for(recorder: &Recorder) -> Box<fmi2CallbackFunctions> {
-    Box::new(importer_logger::callbacks(
-        record,
-        recorder as *const Recorder as *mut c_void,
-    ))
+    Box::new(recorder.callbacks())
 }
 
 impl Fmu {
