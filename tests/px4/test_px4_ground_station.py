@@ -1,7 +1,8 @@
 """A ground station flies flyloop's quadrotor through PX4: a real MAVProxy on PX4's
-ground-station port is typed what an operator types (arm, takeoff, fly to a point, land), and
-PX4's reports, which MAVProxy forwards to the test, are checked against the targets and
-against flyloop's ground truth.
+ground-station port (`mavproxy.py --master=udpout:127.0.0.1:18570+instance`, as the README's
+"Fly it with PX4" starts it) is typed what an operator types (arm, takeoff, fly to a point,
+land), and PX4's reports, which MAVProxy forwards to the test, are checked against the targets
+and against flyloop's ground truth.
 
 Positions are compared in the NED frame around flyloop's home (the global positions PX4
 reports, converted), so no local origin enters."""
