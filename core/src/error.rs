@@ -4,6 +4,25 @@
 //! Every error type of the workspace derives `thiserror::Error`: the message sits next to
 //! the variant it describes.
 
+use crate::number::Compact;
+use std::fmt;
+
+/// What kind of variable a refused value was meant for, as the variable's causality says.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Role {
+    Parameter,
+    Input,
+}
+
+impl fmt::Display for Role {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Role::Parameter => "parameter",
+            Role::Input => "input",
+        })
+    }
+}
+
 /// Why a parameter set, a parameter file or a variable access was refused.
 ///
 /// Every variant names the parameter (or variable) it is about, so a user can fix the input
@@ -12,10 +31,15 @@
 pub enum ParamError {
     /// A value outside its inclusive range `[min, max]` (NaN is always out of range).
     #[error(
-        "parameter `{name}` = {value}{u} is out of range: it must be in [{min}, {max}]{u}",
+        "{role} `{name}` = {v}{u} is out of range: it must be in [{lo}, {hi}]{u}",
+        v = Compact(*.value),
+        lo = Compact(*.min),
+        hi = Compact(*.max),
         u = spaced(unit)
     )]
     OutOfRange {
+        /// Whether the variable is a parameter or an input (for the message).
+        role: Role,
         name: &'static str,
         value: f64,
         min: f64,
@@ -23,7 +47,7 @@ pub enum ParamError {
         unit: &'static str,
     },
     /// An integer or boolean parameter given a value that is not one.
-    #[error("parameter `{name}` = {value} is not {expected}")]
+    #[error("parameter `{name}` = {v} is not {expected}", v = Compact(*.value))]
     WrongKind {
         name: &'static str,
         value: f64,
@@ -49,12 +73,11 @@ pub enum ParamError {
     Parse(String),
 }
 
-/// " unit", or nothing for a dimensionless parameter without a unit.
+/// " unit", or nothing for a dimensionless variable: "1" says nothing after a number.
 fn spaced(unit: &str) -> String {
-    if unit.is_empty() {
-        String::new()
-    } else {
-        format!(" {unit}")
+    match unit {
+        "" | "1" => String::new(),
+        unit => format!(" {unit}"),
     }
 }
 
@@ -101,6 +124,7 @@ mod tests {
     #[test]
     fn messages_name_the_parameter_its_value_and_bound() {
         let e = ParamError::OutOfRange {
+            role: Role::Parameter,
             name: "mass",
             value: -1.0,
             min: 0.05,
@@ -112,15 +136,16 @@ mod tests {
             "parameter `mass` = -1 kg is out of range: it must be in [0.05, 100] kg"
         );
         let e = ParamError::OutOfRange {
+            role: Role::Input,
             name: "gain",
-            value: 3.0,
+            value: 1e300,
             min: 0.0,
             max: 1.0,
-            unit: "",
+            unit: "1",
         };
         assert_eq!(
             e.to_string(),
-            "parameter `gain` = 3 is out of range: it must be in [0, 1]"
+            "input `gain` = 1e300 is out of range: it must be in [0, 1]"
         );
     }
 

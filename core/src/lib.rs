@@ -23,6 +23,7 @@
 
 pub mod error;
 pub mod lander2d;
+pub mod number;
 pub mod params;
 pub mod quadrotor;
 pub mod reference;
@@ -32,7 +33,7 @@ pub mod snapshot;
 pub mod tasks;
 pub mod variables;
 
-pub use error::{InputError, ParamError};
+pub use error::{InputError, ParamError, Role};
 pub use params::{ParamSpec, Parameters, ValueKind};
 pub use rng::SimRng;
 pub use snapshot::SnapshotError;

@@ -2,7 +2,7 @@
 //! description. Validation, name-based get/set (the SITL's parameter protocol), the FMU's
 //! modelDescription and the README's parameter tables all read the same rows.
 
-use crate::error::ParamError;
+use crate::error::{ParamError, Role};
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
@@ -44,6 +44,7 @@ impl<P> ParamSpec<P> {
     pub fn check(&self, value: f64) -> Result<(), ParamError> {
         if !(value >= self.min && value <= self.max) {
             return Err(ParamError::OutOfRange {
+                role: Role::Parameter,
                 name: self.name,
                 value,
                 min: self.min,

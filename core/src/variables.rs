@@ -3,7 +3,7 @@
 //! modelDescription.xml from it and dispatches get/set through it; the SITL serves it over
 //! the MAVLink parameter protocol.
 
-use crate::error::{InputError, ParamError};
+use crate::error::{InputError, ParamError, Role};
 use crate::params::{ParamSpec, Parameters, ValueKind};
 
 /// FMI 2.0 causality.
@@ -263,6 +263,7 @@ pub fn set<M: VariableTable>(
     match row::<M>(vr)? {
         Row::Input(r) => {
             let out_of_range = ParamError::OutOfRange {
+                role: Role::Input,
                 name: r.name,
                 value,
                 min: r.min,

@@ -3,6 +3,7 @@
 
 use crate::fmi2_types::fmi2Status;
 use crate::instance::Stage;
+use flyloop_core::number::Compact;
 use flyloop_core::{ParamError, SnapshotError};
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -54,9 +55,12 @@ pub enum FmuError {
     UnknownState,
     /// `fmi2DoStep`'s currentCommunicationPoint is not the instance's time.
     #[error(
-        "currentCommunicationPoint {given} does not match the instance's time \
-         {expected} (tolerance {tolerance:e}); steps must follow each other, \
-         or restore an FMU state first"
+        "currentCommunicationPoint {g} does not match the instance's time \
+         {e} (tolerance {t}); steps must follow each other, \
+         or restore an FMU state first",
+        g = Compact(*.given),
+        e = Compact(*.expected),
+        t = Compact(*.tolerance)
     )]
     CommunicationPoint {
         given: f64,
@@ -64,24 +68,32 @@ pub enum FmuError {
         tolerance: f64,
     },
     /// `fmi2DoStep`'s communicationStepSize is not a positive finite number.
-    #[error("communicationStepSize must be a positive finite number, got {0}")]
+    #[error(
+        "communicationStepSize must be a positive finite number, got {}",
+        Compact(*.0)
+    )]
     StepSize(f64),
     /// The step would end after the stop time given in fmi2SetupExperiment.
     #[error(
-        "the step would end at {end}, after the stop time {stop} set in \
-         fmi2SetupExperiment"
+        "the step would end at {e}, after the stop time {s} set in \
+         fmi2SetupExperiment",
+        e = Compact(*.end),
+        s = Compact(*.stop)
     )]
     PastStopTime { end: f64, stop: f64 },
     /// The step would take more internal steps than a call should run.
     #[error(
-        "the step would take {steps} internal steps (limit {limit}); \
-         use smaller communication steps"
+        "the step would take {s} internal steps (limit {l}); \
+         use smaller communication steps",
+        s = Compact(*.steps),
+        l = Compact(*.limit)
     )]
     TooManySteps { steps: f64, limit: f64 },
     /// The dynamics produced a non-finite state; the instance stops in the Error stage.
     #[error(
-        "the model state became non-finite at t = {time}; the instance is in the \
-         Error stage (fmi2Reset or fmi2SetFMUstate to go on)"
+        "the model state became non-finite at t = {t}; the instance is in the \
+         Error stage (fmi2Reset or fmi2SetFMUstate to go on)",
+        t = Compact(*.time)
     )]
     Diverged { time: f64 },
     /// A capability this FMU does not declare (Model Exchange, input interpolation, ...).

@@ -7,6 +7,7 @@ use crate::error::FmuError;
 use crate::model::{FmuModel, ModelTable, StepRequest, settable_after_initialisation, type_name};
 use crate::state_record;
 use flyloop_core::SnapshotError;
+use flyloop_core::number::Compact;
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::Causality;
 use serde::{Deserialize, Serialize};
@@ -232,13 +233,16 @@ impl<M: FmuModel> Simulation for Engine<M> {
     fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> Result<(), FmuError> {
         if !start.is_finite() {
             return Err(FmuError::InvalidArgument(format!(
-                "startTime must be finite, got {start}"
+                "startTime must be finite, got {}",
+                Compact(start)
             )));
         }
         if let Some(stop) = stop {
             if stop.is_nan() || stop < start {
                 return Err(FmuError::InvalidArgument(format!(
-                    "stopTime {stop} must not be before startTime {start}"
+                    "stopTime {} must not be before startTime {}",
+                    Compact(stop),
+                    Compact(start)
                 )));
             }
         }

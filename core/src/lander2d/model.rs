@@ -38,6 +38,13 @@ pub struct Lander2d {
     contact: ContactState,
     /// Control periods since the start.
     steps: u64,
+    /// Physics substeps done in the current control period, in [0, physics_substeps).
+    substep: u32,
+    /// Time into the current physics substep, s: 0 on the substep grid, more after a
+    /// shortened physics step that stopped at a communication point inside a substep.
+    partial: f64,
+    /// Drone velocity at the start of the current control period, m/s (for `acceleration`).
+    period_start_velocity: [f64; 2],
 }
 
 impl std::fmt::Debug for Lander2d {
@@ -114,6 +121,9 @@ impl Lander2d {
             acceleration: [0.0; 2],
             contact: ContactState::default(),
             steps: 0,
+            substep: 0,
+            partial: 0.0,
+            period_start_velocity: [0.0; 2],
         }
     }
 
@@ -137,9 +147,51 @@ impl Lander2d {
         Ok(())
     }
 
-    /// Advances by one control period (`params.dt`): draws the period's thrust noise, drains
-    /// the battery, then runs `physics_substeps` physics steps, classifying contacts after each.
+    /// Advances to the end of the current control period (`params.dt`; a whole period from a
+    /// period boundary): the period's thrust noise and battery drain at its start, then
+    /// `physics_substeps` physics steps, classifying contacts after each.
     pub fn step(&mut self) {
+        let end = (self.steps + 1) as f64 * self.params.dt;
+        self.advance_to(end);
+    }
+
+    /// Advances to `time` seconds since the start, so that the state is the state at `time`:
+    /// whole physics substeps on the grid `k · dt / physics_substeps`, and a shortened
+    /// physics step for the last piece when `time` falls inside a substep (the rest of that
+    /// substep follows on the next call). Thrust noise and battery drain stay on the control
+    /// period grid. A `time` at or before now does nothing.
+    pub fn advance_to(&mut self, time: f64) {
+        let n = self.params.physics_substeps;
+        let substep = self.params.dt / f64::from(n);
+        let slack = GRID_SLACK * substep;
+        loop {
+            let remaining = time - self.time();
+            if remaining.is_nan() || remaining <= slack {
+                return;
+            }
+            if self.substep == 0 && self.partial == 0.0 {
+                self.begin_period();
+            }
+            let rest = substep - self.partial;
+            if remaining >= rest - slack {
+                // On the grid from a grid point: the world's own step, the same bits as a
+                // run that never stopped in between.
+                let length = (self.partial != 0.0).then_some(rest);
+                self.physics_step(length);
+                self.partial = 0.0;
+                self.substep += 1;
+                if self.substep == n {
+                    self.end_period();
+                }
+            } else {
+                self.physics_step(Some(remaining));
+                self.partial += remaining;
+            }
+        }
+    }
+
+    /// The start of a control period: the period's thrust (with noise) and battery drain.
+    fn begin_period(&mut self) {
         self.thrust = self.draw_thrust();
         if self.battery > 0.0 {
             let drain = (self.thrust[0] + self.thrust[1])
@@ -148,28 +200,46 @@ impl Lander2d {
             self.battery = (self.battery - drain).max(0.0);
         }
         let v0 = self.drone_body().linvel();
+        self.period_start_velocity = [v0.x, v0.y];
         self.contact.begin_period();
-        for _ in 0..self.params.physics_substeps {
-            self.apply_forces();
-            let before = self.drone();
-            let platform_vx = self.platform_vx();
-            self.world.step();
-            self.steer_platform();
-            let on_platform = self
-                .handles
-                .drone_touches(&self.world, self.handles.platform_collider);
-            let on_ground = self
-                .handles
-                .drone_touches(&self.world, self.handles.ground_collider);
-            self.contact
-                .update(&self.params, &before, platform_vx, on_platform, on_ground);
+    }
+
+    /// One physics step of the world's substep length, or of `length` seconds (a piece of a
+    /// substep), with the contacts classified after it.
+    fn physics_step(&mut self, length: Option<f64>) {
+        self.apply_forces();
+        let before = self.drone();
+        let platform_vx = self.platform_vx();
+        match length {
+            None => self.world.step(),
+            Some(length) => {
+                let nominal = self.world.integration_parameters.dt;
+                self.world.integration_parameters.dt = length;
+                self.world.step();
+                self.world.integration_parameters.dt = nominal;
+            }
         }
+        self.steer_platform();
+        let on_platform = self
+            .handles
+            .drone_touches(&self.world, self.handles.platform_collider);
+        let on_ground = self
+            .handles
+            .drone_touches(&self.world, self.handles.ground_collider);
+        self.contact
+            .update(&self.params, &before, platform_vx, on_platform, on_ground);
+    }
+
+    /// The end of a control period: its mean acceleration; the period count moves on.
+    fn end_period(&mut self) {
         let v1 = self.drone_body().linvel();
+        let v0 = self.period_start_velocity;
         self.acceleration = [
-            (v1.x - v0.x) / self.params.dt,
-            (v1.y - v0.y) / self.params.dt,
+            (v1.x - v0[0]) / self.params.dt,
+            (v1.y - v0[1]) / self.params.dt,
         ];
         self.steps += 1;
+        self.substep = 0;
     }
 
     /// Thrust of each motor for the coming period: commanded level plus Gaussian noise,
@@ -301,9 +371,20 @@ impl Lander2d {
         self.steps
     }
 
-    /// Simulated time since the start, s (n · dt, never accumulated).
+    /// Simulated time since the start, s: whole periods n · dt (never accumulated), plus
+    /// the substeps and the piece of a substep done in the current period.
     pub fn time(&self) -> f64 {
-        self.steps as f64 * self.params.dt
+        let periods = self.steps as f64 * self.params.dt;
+        if self.substep == 0 && self.partial == 0.0 {
+            return periods;
+        }
+        let substep = self.params.dt / f64::from(self.params.physics_substeps);
+        periods + f64::from(self.substep) * substep + self.partial
+    }
+
+    /// Whether the instance stands on a control period boundary.
+    pub fn at_period_boundary(&self) -> bool {
+        self.substep == 0 && self.partial == 0.0
     }
 
     /// The parameters in force.
@@ -328,7 +409,7 @@ impl Lander2d {
         params.set(name, value)?;
         let drone = self.drone();
         check_start(&drone)?;
-        let fresh = self.steps == 0;
+        let fresh = self.steps == 0 && self.at_period_boundary();
         let platform_x = if fresh {
             self.platform_direction = self.draws.platform_heading;
             self.battery = params.initial_battery;
@@ -380,7 +461,11 @@ impl EpisodeDraws {
 }
 
 /// Format tag of a Lander2d snapshot (name and version).
-const SNAPSHOT_TAG: &[u8; 8] = b"FLYL2D01";
+const SNAPSHOT_TAG: &[u8; 8] = b"FLYL2D02";
+
+/// How far a communication point may miss the physics substep grid and still count as on
+/// it, as a fraction of a substep: t0 + n·h and k · dt agree only up to rounding.
+const GRID_SLACK: f64 = 1e-6;
 
 impl Lander2d {
     /// The whole state as bytes: the rapier world (bodies, colliders, islands, broad and
@@ -420,10 +505,19 @@ impl Lander2d {
         .chain(lander.command)
         .chain(lander.external_wind_force)
         .chain(lander.wind_force)
-        .chain(lander.thrust);
+        .chain(lander.thrust)
+        .chain(lander.period_start_velocity);
         if numbers.into_iter().any(|v| !v.is_finite()) {
             return Err(SnapshotError::Invalid(
                 "a command, force or the battery is not finite".into(),
+            ));
+        }
+        let substep = lander.params.dt / f64::from(lander.params.physics_substeps);
+        if lander.substep >= lander.params.physics_substeps
+            || !(0.0..substep).contains(&lander.partial)
+        {
+            return Err(SnapshotError::Invalid(
+                "the position inside the control period is off its grid".into(),
             ));
         }
         Ok(())

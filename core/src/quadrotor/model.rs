@@ -5,7 +5,7 @@ use super::contact::foot_heights;
 use super::dynamics::{accelerations, integrate};
 use super::params::{QuadrotorInitial, QuadrotorParams};
 use super::state::{BodyState, WindState};
-use super::wind::{OuCache, apply_transition, reset_wind};
+use super::wind::{OuCache, apply_transition, next_segment, reset_wind};
 use crate::error::{InputError, ParamError, check_finite};
 use crate::params::Parameters;
 use crate::rng::SimRng;
@@ -94,14 +94,32 @@ impl Quadrotor {
         self.command
     }
 
-    /// Advances the vehicle by `dt` seconds: physics under the wind of the step's start, then
-    /// the turbulence moves on by `dt`.
+    /// Advances the vehicle by `dt` seconds. The turbulence lives on its own grid of
+    /// `turbulence_dt` seconds and holds between samples: the step is cut at each sample time
+    /// it crosses, each piece integrated under the wind of its start. So the same seed gives
+    /// the same wind for any `dt` (a step of exactly `turbulence_dt` is one piece).
     pub fn step(&mut self, dt: f64) {
-        let wind = self.wind_velocity();
-        integrate(&self.params, &mut self.body, &self.command, &wind, dt);
-        if self.params.wind_enabled {
-            let transition = self.ou_cache.get(&self.params, dt);
+        if !self.params.wind_enabled {
+            let wind = self.wind_velocity();
+            integrate(&self.params, &mut self.body, &self.command, &wind, dt);
+            return;
+        }
+        let mut remaining = dt;
+        loop {
+            let (segment, sample) = next_segment(&self.params, &self.wind, remaining);
+            let wind = self.wind_velocity();
+            integrate(&self.params, &mut self.body, &self.command, &wind, segment);
+            remaining -= segment;
+            if !sample {
+                self.wind.since_sample += segment;
+                return;
+            }
+            let transition = self.ou_cache.get(&self.params, self.params.turbulence_dt);
             apply_transition(&transition, &mut self.wind, &mut self.rng);
+            self.wind.since_sample = 0.0;
+            if remaining <= 0.0 {
+                return;
+            }
         }
     }
 
@@ -166,15 +184,18 @@ impl Quadrotor {
             && b.attitude.coords.iter().all(|v| v.is_finite())
             && b.attitude.norm() > 0.0
             && b.motors.iter().chain(&quad.command).all(|v| v.is_finite())
-            && b.gear_stretch.iter().flatten().all(|v| v.is_finite());
+            && b.gear_stretch.iter().flatten().all(|v| v.is_finite())
+            && (0.0..quad.params.turbulence_dt).contains(&quad.wind.since_sample);
         if !finite {
             return Err(SnapshotError::Invalid(
-                "state holds a non-finite value or a zero quaternion".into(),
+                "state holds a non-finite value, a zero quaternion or a wind sample time off its grid"
+                    .into(),
             ));
         }
         Ok(quad)
     }
 }
 
-/// Format tag of a Quadrotor snapshot (name and version; 02 added the gear's bristles).
-const SNAPSHOT_TAG: &[u8; 8] = b"FLYQUA02";
+/// Format tag of a Quadrotor snapshot (name and version; 02 added the gear's bristles, 03 the
+/// time since the last turbulence sample).
+const SNAPSHOT_TAG: &[u8; 8] = b"FLYQUA03";

@@ -1,6 +1,7 @@
 //! Physical parameters of the quadrotor and its initial conditions.
 
 use crate::error::ParamError;
+use crate::number::Compact;
 use crate::param;
 use crate::params::{ParamSpec, Parameters};
 use serde::{Deserialize, Serialize};
@@ -77,6 +78,10 @@ pub struct QuadrotorParams {
     pub turbulence_sigma: f64,
     /// Vertical turbulence σ as a fraction of the horizontal one. Default 0.2.
     pub turbulence_vertical_ratio: f64,
+    /// Time between turbulence samples, s: the wind's own grid, held between samples, so the
+    /// weather does not depend on the step size a caller (an FMU master, a task) chooses.
+    /// Default 0.01.
+    pub turbulence_dt: f64,
 }
 
 impl Default for QuadrotorParams {
@@ -111,11 +116,12 @@ impl Default for QuadrotorParams {
             turbulence_theta: 0.5,
             turbulence_sigma: 1.0,
             turbulence_vertical_ratio: 0.2,
+            turbulence_dt: 0.01,
         }
     }
 }
 
-static QUADROTOR_SPECS: [ParamSpec<QuadrotorParams>; 29] = [
+static QUADROTOR_SPECS: [ParamSpec<QuadrotorParams>; 30] = [
     param!(real mass, "kg", 1e-3, 1e4, "Vehicle mass"),
     param!(real arm_length, "m", 1e-3, 100.0, "Distance from the centre to each rotor"),
     param!(real inertia_xx, "kg.m2", 1e-7, 1e4, "Moment of inertia about body x (forward)"),
@@ -145,6 +151,7 @@ static QUADROTOR_SPECS: [ParamSpec<QuadrotorParams>; 29] = [
     param!(real gear_damping, "N.s/m", 1e-3, 1e9, "Normal and tangential damping of each foot"),
     param!(real gear_friction, "1", 0.0, 10.0, "Coulomb friction coefficient foot-ground"),
     param!(real contact_substep, "s", 1e-6, 1.0, "Largest RK4 substep while a foot may touch the ground"),
+    param!(real turbulence_dt, "s", 1e-4, 10.0, "Time between turbulence samples (the wind's own grid, independent of the step size)"),
 ];
 
 impl Parameters for QuadrotorParams {
@@ -158,7 +165,8 @@ impl Parameters for QuadrotorParams {
                 name: "wind_speed_min",
                 requirement: format!(
                     "wind_speed_min ({}) must not exceed wind_speed_max ({})",
-                    self.wind_speed_min, self.wind_speed_max
+                    Compact(self.wind_speed_min),
+                    Compact(self.wind_speed_max)
                 ),
             });
         }

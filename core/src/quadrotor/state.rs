@@ -56,8 +56,10 @@ impl BodyState {
 pub struct WindState {
     /// Mean wind for the episode (world ENU), m/s.
     pub mean: Vector3<f64>,
-    /// Turbulence (world ENU), m/s.
+    /// Turbulence (world ENU), m/s, held since the last sample.
     pub turbulence: Vector3<f64>,
+    /// Time since the last turbulence sample, s, in [0, turbulence_dt).
+    pub since_sample: f64,
 }
 
 impl WindState {

@@ -16,6 +16,38 @@ pub fn reset_wind(params: &QuadrotorParams, rng: &mut SimRng) -> WindState {
     WindState {
         mean: Vector3::new(speed * direction.cos(), speed * direction.sin(), 0.0),
         turbulence: Vector3::zeros(),
+        since_sample: 0.0,
+    }
+}
+
+/// How far a step end may miss a turbulence sample time and still count as on it, as a
+/// fraction of `turbulence_dt`: steps of h = 0.005 s add up to 0.01 s only up to rounding.
+const GRID_SLACK: f64 = 1e-9;
+
+/// The next piece of a step of `remaining` seconds on the turbulence grid: how long to
+/// integrate under the current wind, and whether the turbulence is sampled at its end.
+/// A step that ends on a sample time (within [`GRID_SLACK`]) is integrated whole, so a caller
+/// stepping at exactly `turbulence_dt` integrates the same intervals it asked for.
+pub fn next_segment(params: &QuadrotorParams, wind: &WindState, remaining: f64) -> (f64, bool) {
+    let grid = params.turbulence_dt;
+    let slack = GRID_SLACK * grid;
+    let to_sample = grid - wind.since_sample;
+    if remaining < to_sample - slack {
+        (remaining, false)
+    } else if remaining <= to_sample + slack {
+        (remaining, true)
+    } else {
+        (to_sample, true)
+    }
+}
+
+/// How many wind segments a step of `dt` seconds takes at most (one more than the samples in
+/// it), for callers that bound the work a step may cost.
+pub fn segment_count(params: &QuadrotorParams, dt: f64) -> f64 {
+    if params.wind_enabled {
+        (dt / params.turbulence_dt).ceil() + 1.0
+    } else {
+        1.0
     }
 }
 

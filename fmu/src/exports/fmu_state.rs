@@ -9,6 +9,7 @@ use super::guard::{c_slice, c_slice_mut, with_instance, write_out};
 use crate::error::FmuError;
 use crate::fmi2_types::*;
 use crate::instance::{SavedState, Stage, masks};
+use flyloop_core::number::Compact;
 
 /// Copies the current state. `*FMUstate` NULL gets a new state; a state of this instance is
 /// overwritten in place.
@@ -37,7 +38,7 @@ pub unsafe extern "C" fn fmi2GetFMUstate(
         }
         instance.event(&format!(
             "{function}: state saved at t = {}",
-            instance.sim.time()
+            Compact(instance.sim.time())
         ));
         Ok(fmi2Status::fmi2OK)
     })
@@ -63,7 +64,7 @@ pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstat
         instance.stage = stage_of(code)?;
         instance.event(&format!(
             "{function}: state restored, t = {}, stage {:?}",
-            instance.sim.time(),
+            Compact(instance.sim.time()),
             instance.stage
         ));
         Ok(fmi2Status::fmi2OK)

@@ -6,6 +6,7 @@ use crate::fmi2_types::*;
 use crate::instance::{Instance, Stage, masks};
 use crate::log::{self, Category, Logger};
 use crate::models;
+use flyloop_core::number::Compact;
 use std::ffi::{CStr, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
@@ -201,8 +202,9 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
             let stop = (stopTimeDefined != fmi2False).then_some(stopTime);
             instance.sim.setup_experiment(startTime, stop)?;
             instance.event(&format!(
-                "fmi2SetupExperiment: start {startTime}, stop {}",
-                stop.map_or("undefined".to_string(), |s| s.to_string())
+                "fmi2SetupExperiment: start {}, stop {}",
+                Compact(startTime),
+                stop.map_or("undefined".to_string(), |s| Compact(s).to_string())
             ));
             Ok(fmi2Status::fmi2OK)
         },
@@ -228,7 +230,7 @@ pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Sta
     let function = "fmi2ExitInitializationMode";
     with_instance(c, function, masks::EXIT_INITIALIZATION_MODE, |instance| {
         instance.stage = Stage::StepComplete;
-        instance.event(&format!("{function}: t = {}", instance.sim.time()));
+        instance.event(&format!("{function}: t = {}", Compact(instance.sim.time())));
         Ok(fmi2Status::fmi2OK)
     })
 }
@@ -239,7 +241,10 @@ pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Sta
 pub unsafe extern "C" fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
     with_instance(c, "fmi2Terminate", masks::TERMINATE, |instance| {
         instance.stage = Stage::Terminated;
-        instance.event(&format!("fmi2Terminate: t = {}", instance.sim.time()));
+        instance.event(&format!(
+            "fmi2Terminate: t = {}",
+            Compact(instance.sim.time())
+        ));
         Ok(fmi2Status::fmi2OK)
     })
 }

@@ -1,18 +1,13 @@
-//! The lander behind Lander2D.fmu. The core advances in fixed control periods of `dt`; a
-//! communication step to time t runs every whole period whose end lies at or before t on
-//! the grid `start_time + k·dt` (k counted by the core, never summed), so the outputs are
-//! exactly the core's state after those periods. A communication step shorter than `dt` may
-//! run no period at all; the outputs then stay as they are until the grid is reached.
+//! The lander behind Lander2D.fmu. A communication step to time t leaves the core in its
+//! state at t (`Lander2d::advance_to`): whole physics substeps on the grid
+//! `start_time + k·dt/physics_substeps`, and a shortened physics step when t falls inside a
+//! substep. Thrust noise and battery drain stay on the control period grid `k·dt`.
 
 use crate::model::{FmuModel, ModelInfo, ModelTable, StepRequest};
 use flyloop_core::lander2d::{Lander2d, Lander2dInitial};
 use flyloop_core::variables;
 use flyloop_core::{ParamError, SnapshotError};
 use std::sync::OnceLock;
-
-/// A period counts as reached when its end is within this fraction of a period of the
-/// communication point (absorbs the rounding of t0 + n·h against k·dt).
-const GRID_TOLERANCE: f64 = 1e-6;
 
 static INFO: ModelInfo = ModelInfo {
     identifier: "Lander2D",
@@ -26,13 +21,6 @@ static INFO: ModelInfo = ModelInfo {
         ("wind_force_y", &["wind_force_input_y"]),
     ],
 };
-
-/// Control periods from the start to `step.end_time` on the fixed grid of `lander`.
-fn periods_until(lander: &Lander2d, step: &StepRequest) -> u64 {
-    let periods = (step.end_time - step.start_time) / lander.params().dt + GRID_TOLERANCE;
-    // `as` saturates: negative → 0, huge → u64::MAX (refused by internal_steps first).
-    periods.floor() as u64
-}
 
 impl FmuModel for Lander2d {
     type Initial = Lander2dInitial;
@@ -61,15 +49,14 @@ impl FmuModel for Lander2d {
     }
 
     fn internal_steps(&self, step: &StepRequest) -> f64 {
-        let periods = periods_until(self, step).saturating_sub(self.steps());
-        periods as f64 * f64::from(self.params().physics_substeps)
+        // Physics steps to go: whole substeps plus at most two pieces of one.
+        let substep = self.params().dt / f64::from(self.params().physics_substeps);
+        let ahead = (step.end_time - step.start_time - self.time()) / substep;
+        ahead.max(0.0).ceil() + 2.0
     }
 
     fn advance(&mut self, step: &StepRequest) {
-        let target = periods_until(self, step);
-        while self.steps() < target {
-            self.step();
-        }
+        self.advance_to(step.end_time - step.start_time);
     }
 
     fn is_finite(&self) -> bool {

@@ -1,9 +1,10 @@
 //! The quadrotor behind Quadrotor.fmu: a communication step of h seconds is one
-//! `Quadrotor::step(h)`, which integrates in ceil(h / max_substep) equal RK4 substeps under
-//! the wind of the step's start.
+//! `Quadrotor::step(h)`, which cuts the step at the turbulence's own sample times
+//! (`turbulence_dt`) and integrates each piece in ceil(piece / max_substep) equal RK4
+//! substeps under the wind of the piece's start, so h does not change the weather.
 
 use crate::model::{FmuModel, ModelInfo, ModelTable, StepRequest};
-use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial};
+use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial, wind};
 use flyloop_core::variables;
 use flyloop_core::{ParamError, SnapshotError};
 use std::sync::OnceLock;
@@ -55,6 +56,7 @@ impl FmuModel for Quadrotor {
 
     fn internal_steps(&self, step: &StepRequest) -> f64 {
         (step.step_size / self.params.max_substep).ceil()
+            + wind::segment_count(&self.params, step.step_size)
     }
 
     fn advance(&mut self, step: &StepRequest) {
