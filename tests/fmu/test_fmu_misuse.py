@@ -46,8 +46,17 @@ def test_nan_input_is_refused_and_the_vehicle_flies_on(quad):
     quad.slave.setReal([vr], [0.5])
     with pytest.raises(FMICallException):
         quad.slave.setReal([vr], [float("nan")])
-    assert "`motor_command_0` = NaN" in quad.last_message()
+    # "input" as the causality says; no unit "1" after a plain number.
+    assert quad.last_message().endswith(
+        "input `motor_command_0` = NaN is out of range: it must be in [0, 1]"
+    ), quad.last_message()
     assert quad.slave.getReal([vr]) == [0.5]
+    # Huge numbers print compactly, not as 301 digits.
+    with pytest.raises(FMICallException):
+        quad.slave.setReal([quad.vrs["wind_input_x"]], [1e300])
+    assert quad.last_message().endswith(
+        "input `wind_input_x` = 1e300 m/s is out of range: it must be in [-100, 100] m/s"
+    ), quad.last_message()
     quad.slave.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.1)
     assert all(math.isfinite(v) for v in quad.outputs()), "no NaN got in"
 

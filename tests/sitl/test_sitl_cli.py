@@ -45,7 +45,7 @@ def test_a_bad_config_names_the_parameter_and_its_bound(sitl_binary, tmp_path):
     assert result.returncode != 0
     assert result.stderr.strip().splitlines() == [
         f"flyloop-sitl: error: config file {config}: parameter `thrust_coefficient` = -3 N "
-        "is out of range: it must be in [0, 1000000] N"
+        "is out of range: it must be in [0, 1e6] N"
     ]
     result = run(sitl_binary, "--config", str(tmp_path / "missing.toml"))
     assert result.returncode != 0 and "cannot read config file" in result.stderr
