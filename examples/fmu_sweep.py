@@ -132,7 +132,8 @@ def main(argv: list[str] | None = None) -> list[dict]:
     if args.address:
         ray.init(address=args.address)
     else:
-        ray.init(num_cpus=args.num_cpus, include_dashboard=False)
+        # address="local": a fresh local instance, even when another Ray runs on this machine.
+        ray.init(address="local", num_cpus=args.num_cpus, include_dashboard=False)
     try:
         results = sweep(args.fmu, args.masses, args.thrust)
     finally:
