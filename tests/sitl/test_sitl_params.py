@@ -23,7 +23,8 @@ def test_the_list_serves_every_model_and_task_parameter_with_unique_short_ids(
     client = client_for(start_sitl("--task", "waypoints"))
     values = param_list(client)
     ids = [v.param_id for v in values]
-    # 30 quadrotor parameters (22 + the 7 of the landing gear + turbulence_dt), 12 flight, 4 waypoints.
+    # 30 quadrotor parameters (22 + 7 of the landing gear + turbulence_dt), 12 flight,
+    # 4 waypoints.
     assert len(values) == values[0].param_count == 30 + 12 + 4
     assert [v.param_index for v in values] == list(range(len(values)))
     assert len(set(ids)) == len(ids) and all(len(i) <= 16 for i in ids)
