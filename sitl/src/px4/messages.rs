@@ -1,6 +1,7 @@
 //! The messages PX4 reads from its simulator, built from the core's sensor readings
 //! (units as PX4's simulator_mavlink reads them; see docs/protocol.md).
 
+use crate::kinematics::{round_i16, round_i32, round_u16};
 use flyloop_core::sensors::{GpsFix, SensorReading};
 use mavlink::dialects::common::{HIL_GPS_DATA, HIL_SENSOR_DATA, HilSensorUpdatedFlags, MavMessage};
 
@@ -46,44 +47,27 @@ pub fn hil_sensor(r: &SensorReading, time_usec: u64) -> MavMessage {
     })
 }
 
-/// Nearest integer in the range of `T` (NaN → 0), for MAVLink's integer units.
-fn saturate<T: TryFrom<i64> + Default>(x: f64, lo: i64, hi: i64) -> T {
-    T::try_from((x.round() as i64).clamp(lo, hi)).unwrap_or_default()
-}
-
 /// HIL_GPS for `fix`, stamped `time_usec` (µs since the UNIX epoch): lat/lon degE7, alt mm
 /// MSL, eph/epv cm, velocities cm/s NED, course cdeg (65535 = unknown), 3D fix.
 pub fn hil_gps(fix: &GpsFix, time_usec: u64) -> MavMessage {
     let p = fix.position;
     let v = fix.velocity_ned * 100.0;
-    let i16_range = (i64::from(i16::MIN), i64::from(i16::MAX));
-    let u16_max = i64::from(u16::MAX);
+    // 65535 means "unknown" for eph, epv, vel and cog: a known value stays below it.
+    let known_u16 = |x: f64| round_u16(x).min(u16::MAX - 1);
     MavMessage::HIL_GPS(HIL_GPS_DATA {
         time_usec,
-        lat: saturate(
-            p.latitude_deg * 1e7,
-            i64::from(i32::MIN),
-            i64::from(i32::MAX),
-        ),
-        lon: saturate(
-            p.longitude_deg * 1e7,
-            i64::from(i32::MIN),
-            i64::from(i32::MAX),
-        ),
-        alt: saturate(
-            p.altitude_m * 1000.0,
-            i64::from(i32::MIN),
-            i64::from(i32::MAX),
-        ),
-        eph: saturate(fix.eph * 100.0, 0, u16_max - 1),
-        epv: saturate(fix.epv * 100.0, 0, u16_max - 1),
-        vel: saturate(fix.ground_speed * 100.0, 0, u16_max - 1),
-        vn: saturate(v.x, i16_range.0, i16_range.1),
-        ve: saturate(v.y, i16_range.0, i16_range.1),
-        vd: saturate(v.z, i16_range.0, i16_range.1),
+        lat: round_i32(p.latitude_deg * 1e7),
+        lon: round_i32(p.longitude_deg * 1e7),
+        alt: round_i32(p.altitude_m * 1000.0),
+        eph: known_u16(fix.eph * 100.0),
+        epv: known_u16(fix.epv * 100.0),
+        vel: known_u16(fix.ground_speed * 100.0),
+        vn: round_i16(v.x),
+        ve: round_i16(v.y),
+        vd: round_i16(v.z),
         cog: fix
             .course_deg
-            .map_or(u16::MAX, |c| saturate(c * 100.0, 0, 35_999)),
+            .map_or(u16::MAX, |c| round_u16(c * 100.0).min(35_999)),
         fix_type: 3,
         satellites_visible: fix.satellites,
         id: 0,
