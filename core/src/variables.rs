@@ -307,3 +307,41 @@ pub(crate) fn assert_names_and_value_references_are_unique(vars: &[Variable]) {
         assert!(!v.description.is_empty(), "{} has no description", v.name);
     }
 }
+
+/// Test helper: the value reference of the variable `name` of `M`'s table.
+#[cfg(test)]
+pub(crate) fn value_reference<M: VariableTable>(name: &str) -> u32 {
+    variables::<M>()
+        .into_iter()
+        .find(|v| v.name == name)
+        .unwrap_or_else(|| panic!("no variable {name}"))
+        .value_reference
+}
+
+/// Test helper: `M`'s table is well formed (see
+/// [`assert_names_and_value_references_are_unique`]), every variable reads a finite value and
+/// (inputs only when `inputs_read_start`) its start value, and value references outside the
+/// table are refused.
+#[cfg(test)]
+pub(crate) fn assert_every_variable_reads<M: VariableTable>(
+    model: &M,
+    initial: &M::Initial,
+    inputs_read_start: bool,
+) {
+    let vars = variables::<M>();
+    assert_names_and_value_references_are_unique(&vars);
+    for v in &vars {
+        let value = get(model, initial, v.value_reference).unwrap();
+        assert!(value.is_finite(), "{} = {value}", v.name);
+        let checked = inputs_read_start || v.causality != Causality::Input;
+        if let (Some(start), true) = (v.start, checked) {
+            assert_eq!(value, start, "{} does not read its start value", v.name);
+        }
+    }
+    for vr in [99, 10_000] {
+        assert_eq!(
+            get(model, initial, vr),
+            Err(ParamError::UnknownValueReference(vr))
+        );
+    }
+}

@@ -188,8 +188,7 @@ mod tests {
     use super::*;
     use crate::quadrotor::BodyState;
     use crate::rng::SimRng;
-    use crate::variables::Causality;
-    use crate::variables::{get, set, variables};
+    use crate::variables::{get, set};
     use nalgebra::Vector3;
 
     fn quad() -> Quadrotor {
@@ -199,40 +198,15 @@ mod tests {
 
     #[test]
     fn names_and_value_references_are_unique_and_every_one_reads() {
-        let vars = variables::<Quadrotor>();
-        let q = quad();
-        let init = QuadrotorInitial::default();
-        crate::variables::assert_names_and_value_references_are_unique(&vars);
-        for v in &vars {
-            let value = get(&q, &init, v.value_reference).unwrap();
-            assert!(value.is_finite(), "{} = {value}", v.name);
-            if let Some(start) = v.start {
-                if v.causality != Causality::Input {
-                    assert_eq!(value, start, "{} does not read its start value", v.name);
-                }
-            }
-        }
-        assert_eq!(
-            get(&q, &init, 99),
-            Err(ParamError::UnknownValueReference(99))
-        );
-        assert_eq!(
-            get(&q, &init, 10_000),
-            Err(ParamError::UnknownValueReference(10_000))
-        );
+        // Inputs read what quad() commands, not their start values.
+        crate::variables::assert_every_variable_reads(&quad(), &QuadrotorInitial::default(), false);
     }
 
     #[test]
     fn outputs_read_the_state_and_cannot_be_set() {
         let mut q = quad();
         let mut init = QuadrotorInitial::default();
-        let vr = |name: &str| {
-            variables::<Quadrotor>()
-                .into_iter()
-                .find(|v| v.name == name)
-                .unwrap()
-                .value_reference
-        };
+        let vr = crate::variables::value_reference::<Quadrotor>;
         assert_eq!(get(&q, &init, vr("z")).unwrap(), 3.0);
         assert!((get(&q, &init, vr("yaw")).unwrap() - 0.5).abs() < 1e-12);
         assert_eq!(
@@ -245,13 +219,7 @@ mod tests {
     fn inputs_and_parameters_are_range_checked_and_refusals_change_nothing() {
         let mut q = quad();
         let mut init = QuadrotorInitial::default();
-        let vr = |name: &str| {
-            variables::<Quadrotor>()
-                .into_iter()
-                .find(|v| v.name == name)
-                .unwrap()
-                .value_reference
-        };
+        let vr = crate::variables::value_reference::<Quadrotor>;
         set(&mut q, &mut init, vr("motor_command_2"), 0.7).unwrap();
         assert_eq!(q.command()[2], 0.7);
         let err = set(&mut q, &mut init, vr("motor_command_2"), f64::NAN).unwrap_err();
