@@ -12,6 +12,8 @@ pub enum Causality {
     Parameter,
     Input,
     Output,
+    /// Visible but not part of the interface (Model Exchange's extra states, derivatives).
+    Local,
 }
 
 /// FMI 2.0 variability.

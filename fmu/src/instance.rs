@@ -1,6 +1,6 @@
-//! An FMU instance (what an `fmi2Component` points to) and the FMI 2.0 Co-Simulation state
-//! machine: the stage it is in and, per function, the stages it may be called in (the
-//! pattern of modelica/Reference-FMUs).
+//! An FMU instance (what an `fmi2Component` points to) and the FMI 2.0 state machine of
+//! Co-Simulation and Model Exchange: the stage it is in and, per function, the stages it may
+//! be called in (the masks of modelica/Reference-FMUs' fmi2Functions.c).
 
 use crate::error::FmuError;
 use crate::fmi2_types::fmi2Status;
@@ -8,8 +8,9 @@ use crate::log::{Category, LogFilter, Logger, category_of};
 use crate::simulation::Simulation;
 use std::collections::HashMap;
 
-/// The stages of a Co-Simulation instance. `Fatal` is entered after a caught panic: only
-/// fmi2FreeInstance is allowed then.
+/// The stages of an instance: EventMode and ContinuousTimeMode for Model Exchange, the Step*
+/// stages for Co-Simulation, the others for both. `Fatal` is entered after a caught panic:
+/// only fmi2FreeInstance is allowed then.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[repr(u16)]
 pub enum Stage {
@@ -22,10 +23,12 @@ pub enum Stage {
     Terminated = 1 << 7,
     Error = 1 << 8,
     Fatal = 1 << 9,
+    EventMode = 1 << 10,
+    ContinuousTimeMode = 1 << 11,
 }
 
 impl Stage {
-    const ALL: [Stage; 9] = [
+    const ALL: [Stage; 11] = [
         Stage::Instantiated,
         Stage::InitializationMode,
         Stage::StepComplete,
@@ -35,6 +38,8 @@ impl Stage {
         Stage::Terminated,
         Stage::Error,
         Stage::Fatal,
+        Stage::EventMode,
+        Stage::ContinuousTimeMode,
     ];
 
     /// A small code for FMU state bytes.
@@ -45,6 +50,26 @@ impl Stage {
     pub fn from_code(code: u8) -> Option<Stage> {
         Stage::ALL.into_iter().find(|s| s.code() == code)
     }
+
+    /// Whether an instance of `interface` can be in this stage.
+    pub fn belongs_to(self, interface: Interface) -> bool {
+        let model_exchange = matches!(self, Stage::EventMode | Stage::ContinuousTimeMode);
+        let co_simulation = matches!(
+            self,
+            Stage::StepComplete | Stage::StepInProgress | Stage::StepFailed | Stage::StepCanceled
+        );
+        match interface {
+            Interface::CoSimulation => !model_exchange,
+            Interface::ModelExchange => !co_simulation,
+        }
+    }
+}
+
+/// The interface an instance was created for (fmi2Instantiate's fmuType).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Interface {
+    CoSimulation,
+    ModelExchange,
 }
 
 /// The stages a function may be called in.
@@ -70,13 +95,15 @@ macro_rules! mask {
     };
 }
 
-/// Per-function masks, as in Reference-FMUs' fmi2Functions.c (Co-Simulation subset).
+/// Per-function masks, as in Reference-FMUs' fmi2Functions.c.
 pub mod masks {
     use super::{Mask, Stage};
 
     pub const SET_DEBUG_LOGGING: Mask = mask!(
         Instantiated
             | InitializationMode
+            | EventMode
+            | ContinuousTimeMode
             | StepComplete
             | StepInProgress
             | StepFailed
@@ -87,6 +114,8 @@ pub mod masks {
     pub const FREE_INSTANCE: Mask = mask!(
         Instantiated
             | InitializationMode
+            | EventMode
+            | ContinuousTimeMode
             | StepComplete
             | StepFailed
             | StepCanceled
@@ -97,20 +126,31 @@ pub mod masks {
     pub const SETUP_EXPERIMENT: Mask = mask!(Instantiated);
     pub const ENTER_INITIALIZATION_MODE: Mask = mask!(Instantiated);
     pub const EXIT_INITIALIZATION_MODE: Mask = mask!(InitializationMode);
-    pub const TERMINATE: Mask = mask!(StepComplete | StepFailed);
+    pub const TERMINATE: Mask = mask!(EventMode | ContinuousTimeMode | StepComplete | StepFailed);
     pub const RESET: Mask = mask!(
         Instantiated
             | InitializationMode
+            | EventMode
+            | ContinuousTimeMode
             | StepComplete
             | StepFailed
             | StepCanceled
             | Terminated
             | Error
     );
-    pub const GET_VALUE: Mask =
-        mask!(InitializationMode | StepComplete | StepFailed | StepCanceled | Terminated | Error);
-    pub const SET_REAL: Mask = mask!(Instantiated | InitializationMode | StepComplete);
-    pub const SET_OTHER: Mask = mask!(Instantiated | InitializationMode | StepComplete);
+    pub const GET_VALUE: Mask = mask!(
+        InitializationMode
+            | EventMode
+            | ContinuousTimeMode
+            | StepComplete
+            | StepFailed
+            | StepCanceled
+            | Terminated
+            | Error
+    );
+    pub const SET_REAL: Mask =
+        mask!(Instantiated | InitializationMode | EventMode | ContinuousTimeMode | StepComplete);
+    pub const SET_OTHER: Mask = mask!(Instantiated | InitializationMode | EventMode | StepComplete);
     pub const FMU_STATE: Mask = RESET;
     pub const DIRECTIONAL_DERIVATIVE: Mask = GET_VALUE;
     pub const SET_REAL_INPUT_DERIVATIVES: Mask =
@@ -120,11 +160,19 @@ pub mod masks {
     pub const DO_STEP: Mask = mask!(StepComplete);
     pub const CANCEL_STEP: Mask = mask!(StepInProgress);
     pub const GET_STATUS: Mask = mask!(StepComplete | StepInProgress | StepFailed | Terminated);
-    /// Model Exchange functions: never, this FMU is Co-Simulation only.
-    pub const MODEL_EXCHANGE: Mask = Mask {
-        bits: 0,
-        names: "a Model Exchange instance (this FMU is Co-Simulation only)",
-    };
+    // Model Exchange.
+    pub const ENTER_EVENT_MODE: Mask = mask!(EventMode | ContinuousTimeMode);
+    pub const NEW_DISCRETE_STATES: Mask = mask!(EventMode);
+    pub const ENTER_CONTINUOUS_TIME_MODE: Mask = mask!(EventMode);
+    pub const COMPLETED_INTEGRATOR_STEP: Mask = mask!(ContinuousTimeMode);
+    pub const SET_TIME: Mask = mask!(EventMode | ContinuousTimeMode);
+    pub const SET_CONTINUOUS_STATES: Mask = mask!(ContinuousTimeMode);
+    pub const GET_EVENT_INDICATORS: Mask =
+        mask!(InitializationMode | EventMode | ContinuousTimeMode | Terminated | Error);
+    pub const GET_CONTINUOUS_STATES: Mask = GET_EVENT_INDICATORS;
+    pub const GET_DERIVATIVES: Mask = mask!(EventMode | ContinuousTimeMode | Terminated | Error);
+    pub const GET_NOMINALS: Mask =
+        mask!(Instantiated | EventMode | ContinuousTimeMode | Terminated | Error);
 }
 
 /// A saved FMU state: the bytes of [`Simulation::save`]. Boxed; the box's address is the
@@ -136,6 +184,7 @@ pub struct SavedState {
 
 /// One FMU instance.
 pub struct Instance {
+    pub interface: Interface,
     pub logger: Logger,
     pub filter: LogFilter,
     pub stage: Stage,
@@ -157,8 +206,14 @@ impl std::fmt::Debug for Instance {
 }
 
 impl Instance {
-    pub fn new(logger: Logger, logging_on: bool, sim: Box<dyn Simulation>) -> Self {
+    pub fn new(
+        interface: Interface,
+        logger: Logger,
+        logging_on: bool,
+        sim: Box<dyn Simulation>,
+    ) -> Self {
         Instance {
+            interface,
             logger,
             filter: LogFilter::at_instantiation(logging_on),
             stage: Stage::Instantiated,
@@ -203,6 +258,33 @@ impl Instance {
                 allowed: mask.names,
             })
         }
+    }
+
+    /// Fails unless this is a Model Exchange instance (the Model Exchange masks share
+    /// InitializationMode and Terminated with Co-Simulation).
+    pub fn check_model_exchange(&self) -> Result<(), FmuError> {
+        match self.interface {
+            Interface::ModelExchange => Ok(()),
+            Interface::CoSimulation => Err(FmuError::NotSupported(
+                "Model Exchange functions on a Co-Simulation instance (instantiate with \
+                 fmuType fmi2ModelExchange)",
+            )),
+        }
+    }
+
+    /// The stage saved as `code` in an FMU state, if an instance of this interface can be
+    /// in it.
+    pub fn stage_from_code(&self, code: u8) -> Result<Stage, FmuError> {
+        let stage = Stage::from_code(code).ok_or_else(|| {
+            FmuError::InvalidArgument(format!("the FMU state holds an unknown stage code {code}"))
+        })?;
+        if !stage.belongs_to(self.interface) {
+            return Err(FmuError::InvalidArgument(format!(
+                "the FMU state was saved in stage {stage:?}, which a {:?} instance never is in",
+                self.interface
+            )));
+        }
+        Ok(stage)
     }
 
     /// Keeps `state` and returns its address for the importer.
@@ -258,6 +340,13 @@ mod tests {
         assert!(!masks::DO_STEP.allows(Stage::Instantiated));
         assert!(masks::FREE_INSTANCE.allows(Stage::Fatal));
         assert!(!masks::RESET.allows(Stage::Fatal));
-        assert_eq!(masks::TERMINATE.names, "StepComplete, StepFailed");
+        assert_eq!(
+            masks::TERMINATE.names,
+            "EventMode, ContinuousTimeMode, StepComplete, StepFailed"
+        );
+        assert!(Stage::EventMode.belongs_to(Interface::ModelExchange));
+        assert!(!Stage::EventMode.belongs_to(Interface::CoSimulation));
+        assert!(!Stage::StepComplete.belongs_to(Interface::ModelExchange));
+        assert!(Stage::Terminated.belongs_to(Interface::ModelExchange));
     }
 }

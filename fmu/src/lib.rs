@@ -1,5 +1,5 @@
-//! FMI 2.0 Co-Simulation front end of flyloop-core: `Quadrotor.fmu` and `Lander2D.fmu` from
-//! one cdylib.
+//! FMI 2.0 front end of flyloop-core: `Quadrotor.fmu` (Co-Simulation and Model Exchange) and
+//! `Lander2D.fmu` (Co-Simulation) from one cdylib.
 //!
 //! Layers, from the C boundary down:
 //! - [`exports`]: every `fmi2*` function, each inside `catch_unwind` (a panic becomes
@@ -8,12 +8,14 @@
 //!   in modelica/Reference-FMUs), logging by category, the FMU states handed out.
 //! - [`simulation`]: start values, experiment, the time grid t0 + n·h, typed variable access,
 //!   doStep checks, FMU state bytes — for any [`model::FmuModel`].
+//! - [`exchange`]: Model Exchange on top of the engine (time, states, events).
 //! - [`models`]: the quadrotor and the lander behind `FmuModel`; the GUID picks one.
 //!
 //! [`model_description`] writes each modelDescription.xml from the core's variable tables;
 //! [`pack`] zips the FMUs (binary `flyloop-fmu-pack`).
 
 pub mod error;
+pub mod exchange;
 pub mod exports;
 pub mod fmi2_types;
 pub mod guid;

@@ -2,6 +2,7 @@
 //! implemented for the quadrotor and the lander in [`crate::models`], and the [`ModelTable`]
 //! each model derives from its core variable table (lookup by value reference, GUID).
 
+use crate::error::FmuError;
 use crate::guid;
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::{Causality, Variability, Variable};
@@ -34,6 +35,18 @@ pub struct ModelInfo {
     /// Inputs (by name) each output depends on directly, without a step in between
     /// (ModelStructure/Outputs/Unknown/@dependencies). Outputs not listed depend on none.
     pub direct_feedthrough: &'static [(&'static str, &'static [&'static str])],
+    /// Outputs that do not depend on the continuous states (Model Exchange dependencies).
+    pub state_free_outputs: &'static [&'static str],
+}
+
+/// What a Model-Exchange capable model adds to its table: its continuous states and their
+/// derivatives as variables (value references in state-vector order) and its number of event
+/// indicators.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ModelExchangeTable {
+    pub states: Vec<u32>,
+    pub derivatives: Vec<u32>,
+    pub event_indicators: usize,
 }
 
 /// A model behind the FMU: built from start values, read and written by value reference,
@@ -69,6 +82,32 @@ pub trait FmuModel: Sized + 'static {
 
     /// A model from [`FmuModel::save`] bytes; foreign or damaged bytes are an error.
     fn restore(bytes: &[u8]) -> Result<Self, SnapshotError>;
+
+    /// The model as a hybrid system for Model Exchange, or `None` (the default) for a model
+    /// that is Co-Simulation only.
+    fn hybrid(&self) -> Option<&dyn Hybrid> {
+        None
+    }
+
+    /// [`FmuModel::hybrid`], mutable.
+    fn hybrid_mut(&mut self) -> Option<&mut dyn Hybrid> {
+        None
+    }
+}
+
+/// A model as Model Exchange sees it: a state vector the importer's solver integrates, its
+/// derivative, event indicators and the discrete changes at events. Slices have the lengths
+/// of the model's [`ModelExchangeTable`] (the engine checks the importer's lengths).
+pub trait Hybrid {
+    fn states(&self, x: &mut [f64]);
+    /// Sets the states; a non-finite value is refused and nothing changes.
+    fn set_states(&mut self, x: &[f64]) -> Result<(), FmuError>;
+    fn derivatives(&self, dx: &mut [f64]);
+    fn event_indicators(&self, z: &mut [f64]);
+    /// Seconds from the last event to the next time event, if there is one.
+    fn time_event_after(&self) -> Option<f64>;
+    /// The discrete changes of an event `elapsed` seconds after the previous one.
+    fn event_update(&mut self, elapsed: f64);
 }
 
 /// The variable table of a model with what the FMI layer looks up on every call.
@@ -81,11 +120,23 @@ pub struct ModelTable {
     pub guid_c: CString,
     /// Value reference → position in `variables`, sorted for binary search.
     by_vr: Vec<(u32, usize)>,
+    /// States and derivatives, for a model that offers Model Exchange.
+    pub model_exchange: Option<ModelExchangeTable>,
 }
 
 impl ModelTable {
     /// The table of `info` over the core's `variables`.
     pub fn new(info: &'static ModelInfo, variables: Vec<Variable>) -> Self {
+        Self::with_model_exchange(info, variables, None)
+    }
+
+    /// The table of a model that may offer Model Exchange (`variables` include the states and
+    /// derivatives `model_exchange` names).
+    pub fn with_model_exchange(
+        info: &'static ModelInfo,
+        variables: Vec<Variable>,
+        model_exchange: Option<ModelExchangeTable>,
+    ) -> Self {
         let guid = guid::of_interface(info.identifier, &variables);
         let mut by_vr: Vec<(u32, usize)> = variables
             .iter()
@@ -101,6 +152,7 @@ impl ModelTable {
             guid,
             guid_c,
             by_vr,
+            model_exchange,
         }
     }
 

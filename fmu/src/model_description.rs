@@ -1,4 +1,5 @@
-//! Writes a model's modelDescription.xml (FMI 2.0 Co-Simulation) from its table: every
+//! Writes a model's modelDescription.xml (FMI 2.0 Co-Simulation, and Model Exchange for a
+//! model that offers it: states, derivatives, event indicators) from its table: every
 //! variable with unit, description, start and range; unit definitions for every unit used;
 //! log categories; the default experiment; the model structure. Deterministic output (no
 //! date), so the checked-in copies under modelDescription/ can be compared byte for byte.
@@ -60,6 +61,7 @@ fn causality(c: Causality) -> &'static str {
         Causality::Parameter => "parameter",
         Causality::Input => "input",
         Causality::Output => "output",
+        Causality::Local => "local",
     }
 }
 
@@ -110,7 +112,8 @@ fn unit_definitions(out: &mut String, variables: &[Variable]) -> Result<(), Unkn
     Ok(())
 }
 
-fn scalar_variable(out: &mut String, v: &Variable) {
+/// `derivative` is the 1-based index of the state a derivative variable belongs to.
+fn scalar_variable(out: &mut String, v: &Variable, derivative: Option<usize>) {
     let _ = writeln!(
         out,
         "    <ScalarVariable name=\"{}\" valueReference=\"{}\" description=\"{}\" \
@@ -136,6 +139,9 @@ fn scalar_variable(out: &mut String, v: &Variable) {
     if let Some(start) = v.start {
         let _ = write!(out, " start=\"{}\"", value_text(v.kind, start));
     }
+    if let Some(state) = derivative {
+        let _ = write!(out, " derivative=\"{state}\"");
+    }
     out.push_str("/>\n    </ScalarVariable>\n");
 }
 
@@ -149,6 +155,37 @@ fn indices(table: &ModelTable, names: &[&str]) -> String {
         .join(" ")
 }
 
+/// 1-based position (ModelVariables order) of value reference `vr`.
+fn index_of(table: &ModelTable, vr: u32) -> Option<usize> {
+    table
+        .variables
+        .iter()
+        .position(|v| v.value_reference == vr)
+        .map(|i| i + 1)
+}
+
+/// The dependencies of `output`: its direct-feedthrough inputs and, under Model Exchange,
+/// the continuous states (none for a state itself, which is its own known).
+fn output_dependencies(table: &ModelTable, output: &Variable) -> String {
+    let mut dependencies = indices(table, table.direct_feedthrough(output.name));
+    if let Some(me) = &table.model_exchange {
+        let is_state = me.states.contains(&output.value_reference);
+        if !is_state && !table.info.state_free_outputs.contains(&output.name) {
+            let states: Vec<String> = me
+                .states
+                .iter()
+                .filter_map(|&vr| index_of(table, vr))
+                .map(|i| i.to_string())
+                .collect();
+            if !dependencies.is_empty() {
+                dependencies.push(' ');
+            }
+            dependencies.push_str(&states.join(" "));
+        }
+    }
+    dependencies
+}
+
 fn model_structure(out: &mut String, table: &ModelTable) {
     let outputs: Vec<(usize, &Variable)> = table
         .variables
@@ -158,17 +195,33 @@ fn model_structure(out: &mut String, table: &ModelTable) {
         .collect();
     out.push_str("  <ModelStructure>\n    <Outputs>\n");
     for &(i, v) in &outputs {
-        let dependencies = indices(table, table.direct_feedthrough(v.name));
         let _ = writeln!(
             out,
-            "      <Unknown index=\"{}\" dependencies=\"{dependencies}\"/>",
-            i + 1
+            "      <Unknown index=\"{}\" dependencies=\"{}\"/>",
+            i + 1,
+            output_dependencies(table, v)
         );
     }
-    // Every output is calculated during initialisation, from any of the start values.
-    out.push_str("    </Outputs>\n    <InitialUnknowns>\n");
-    for &(i, _) in &outputs {
-        let _ = writeln!(out, "      <Unknown index=\"{}\"/>", i + 1);
+    out.push_str("    </Outputs>\n");
+    // Calculated during initialisation, from any of the start values: every output, and under
+    // Model Exchange the local states and every derivative.
+    let mut initial: Vec<usize> = outputs.iter().map(|&(i, _)| i + 1).collect();
+    if let Some(me) = &table.model_exchange {
+        out.push_str("    <Derivatives>\n");
+        for &vr in &me.derivatives {
+            if let Some(i) = index_of(table, vr) {
+                let _ = writeln!(out, "      <Unknown index=\"{i}\"/>");
+                initial.push(i);
+            }
+        }
+        out.push_str("    </Derivatives>\n");
+        initial.extend(me.states.iter().filter_map(|&vr| index_of(table, vr)));
+    }
+    initial.sort_unstable();
+    initial.dedup();
+    out.push_str("    <InitialUnknowns>\n");
+    for i in initial {
+        let _ = writeln!(out, "      <Unknown index=\"{i}\"/>");
     }
     out.push_str("    </InitialUnknowns>\n  </ModelStructure>\n");
 }
@@ -181,12 +234,27 @@ pub fn generate(table: &ModelTable) -> Result<String, UnknownUnit> {
         out,
         "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{}\" guid=\"{}\" \
          description=\"{}\" version=\"{}\" generationTool=\"flyloop\" \
-         variableNamingConvention=\"flat\" numberOfEventIndicators=\"0\">",
+         variableNamingConvention=\"flat\" numberOfEventIndicators=\"{}\">",
         info.identifier,
         table.guid,
         escape(info.description),
-        env!("CARGO_PKG_VERSION")
+        env!("CARGO_PKG_VERSION"),
+        table
+            .model_exchange
+            .as_ref()
+            .map_or(0, |me| me.event_indicators)
     );
+    if table.model_exchange.is_some() {
+        let _ = writeln!(
+            out,
+            "  <ModelExchange modelIdentifier=\"{}\" needsExecutionTool=\"false\" \
+             completedIntegratorStepNotNeeded=\"true\" \
+             canBeInstantiatedOnlyOncePerProcess=\"false\" \
+             canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" \
+             canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"/>",
+            info.identifier
+        );
+    }
     let _ = writeln!(
         out,
         "  <CoSimulation modelIdentifier=\"{}\" needsExecutionTool=\"false\" \
@@ -219,7 +287,14 @@ pub fn generate(table: &ModelTable) -> Result<String, UnknownUnit> {
     out.push_str("  <ModelVariables>\n");
     for (i, v) in table.variables.iter().enumerate() {
         let _ = writeln!(out, "    <!-- Index {} -->", i + 1);
-        scalar_variable(&mut out, v);
+        let derivative = table.model_exchange.as_ref().and_then(|me| {
+            let k = me
+                .derivatives
+                .iter()
+                .position(|&d| d == v.value_reference)?;
+            index_of(table, me.states[k])
+        });
+        scalar_variable(&mut out, v, derivative);
     }
     out.push_str("  </ModelVariables>\n");
     model_structure(&mut out, table);
@@ -278,7 +353,11 @@ mod tests {
             .filter(|v| v.causality == Causality::Output)
             .count();
         let structure = &xml[xml.find("<ModelStructure>").unwrap()..];
-        assert_eq!(structure.matches("<Unknown ").count(), 2 * outputs);
+        // Outputs twice (Outputs, InitialUnknowns); 25 derivatives twice, 8 local states once.
+        assert_eq!(
+            structure.matches("<Unknown ").count(),
+            2 * outputs + 2 * 25 + 8
+        );
         // wind_x (index after the 7 inputs and 23 outputs before it) depends on wind_input_x.
         let wind_x = table
             .variables

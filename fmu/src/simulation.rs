@@ -145,6 +145,25 @@ pub trait Simulation {
     fn check_saved(&self, bytes: &[u8]) -> Result<u8, FmuError>;
     /// Applies state bytes; returns the stage code saved with them. Nothing changes on error.
     fn restore(&mut self, bytes: &[u8]) -> Result<u8, FmuError>;
+
+    // Model Exchange (see `crate::exchange`); each is an error for a Co-Simulation-only model.
+    /// fmi2SetTime.
+    fn set_time(&mut self, time: f64) -> Result<(), FmuError>;
+    /// fmi2GetContinuousStates.
+    fn continuous_states(&self, x: &mut [f64]) -> Result<(), FmuError>;
+    /// fmi2SetContinuousStates; nothing changes when a value is refused.
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), FmuError>;
+    /// fmi2GetDerivatives.
+    fn derivatives(&self, dx: &mut [f64]) -> Result<(), FmuError>;
+    /// fmi2GetEventIndicators.
+    fn event_indicators(&self, z: &mut [f64]) -> Result<(), FmuError>;
+    /// fmi2GetNominalsOfContinuousStates.
+    fn nominals(&self, nominals: &mut [f64]) -> Result<(), FmuError>;
+    /// fmi2NewDiscreteStates: the discrete changes of an event at the current time. Returns
+    /// whether the continuous states changed, and the next time event (absolute time).
+    fn new_discrete_states(&mut self) -> Result<(bool, Option<f64>), FmuError>;
+    /// fmi2CompletedIntegratorStep: an error once the state is no longer finite.
+    fn completed_integrator_step(&self) -> Result<(), FmuError>;
 }
 
 /// [`Simulation`] for one model type.
@@ -157,6 +176,8 @@ pub struct Engine<M: FmuModel> {
     early_inputs: Vec<(u32, f64)>,
     experiment: Experiment,
     clock: Clock,
+    /// Model Exchange: time of the last event (its discrete changes are done up to here).
+    pub(crate) event_time: f64,
 }
 
 /// An FMU state: which model it belongs to (readable for any model, so that a state of
@@ -176,6 +197,7 @@ struct Body<I> {
     early_inputs: Vec<(u32, f64)>,
     experiment: Experiment,
     clock: Clock,
+    event_time: f64,
     /// The model's own snapshot (the core's format, with its own checks).
     model: Vec<u8>,
 }
@@ -190,12 +212,22 @@ impl<M: FmuModel> Engine<M> {
             early_inputs: Vec::new(),
             experiment: Experiment::default(),
             clock: Clock::at(0.0),
+            event_time: 0.0,
         })
     }
 
     /// The model (for tests and benchmarks that compare with the core).
     pub fn model(&self) -> &M {
         &self.model
+    }
+
+    pub(crate) fn model_mut(&mut self) -> &mut M {
+        &mut self.model
+    }
+
+    /// Model Exchange moves time by fmi2SetTime, not by steps.
+    pub(crate) fn set_clock(&mut self, time: f64) {
+        self.clock = Clock::at(time);
     }
 
     /// Rebuilds the model from the start values, keeping the inputs set so far.
@@ -248,6 +280,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
         }
         self.experiment = Experiment { start, stop };
         self.clock = Clock::at(start);
+        self.event_time = start;
         Ok(())
     }
 
@@ -366,6 +399,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
             early_inputs: self.early_inputs.clone(),
             experiment: self.experiment,
             clock: self.clock,
+            event_time: self.event_time,
             model: self.model.save()?,
         };
         let record = Record {
@@ -389,8 +423,52 @@ impl<M: FmuModel> Simulation for Engine<M> {
             early_inputs: body.early_inputs,
             experiment: body.experiment,
             clock: body.clock,
+            event_time: body.event_time,
         };
         Ok(stage)
+    }
+
+    fn set_time(&mut self, time: f64) -> Result<(), FmuError> {
+        crate::exchange::set_time(self, time)
+    }
+
+    fn continuous_states(&self, x: &mut [f64]) -> Result<(), FmuError> {
+        crate::exchange::hybrid(self, x.len(), "nx")?.states(x);
+        Ok(())
+    }
+
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), FmuError> {
+        crate::exchange::hybrid(self, x.len(), "nx")?;
+        crate::exchange::hybrid_mut(self)?.set_states(x)
+    }
+
+    fn derivatives(&self, dx: &mut [f64]) -> Result<(), FmuError> {
+        crate::exchange::hybrid(self, dx.len(), "nx")?.derivatives(dx);
+        Ok(())
+    }
+
+    fn event_indicators(&self, z: &mut [f64]) -> Result<(), FmuError> {
+        crate::exchange::event_indicators(self, z)
+    }
+
+    fn nominals(&self, nominals: &mut [f64]) -> Result<(), FmuError> {
+        crate::exchange::hybrid(self, nominals.len(), "nx")?;
+        nominals.fill(1.0);
+        Ok(())
+    }
+
+    fn new_discrete_states(&mut self) -> Result<(bool, Option<f64>), FmuError> {
+        crate::exchange::new_discrete_states(self)
+    }
+
+    fn completed_integrator_step(&self) -> Result<(), FmuError> {
+        if self.model.is_finite() {
+            Ok(())
+        } else {
+            Err(FmuError::Diverged {
+                time: self.clock.time(),
+            })
+        }
     }
 }
 

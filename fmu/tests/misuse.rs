@@ -93,13 +93,13 @@ fn null_callbacks_a_null_logger_or_a_missing_name_give_null_without_a_crash() {
     assert!(instantiate(None, fmi2CoSimulation, Some(&guid), Some(&callbacks)).is_null());
     assert!(instantiate(Some(""), fmi2CoSimulation, Some(&guid), Some(&callbacks)).is_null());
     assert!(instantiate(Some("a"), fmi2CoSimulation, None, Some(&callbacks)).is_null());
-    assert!(instantiate(Some("a"), fmi2ModelExchange, Some(&guid), Some(&callbacks)).is_null());
+    assert!(instantiate(Some("a"), 7, Some(&guid), Some(&callbacks)).is_null());
     let log = messages(&recorder);
     assert_eq!(log.len(), 4, "{log:?}");
     assert!(log[0].contains("instanceName is NULL or empty"));
     assert!(log[1].contains("instanceName is NULL or empty"));
     assert!(log[2].contains("fmuGUID is NULL"));
-    assert!(log[3].contains("Co-Simulation (1) only"));
+    assert!(log[3].contains("fmuType 7 is neither Model Exchange (0) nor Co-Simulation (1)"));
     // The memory callbacks are not needed: NULL ones are fine.
     let c = instantiate(Some("a"), fmi2CoSimulation, Some(&guid), Some(&callbacks));
     assert!(!c.is_null());

@@ -1,6 +1,11 @@
-"""fmpy's validator finds no problem in either FMU; each FMU holds what it should."""
+"""fmpy's validator and fmutool (fmu-manipulation-toolbox: schema and semantic checks) find no
+problem in either FMU; each FMU holds what it should."""
 
+import shutil
+import subprocess
+import sys
 import zipfile
+from pathlib import Path
 
 import pytest
 from fmpy import read_model_description
@@ -10,6 +15,22 @@ from fmpy.validation import validate_fmu
 @pytest.mark.parametrize("name", ["Quadrotor", "Lander2D"])
 def test_fmpy_validate_reports_no_problems(fmus, name):
     assert validate_fmu(str(fmus[name])) == []
+
+
+@pytest.mark.parametrize("name", ["Quadrotor", "Lander2D"])
+def test_fmutool_check_finds_the_fmu_compliant(fmus, name):
+    # The console script next to this interpreter (the venv's), else on PATH.
+    fmutool = Path(sys.executable).with_name("fmutool")
+    tool = str(fmutool) if fmutool.is_file() else shutil.which("fmutool")
+    assert tool, "fmutool missing: pip install -r tests/requirements.txt"
+    run = subprocess.run(
+        [tool, "-input", str(fmus[name]), "-check"], capture_output=True, text=True, timeout=120
+    )
+    text = run.stdout + run.stderr
+    assert run.returncode == 0, text
+    assert "This FMU seems to be compliant with FMI-2.0." in text, text
+    assert "No semantic error against the FMI-2 standard." in text, text
+    assert not [ln for ln in text.splitlines() if "WARNING" in ln or "ERROR" in ln], text
 
 
 @pytest.mark.parametrize("name", ["Quadrotor", "Lander2D"])

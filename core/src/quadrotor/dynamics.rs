@@ -68,8 +68,43 @@ pub fn derivatives(
     command: &[f64; 4],
     wind: &Vector3<f64>,
 ) -> Derivative {
+    let d = derivative_vector(params, state, command, wind);
+    let s = &d[STRETCH..];
+    Derivative {
+        velocity: Vector3::new(d[0], d[1], d[2]),
+        acceleration: Vector3::new(d[3], d[4], d[5]),
+        attitude_rate: Quaternion::new(d[6], d[7], d[8], d[9]),
+        angular_acceleration: Vector3::new(d[10], d[11], d[12]),
+        motor_rates: [d[13], d[14], d[15], d[16]],
+        gear_stretch_rates: [[s[0], s[1]], [s[2], s[3]], [s[4], s[5]], [s[6], s[7]]],
+    }
+}
+
+/// Length of the continuous state vector: 17 rigid-body and motor values, 8 bristles.
+pub const STATE_LEN: usize = CONTACT_LEN;
+
+/// The continuous state as one vector: position 0..3, velocity 3..6, quaternion w, x, y, z
+/// 6..10, body rates 10..13, motors 13..17, bristles (x, y per foot) 17..25 — the vector the
+/// stepper integrates while a foot may touch, and a Model-Exchange solver always.
+pub fn state_vector(state: &BodyState) -> [f64; STATE_LEN] {
+    flatten_contact(state)
+}
+
+/// Writes a [`state_vector`] back into `state`.
+pub fn set_state_vector(x: &[f64; STATE_LEN], state: &mut BodyState) {
+    unflatten_contact(x, state);
+}
+
+/// The time derivative of [`state_vector`]: the right-hand side RK4 integrates (with the
+/// contact when the ground is on; the bristles do not move without it).
+pub fn derivative_vector(
+    params: &QuadrotorParams,
+    state: &BodyState,
+    command: &[f64; 4],
+    wind: &Vector3<f64>,
+) -> [f64; STATE_LEN] {
     let c = Coefficients::new(params);
-    let d = if params.ground_enabled {
+    if params.ground_enabled {
         contact_rates(
             params,
             &c,
@@ -82,15 +117,6 @@ pub fn derivatives(
         let mut d = [0.0; CONTACT_LEN];
         d[..STRETCH].copy_from_slice(&rates(params, &c, &flatten(state), command, wind));
         d
-    };
-    let s = &d[STRETCH..];
-    Derivative {
-        velocity: Vector3::new(d[0], d[1], d[2]),
-        acceleration: Vector3::new(d[3], d[4], d[5]),
-        attitude_rate: Quaternion::new(d[6], d[7], d[8], d[9]),
-        angular_acceleration: Vector3::new(d[10], d[11], d[12]),
-        motor_rates: [d[13], d[14], d[15], d[16]],
-        gear_stretch_rates: [[s[0], s[1]], [s[2], s[3]], [s[4], s[5]], [s[6], s[7]]],
     }
 }
 

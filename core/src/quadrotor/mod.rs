@@ -4,6 +4,7 @@
 //! the table the FMU and the SITL read.
 
 pub mod contact;
+pub mod continuous;
 pub mod dynamics;
 pub mod model;
 pub mod params;

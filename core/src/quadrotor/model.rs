@@ -114,13 +114,19 @@ impl Quadrotor {
                 self.wind.since_sample += segment;
                 return;
             }
-            let transition = self.ou_cache.get(&self.params, self.params.turbulence_dt);
-            apply_transition(&transition, &mut self.wind, &mut self.rng);
-            self.wind.since_sample = 0.0;
+            self.sample_turbulence();
             if remaining <= 0.0 {
                 return;
             }
         }
+    }
+
+    /// Draws the next turbulence sample (one OU transition of `turbulence_dt`) and restarts
+    /// the time since the last sample.
+    pub(super) fn sample_turbulence(&mut self) {
+        let transition = self.ou_cache.get(&self.params, self.params.turbulence_dt);
+        apply_transition(&transition, &mut self.wind, &mut self.rng);
+        self.wind.since_sample = 0.0;
     }
 
     /// Total wind at the vehicle (episode wind + external), world ENU, m/s.

@@ -41,6 +41,11 @@ pub fn next_segment(params: &QuadrotorParams, wind: &WindState, remaining: f64) 
     }
 }
 
+/// Whether the turbulence is due for its next sample (on its grid within [`GRID_SLACK`]).
+pub fn sample_due(params: &QuadrotorParams, wind: &WindState) -> bool {
+    params.turbulence_dt - wind.since_sample <= GRID_SLACK * params.turbulence_dt
+}
+
 /// How many wind segments a step of `dt` seconds takes at most (one more than the samples in
 /// it), for callers that bound the work a step may cost.
 pub fn segment_count(params: &QuadrotorParams, dt: f64) -> f64 {

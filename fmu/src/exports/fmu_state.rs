@@ -8,7 +8,7 @@
 use super::guard::{c_slice, c_slice_mut, with_instance, write_out};
 use crate::error::FmuError;
 use crate::fmi2_types::*;
-use crate::instance::{SavedState, Stage, masks};
+use crate::instance::{SavedState, masks};
 use flyloop_core::number::Compact;
 
 /// Copies the current state. `*FMUstate` NULL gets a new state; a state of this instance is
@@ -61,19 +61,13 @@ pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstat
         // code included, and restore changes nothing when it fails.
         let bytes = instance.state(FMUstate as usize)?.bytes.clone();
         let code = instance.sim.restore(&bytes)?;
-        instance.stage = stage_of(code)?;
+        instance.stage = instance.stage_from_code(code)?;
         instance.event(&format!(
             "{function}: state restored, t = {}, stage {:?}",
             Compact(instance.sim.time()),
             instance.stage
         ));
         Ok(fmi2Status::fmi2OK)
-    })
-}
-
-fn stage_of(code: u8) -> Result<Stage, FmuError> {
-    Stage::from_code(code).ok_or_else(|| {
-        FmuError::InvalidArgument(format!("the FMU state holds an unknown stage code {code}"))
     })
 }
 
@@ -170,7 +164,7 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
         }
         // SAFETY: per the contract.
         let bytes = unsafe { c_slice(serializedState.cast::<u8>(), size, "serializedState") }?;
-        stage_of(instance.sim.check_saved(bytes)?)?;
+        instance.stage_from_code(instance.sim.check_saved(bytes)?)?;
         // SAFETY: non-NULL and readable per the contract.
         let existing = unsafe { FMUstate.read() };
         if existing.is_null() {

@@ -3,7 +3,7 @@
 use super::guard::{c_slice, guarded, with_instance};
 use crate::error::FmuError;
 use crate::fmi2_types::*;
-use crate::instance::{Instance, Stage, masks};
+use crate::instance::{Instance, Interface, Stage, masks};
 use crate::log::{self, Category, Logger};
 use crate::models;
 use flyloop_core::number::Compact;
@@ -22,9 +22,10 @@ pub extern "C" fn fmi2GetVersion() -> *const c_char {
     guarded(fmi2Version.as_ptr(), || fmi2Version.as_ptr())
 }
 
-/// Creates a Co-Simulation instance of the model whose GUID is `fmuGUID` (Quadrotor or
-/// Lander2D). Returns NULL, with the reason sent to the logger when there is one, for NULL or
-/// logger-less callbacks, a missing instance name, Model Exchange, or an unknown GUID.
+/// Creates a Co-Simulation or Model Exchange instance of the model whose GUID is `fmuGUID`
+/// (Quadrotor: both; Lander2D: Co-Simulation only). Returns NULL, with the reason sent to the
+/// logger when there is one, for NULL or logger-less callbacks, a missing instance name, an
+/// interface the model does not offer, or an unknown GUID.
 ///
 /// # Safety
 /// Pointer arguments must be NULL or valid per the FMI 2.0 standard.
@@ -63,11 +64,15 @@ pub unsafe extern "C" fn fmi2Instantiate(
         let Some(name) = name.filter(|n| !n.is_empty()) else {
             return fail("instanceName is NULL or empty");
         };
-        if fmuType != fmi2CoSimulation {
-            return fail(&format!(
-                "fmuType {fmuType} requested; this FMU supports Co-Simulation (1) only"
-            ));
-        }
+        let interface = match fmuType {
+            fmi2CoSimulation => Interface::CoSimulation,
+            fmi2ModelExchange => Interface::ModelExchange,
+            other => {
+                return fail(&format!(
+                    "fmuType {other} is neither Model Exchange (0) nor Co-Simulation (1)"
+                ));
+            }
+        };
         // SAFETY: NULL or a NUL-terminated string.
         let Some(guid) = (unsafe { c_str(fmuGUID) }) else {
             return fail("fmuGUID is NULL");
@@ -88,14 +93,23 @@ pub unsafe extern "C" fn fmi2Instantiate(
             Ok(sim) => sim,
             Err(e) => return fail(&format!("the model does not start: {e}")),
         };
+        if interface == Interface::ModelExchange && sim.table().model_exchange.is_none() {
+            return fail(&format!(
+                "{} is Co-Simulation only (its physics engine steps internally); \
+                 instantiate it with fmuType fmi2CoSimulation",
+                sim.table().info.identifier
+            ));
+        }
         let instance = Instance::new(
+            interface,
             Logger::new(logger, env, name.to_owned()),
             loggingOn != fmi2False,
             sim,
         );
         instance.event(&format!(
-            "fmi2Instantiate: {} instance ({guid}) created",
-            instance.sim.table().info.identifier
+            "fmi2Instantiate: {} {:?} instance ({guid}) created",
+            instance.sim.table().info.identifier,
+            instance.interface
         ));
         Some(Box::into_raw(Box::new(instance)))
     }));
@@ -229,7 +243,10 @@ pub unsafe extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2St
 pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
     let function = "fmi2ExitInitializationMode";
     with_instance(c, function, masks::EXIT_INITIALIZATION_MODE, |instance| {
-        instance.stage = Stage::StepComplete;
+        instance.stage = match instance.interface {
+            Interface::CoSimulation => Stage::StepComplete,
+            Interface::ModelExchange => Stage::EventMode,
+        };
         instance.event(&format!("{function}: t = {}", Compact(instance.sim.time())));
         Ok(fmi2Status::fmi2OK)
     })

@@ -1,108 +1,237 @@
-//! The Model Exchange functions, exported so that the library offers the whole FMI 2.0 API:
-//! fmi2Instantiate refuses Model Exchange, so every call here is an illegal call sequence.
+//! The Model Exchange functions (FMI 2.0 ME) of an instance made with fmuType
+//! fmi2ModelExchange: the importer's solver sets time and continuous states, reads
+//! derivatives and event indicators, and calls the event functions. Each checks the stage mask
+//! (Reference-FMUs), the interface, NULL pointers and array lengths; a refusal is an error
+//! status plus a log line, never a crash.
 
-use super::guard::with_instance;
+use super::guard::{c_slice, c_slice_mut, with_instance, write_out};
+use crate::error::FmuError;
 use crate::fmi2_types::*;
-use crate::instance::masks::MODEL_EXCHANGE;
+use crate::instance::{Instance, Mask, Stage, masks};
+use flyloop_core::number::Compact;
 
-fn refuse(c: fmi2Component, function: &'static str) -> fmi2Status {
-    with_instance(c, function, MODEL_EXCHANGE, |_| Ok(fmi2Status::fmi2OK))
+/// [`with_instance`] for a Model Exchange function: also refuses a Co-Simulation instance.
+fn with_me(
+    c: fmi2Component,
+    function: &'static str,
+    mask: Mask,
+    body: impl FnOnce(&mut Instance) -> Result<(), FmuError>,
+) -> fmi2Status {
+    with_instance(c, function, mask, |instance| {
+        instance.check_model_exchange()?;
+        body(instance)?;
+        Ok(fmi2Status::fmi2OK)
+    })
 }
 
 /// # Safety
 /// `c` must be NULL or a live instance.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2EnterEventMode(c: fmi2Component) -> fmi2Status {
-    refuse(c, "fmi2EnterEventMode")
+    with_me(
+        c,
+        "fmi2EnterEventMode",
+        masks::ENTER_EVENT_MODE,
+        |instance| {
+            instance.stage = Stage::EventMode;
+            Ok(())
+        },
+    )
 }
 
+/// The discrete changes of the event at the current time (turbulence sample, released
+/// bristles) and the next time event.
+///
 /// # Safety
-/// `c` must be NULL or a live instance.
+/// `c` must be NULL or a live instance; `eventInfo` NULL or writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2NewDiscreteStates(
     c: fmi2Component,
-    _eventInfo: *mut fmi2EventInfo,
+    eventInfo: *mut fmi2EventInfo,
 ) -> fmi2Status {
-    refuse(c, "fmi2NewDiscreteStates")
+    let function = "fmi2NewDiscreteStates";
+    with_me(c, function, masks::NEW_DISCRETE_STATES, |instance| {
+        if eventInfo.is_null() {
+            return Err(FmuError::NullArgument("eventInfo"));
+        }
+        let (changed, next) = instance.sim.new_discrete_states()?;
+        let info = fmi2EventInfo {
+            newDiscreteStatesNeeded: fmi2False,
+            terminateSimulation: fmi2False,
+            nominalsOfContinuousStatesChanged: fmi2False,
+            valuesOfContinuousStatesChanged: fmi2Boolean::from(changed),
+            nextEventTimeDefined: fmi2Boolean::from(next.is_some()),
+            nextEventTime: next.unwrap_or(0.0),
+        };
+        // SAFETY: non-NULL (checked above) and writable per the contract.
+        unsafe { write_out(eventInfo, info, "eventInfo") }?;
+        instance.event(&format!(
+            "{function}: t = {}, next time event {}",
+            Compact(instance.sim.time()),
+            next.map_or("none".to_string(), |t| Compact(t).to_string())
+        ));
+        Ok(())
+    })
 }
 
 /// # Safety
 /// `c` must be NULL or a live instance.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2EnterContinuousTimeMode(c: fmi2Component) -> fmi2Status {
-    refuse(c, "fmi2EnterContinuousTimeMode")
+    with_me(
+        c,
+        "fmi2EnterContinuousTimeMode",
+        masks::ENTER_CONTINUOUS_TIME_MODE,
+        |instance| {
+            instance.stage = Stage::ContinuousTimeMode;
+            Ok(())
+        },
+    )
 }
 
+/// No step event and no termination; an error (Error stage) once the state is not finite.
+///
 /// # Safety
-/// `c` must be NULL or a live instance.
+/// `c` must be NULL or a live instance; the two flags NULL or writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
     c: fmi2Component,
     _noSetFMUStatePriorToCurrentPoint: fmi2Boolean,
-    _enterEventMode: *mut fmi2Boolean,
-    _terminateSimulation: *mut fmi2Boolean,
+    enterEventMode: *mut fmi2Boolean,
+    terminateSimulation: *mut fmi2Boolean,
 ) -> fmi2Status {
-    refuse(c, "fmi2CompletedIntegratorStep")
+    with_me(
+        c,
+        "fmi2CompletedIntegratorStep",
+        masks::COMPLETED_INTEGRATOR_STEP,
+        |instance| {
+            if enterEventMode.is_null() {
+                return Err(FmuError::NullArgument("enterEventMode"));
+            }
+            if terminateSimulation.is_null() {
+                return Err(FmuError::NullArgument("terminateSimulation"));
+            }
+            instance.sim.completed_integrator_step()?;
+            // SAFETY: both non-NULL (checked above) and writable per the contract.
+            unsafe {
+                write_out(enterEventMode, fmi2False, "enterEventMode")?;
+                write_out(terminateSimulation, fmi2False, "terminateSimulation")
+            }
+        },
+    )
 }
 
 /// # Safety
 /// `c` must be NULL or a live instance.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetTime(c: fmi2Component, _time: fmi2Real) -> fmi2Status {
-    refuse(c, "fmi2SetTime")
+pub unsafe extern "C" fn fmi2SetTime(c: fmi2Component, time: fmi2Real) -> fmi2Status {
+    with_me(c, "fmi2SetTime", masks::SET_TIME, |instance| {
+        instance.sim.set_time(time)
+    })
 }
 
 /// # Safety
-/// `c` must be NULL or a live instance.
+/// `c` must be NULL or a live instance; `x` NULL or `nx` readable values.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2SetContinuousStates(
     c: fmi2Component,
-    _x: *const fmi2Real,
-    _nx: usize,
+    x: *const fmi2Real,
+    nx: usize,
 ) -> fmi2Status {
-    refuse(c, "fmi2SetContinuousStates")
+    with_me(
+        c,
+        "fmi2SetContinuousStates",
+        masks::SET_CONTINUOUS_STATES,
+        |instance| {
+            // SAFETY: per the function's contract.
+            let x = unsafe { c_slice(x, nx, "x") }?;
+            instance.sim.set_continuous_states(x)
+        },
+    )
 }
 
+/// The derivatives of the continuous states: the core's right-hand side, bit for bit.
+///
 /// # Safety
-/// `c` must be NULL or a live instance.
+/// `c` must be NULL or a live instance; `derivatives` NULL or `nx` writable values.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2GetDerivatives(
     c: fmi2Component,
-    _derivatives: *mut fmi2Real,
-    _nx: usize,
+    derivatives: *mut fmi2Real,
+    nx: usize,
 ) -> fmi2Status {
-    refuse(c, "fmi2GetDerivatives")
+    with_me(
+        c,
+        "fmi2GetDerivatives",
+        masks::GET_DERIVATIVES,
+        |instance| {
+            // SAFETY: per the function's contract.
+            let dx = unsafe { c_slice_mut(derivatives, nx, "derivatives") }?;
+            instance.sim.derivatives(dx)
+        },
+    )
 }
 
+/// The foot heights (m): a sign change is a touch-down or a lift-off.
+///
 /// # Safety
-/// `c` must be NULL or a live instance.
+/// `c` must be NULL or a live instance; `eventIndicators` NULL or `ni` writable values.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2GetEventIndicators(
     c: fmi2Component,
-    _eventIndicators: *mut fmi2Real,
-    _ni: usize,
+    eventIndicators: *mut fmi2Real,
+    ni: usize,
 ) -> fmi2Status {
-    refuse(c, "fmi2GetEventIndicators")
+    with_me(
+        c,
+        "fmi2GetEventIndicators",
+        masks::GET_EVENT_INDICATORS,
+        |instance| {
+            // SAFETY: per the function's contract.
+            let z = unsafe { c_slice_mut(eventIndicators, ni, "eventIndicators") }?;
+            instance.sim.event_indicators(z)
+        },
+    )
 }
 
 /// # Safety
-/// `c` must be NULL or a live instance.
+/// `c` must be NULL or a live instance; `x` NULL or `nx` writable values.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2GetContinuousStates(
     c: fmi2Component,
-    _x: *mut fmi2Real,
-    _nx: usize,
+    x: *mut fmi2Real,
+    nx: usize,
 ) -> fmi2Status {
-    refuse(c, "fmi2GetContinuousStates")
+    with_me(
+        c,
+        "fmi2GetContinuousStates",
+        masks::GET_CONTINUOUS_STATES,
+        |instance| {
+            // SAFETY: per the function's contract.
+            let x = unsafe { c_slice_mut(x, nx, "x") }?;
+            instance.sim.continuous_states(x)
+        },
+    )
 }
 
+/// 1 for every state (positions in m, speeds in m/s, quaternion and motors near 1).
+///
 /// # Safety
-/// `c` must be NULL or a live instance.
+/// `c` must be NULL or a live instance; `x_nominal` NULL or `nx` writable values.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(
     c: fmi2Component,
-    _x_nominal: *mut fmi2Real,
-    _nx: usize,
+    x_nominal: *mut fmi2Real,
+    nx: usize,
 ) -> fmi2Status {
-    refuse(c, "fmi2GetNominalsOfContinuousStates")
+    with_me(
+        c,
+        "fmi2GetNominalsOfContinuousStates",
+        masks::GET_NOMINALS,
+        |instance| {
+            // SAFETY: per the function's contract.
+            let nominals = unsafe { c_slice_mut(x_nominal, nx, "x_nominal") }?;
+            instance.sim.nominals(nominals)
+        },
+    )
 }

@@ -20,6 +20,7 @@ static INFO: ModelInfo = ModelInfo {
         ("wind_force_x", &["wind_force_input_x"]),
         ("wind_force_y", &["wind_force_input_y"]),
     ],
+    state_free_outputs: &[],
 };
 
 impl FmuModel for Lander2d {

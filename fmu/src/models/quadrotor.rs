@@ -2,10 +2,20 @@
 //! `Quadrotor::step(h)`, which cuts the step at the turbulence's own sample times
 //! (`turbulence_dt`) and integrates each piece in ceil(piece / max_substep) equal RK4
 //! substeps under the wind of the piece's start, so h does not change the weather.
+//!
+//! Model Exchange integrates the same right-hand side (`flyloop_core::quadrotor::continuous`):
+//! 25 continuous states (the 17 body outputs x .. motor_state_3 and 8 local bristle
+//! stretches), their derivatives as locals `der(..)`, the four foot heights as event
+//! indicators and the turbulence samples as time events.
 
-use crate::model::{FmuModel, ModelInfo, ModelTable, StepRequest};
+use crate::error::FmuError;
+use crate::model::{FmuModel, Hybrid, ModelExchangeTable, ModelInfo, ModelTable, StepRequest};
+use flyloop_core::number::Compact;
+use flyloop_core::params::ValueKind;
+use flyloop_core::quadrotor::continuous::{BODY_STATE_OUTPUTS, BRISTLES, EVENT_INDICATORS};
+use flyloop_core::quadrotor::dynamics::STATE_LEN;
 use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial, wind};
-use flyloop_core::variables;
+use flyloop_core::variables::{self, Causality, Variability, Variable};
 use flyloop_core::{ParamError, SnapshotError};
 use std::sync::OnceLock;
 
@@ -26,14 +36,98 @@ static INFO: ModelInfo = ModelInfo {
         ("wind_y", &["wind_input_y"]),
         ("wind_z", &["wind_input_z"]),
     ],
+    // The wind is the episode wind plus the input: turbulence is a discrete state.
+    state_free_outputs: &["wind_x", "wind_y", "wind_z"],
 };
+
+/// Value references of the bristle states (locals) and of the 25 derivatives.
+const BRISTLE_VR: u32 = 700;
+const DERIVATIVE_VR: u32 = 800;
+
+/// The derivative variables in state-vector order: name and unit.
+const DERIVATIVES: [(&str, &str); STATE_LEN] = [
+    ("der(x)", "m/s"),
+    ("der(y)", "m/s"),
+    ("der(z)", "m/s"),
+    ("der(vx)", "m/s2"),
+    ("der(vy)", "m/s2"),
+    ("der(vz)", "m/s2"),
+    ("der(qw)", "1/s"),
+    ("der(qx)", "1/s"),
+    ("der(qy)", "1/s"),
+    ("der(qz)", "1/s"),
+    ("der(wx)", "rad/s2"),
+    ("der(wy)", "rad/s2"),
+    ("der(wz)", "rad/s2"),
+    ("der(motor_state_0)", "1/s"),
+    ("der(motor_state_1)", "1/s"),
+    ("der(motor_state_2)", "1/s"),
+    ("der(motor_state_3)", "1/s"),
+    ("der(gear_stretch_0_x)", "m/s"),
+    ("der(gear_stretch_0_y)", "m/s"),
+    ("der(gear_stretch_1_x)", "m/s"),
+    ("der(gear_stretch_1_y)", "m/s"),
+    ("der(gear_stretch_2_x)", "m/s"),
+    ("der(gear_stretch_2_y)", "m/s"),
+    ("der(gear_stretch_3_x)", "m/s"),
+    ("der(gear_stretch_3_y)", "m/s"),
+];
+
+fn local(name: &'static str, vr: u32, unit: &'static str, description: &'static str) -> Variable {
+    Variable {
+        name,
+        value_reference: vr,
+        kind: ValueKind::Real,
+        causality: Causality::Local,
+        variability: Variability::Continuous,
+        unit,
+        description,
+        start: None,
+        min: None,
+        max: None,
+    }
+}
+
+/// The core's variables, then the bristle states and the derivatives.
+fn table() -> ModelTable {
+    let mut vars = variables::variables::<Quadrotor>();
+    vars.extend(
+        BRISTLES
+            .iter()
+            .zip(BRISTLE_VR..)
+            .map(|(&(name, text), vr)| local(name, vr, "m", text)),
+    );
+    vars.extend(
+        DERIVATIVES
+            .iter()
+            .zip(DERIVATIVE_VR..)
+            .map(|(&(name, unit), vr)| local(name, vr, unit, "Time derivative of the state")),
+    );
+    let vr_of = |name: &str| {
+        vars.iter()
+            .find(|v| v.name == name)
+            .map(|v| v.value_reference)
+    };
+    let states = BODY_STATE_OUTPUTS
+        .iter()
+        .copied()
+        .chain(BRISTLES.iter().map(|b| b.0))
+        .filter_map(vr_of)
+        .collect();
+    let me = ModelExchangeTable {
+        states,
+        derivatives: (DERIVATIVE_VR..).take(STATE_LEN).collect(),
+        event_indicators: EVENT_INDICATORS,
+    };
+    ModelTable::with_model_exchange(&INFO, vars, Some(me))
+}
 
 impl FmuModel for Quadrotor {
     type Initial = QuadrotorInitial;
 
     fn table() -> &'static ModelTable {
         static TABLE: OnceLock<ModelTable> = OnceLock::new();
-        TABLE.get_or_init(|| ModelTable::new(&INFO, variables::variables::<Quadrotor>()))
+        TABLE.get_or_init(table)
     }
 
     fn build(previous: Option<&Self>, initial: &QuadrotorInitial) -> Result<Self, ParamError> {
@@ -42,7 +136,18 @@ impl FmuModel for Quadrotor {
     }
 
     fn get(&self, initial: &QuadrotorInitial, vr: u32) -> Result<f64, ParamError> {
-        variables::get(self, initial, vr)
+        let local = |first: u32, values: [f64; STATE_LEN], offset: usize| {
+            let at = (vr - first) as usize + offset;
+            values
+                .get(at)
+                .copied()
+                .ok_or(ParamError::UnknownValueReference(vr))
+        };
+        match vr {
+            DERIVATIVE_VR.. => local(DERIVATIVE_VR, self.state_derivative(), 0),
+            BRISTLE_VR.. => local(BRISTLE_VR, self.continuous_state(), 17),
+            _ => variables::get(self, initial, vr),
+        }
     }
 
     fn set(
@@ -80,5 +185,50 @@ impl FmuModel for Quadrotor {
 
     fn restore(bytes: &[u8]) -> Result<Self, SnapshotError> {
         Quadrotor::restore(bytes)
+    }
+
+    fn hybrid(&self) -> Option<&dyn Hybrid> {
+        Some(self)
+    }
+
+    fn hybrid_mut(&mut self) -> Option<&mut dyn Hybrid> {
+        Some(self)
+    }
+}
+
+impl Hybrid for Quadrotor {
+    fn states(&self, x: &mut [f64]) {
+        x.copy_from_slice(&self.continuous_state());
+    }
+
+    fn set_states(&mut self, x: &[f64]) -> Result<(), FmuError> {
+        let mut state = [0.0; STATE_LEN];
+        state.copy_from_slice(x);
+        self.set_continuous_state(&state).map_err(|e| {
+            // The state's name is its derivative's without "der( )".
+            let name = DERIVATIVES[e.index].0;
+            let name = name.trim_start_matches("der(").trim_end_matches(')');
+            FmuError::InvalidArgument(format!(
+                "x[{}] (state `{name}`) is {}, not a finite number; nothing was set",
+                e.index,
+                Compact(e.value)
+            ))
+        })
+    }
+
+    fn derivatives(&self, dx: &mut [f64]) {
+        dx.copy_from_slice(&self.state_derivative());
+    }
+
+    fn event_indicators(&self, z: &mut [f64]) {
+        z.copy_from_slice(&Quadrotor::event_indicators(self));
+    }
+
+    fn time_event_after(&self) -> Option<f64> {
+        self.time_to_turbulence_sample()
+    }
+
+    fn event_update(&mut self, elapsed: f64) {
+        Quadrotor::event_update(self, elapsed);
     }
 }

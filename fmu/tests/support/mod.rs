@@ -58,6 +58,15 @@ impl Fmu {
     }
 
     pub fn named(model: Model, name: &str, logging_on: bool) -> Fmu {
+        Fmu::of_type(model, name, logging_on, fmi2CoSimulation)
+    }
+
+    /// A Model Exchange instance of `model` with logging on.
+    pub fn model_exchange(model: Model) -> Fmu {
+        Fmu::of_type(model, "me", true, fmi2ModelExchange)
+    }
+
+    pub fn of_type(model: Model, name: &str, logging_on: bool, fmu_type: fmi2Type) -> Fmu {
         let recorder = Box::new(Recorder::default());
         let callbacks = callbacks_for(&recorder);
         let name = CString::new(name).unwrap();
@@ -65,7 +74,7 @@ impl Fmu {
         let c = unsafe {
             fmi2Instantiate(
                 name.as_ptr(),
-                fmi2CoSimulation,
+                fmu_type,
                 model.table().guid_c.as_ptr(),
                 std::ptr::null(),
                 &*callbacks,
