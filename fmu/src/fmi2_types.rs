@@ -76,7 +76,7 @@ pub struct fmi2CallbackFunctions {
     pub componentEnvironment: fmi2ComponentEnvironment,
 }
 
-/// `fmi2EventInfo` (Model Exchange only; here for the signature of fmi2NewDiscreteStates).
+/// `fmi2EventInfo`: what fmi2NewDiscreteStates reports to a Model Exchange importer.
 #[repr(C)]
 #[derive(Debug, Clone, Copy)]
 pub struct fmi2EventInfo {
