@@ -125,6 +125,9 @@ def start_ray(address: str | None, num_cpus: int) -> None:
         ray.init(address=address, runtime_env=runtime_env, log_to_driver=False)
     else:
         ray.init(
+            # A fresh local instance: without it ray.init() joins whatever cluster RAY_ADDRESS
+            # or Ray's last-started-cluster file names (and then refuses num_cpus).
+            address="local",
             num_cpus=num_cpus,
             include_dashboard=False,
             runtime_env=runtime_env,

@@ -53,6 +53,24 @@ def start_node(words: list[str], log: Path, env: dict[str, str]) -> subprocess.P
     return proc
 
 
+def active_nodes(env: dict[str, str], timeout: float = 90) -> int:
+    """The cluster's active node count once `ray status` reports both nodes (it needs a few
+    seconds after `ray start` to have a status at all)."""
+    deadline, count, text = time.monotonic() + timeout, 0, ""
+    while time.monotonic() < deadline:
+        status = subprocess.run(
+            ["ray", "status"], env=env, capture_output=True, text=True, timeout=60
+        )
+        text = status.stdout + status.stderr
+        if "Active:" in status.stdout:
+            count = status.stdout.split("Active:")[1].split("Pending:")[0].count("node_")
+            if count == 2:
+                break
+        time.sleep(2)
+    print(text)
+    return count
+
+
 def stop_node(proc: subprocess.Popen) -> None:
     for sig, wait in ((signal.SIGTERM, 20), (signal.SIGKILL, 10)):
         try:
@@ -74,6 +92,10 @@ def test_the_readme_cluster_commands_train_on_a_two_node_cluster(sitl_binary, tm
     env = dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}")
     env["RAY_ADDRESS"] = f"127.0.0.1:{port}"  # what `--address auto` finds
     env["FLYLOOP_SITL"] = str(sitl_binary)
+    # A home of its own: Ray reads ~/.ray (e.g. an auth_token left by another Ray on this
+    # machine), and the nodes and the driver must agree on it.
+    (tmp_path / "home").mkdir()
+    env["HOME"] = str(tmp_path / "home")
 
     head_words = shlex.split(head.replace("6379", str(port)))
     worker_words = shlex.split(worker.replace("HEAD_IP", "127.0.0.1").replace("6379", str(port)))
@@ -89,11 +111,7 @@ def test_the_readme_cluster_commands_train_on_a_two_node_cluster(sitl_binary, tm
     try:
         nodes.append(start_node(head_words, tmp_path / "head.log", env))
         nodes.append(start_node(worker_words, tmp_path / "worker.log", env))
-        status = subprocess.run(
-            ["ray", "status"], env=env, capture_output=True, text=True, timeout=60
-        )
-        active = status.stdout.split("Active:")[1].split("Pending:")[0]
-        assert active.count("node_") == 2, status.stdout + status.stderr
+        assert active_nodes(env) == 2
 
         done = subprocess.run(
             [*train_words, "--minibatch", "100", "--epochs", "1"],
