@@ -52,7 +52,9 @@ bash scripts/pack-fmus.sh
 
 if [[ $demo -eq 1 ]]; then
     say "Demo 1: the Hover task flown by a PD controller in the Rust core"
-    cargo run --release -q -p flyloop-core --example hover
+    # The example the workspace build above made (`cargo run -p flyloop-core` would resolve
+    # features for that crate alone and recompile shared dependencies).
+    target/release/examples/hover
     say "Demo 2: Quadrotor.fmu simulated with fmpy (plot)"
     .venv/bin/python examples/fmu_fmpy_demo.py
     say "Demo 3: the SITL flown through the gym env by a PD controller (GIF)"
