@@ -123,3 +123,35 @@ def test_lander_step_input_matches_the_core_from_rust(fmus, core_trajectory):
     assert differing == []
     assert result["battery"][-1] < 100.0
     assert len(set(np.round(result["platform_x"], 6))) > 10, "the platform moves"
+
+
+def test_lander_flags_leaving_the_world_and_an_empty_battery(fmus):
+    # Issue 13: x = 50.8 beyond a 50 m world went unflagged; out_of_bounds is an output now.
+    start = {"initial_x": 49.0, "initial_vx": 4.0, "wind_enabled": False}
+    result = simulate_fmu(
+        str(fmus["Lander2D"]),
+        start_values=start,
+        stop_time=1.0,
+        output_interval=0.02,
+        output=["x", "out_of_bounds", "battery_empty"],
+    )
+    inside = result["x"] < 50.0
+    assert inside[0] and not inside[-1]
+    # Flagged exactly when the centre is past world_width (50 m), never before.
+    np.testing.assert_array_equal(result["out_of_bounds"], ~inside)
+    assert not result["battery_empty"].any()
+
+    drained = simulate_fmu(
+        str(fmus["Lander2D"]),
+        start_values={"initial_battery": 0.5, "wind_enabled": False},
+        stop_time=0.5,
+        output_interval=0.02,
+        input=np.array(
+            [(0.0, 1.0, 1.0)],
+            dtype=[("time", float), ("motor_command_left", float), ("motor_command_right", float)],
+        ),
+        output=["battery", "battery_empty"],
+    )
+    # 30 N drain 0.1/(N·s): 0.5 units last 1/6 s.
+    assert not drained["battery_empty"][0] and drained["battery_empty"][-1]
+    np.testing.assert_array_equal(drained["battery_empty"], drained["battery"] <= 0.0)

@@ -242,18 +242,23 @@ impl Lander2d {
         self.substep = 0;
     }
 
-    /// Thrust of each motor for the coming period: commanded level plus Gaussian noise,
-    /// clipped to [0, max_thrust]; zero once the battery is empty. The two normal draws happen
-    /// every period, so the stream does not depend on the battery.
+    /// Thrust of each motor for the coming period: commanded level times (1 + Gaussian noise
+    /// of relative σ = thrust_noise_std / max_thrust), clipped to [0, max_thrust]; zero once
+    /// the battery is empty. The noise scales with the level so that a stopped motor (command
+    /// −1) gives exactly zero thrust and drains nothing; at full thrust σ is thrust_noise_std,
+    /// the reference's. (The reference added σ at every level: at command −1 its clipped
+    /// noise still pushed ≈ 0.6 N per motor and drained the battery.) The two normal draws
+    /// happen every period, so the stream does not depend on the battery or the command.
     fn draw_thrust(&mut self) -> [f64; 2] {
         let p = &self.params;
         let noise = [self.rng.normal(), self.rng.normal()];
-        if self.battery <= 0.0 {
+        if self.battery <= 0.0 || p.max_thrust <= 0.0 {
             return [0.0; 2];
         }
+        let relative_std = p.thrust_noise_std / p.max_thrust;
         [0, 1].map(|i| {
             let level = (self.command[i] + 1.0) / 2.0 * p.max_thrust;
-            (level + p.thrust_noise_std * noise[i]).clamp(0.0, p.max_thrust)
+            (level * (1.0 + relative_std * noise[i])).clamp(0.0, p.max_thrust)
         })
     }
 
@@ -364,6 +369,14 @@ impl Lander2d {
     /// Crashed: onto the ground, or onto the platform too fast or tilted (latched).
     pub fn crashed(&self) -> bool {
         self.contact.crashed
+    }
+
+    /// The drone's centre is outside the world: not (0 < x < world_width and
+    /// 0 < y < world_height).
+    pub fn out_of_bounds(&self) -> bool {
+        let d = self.drone();
+        let p = &self.params;
+        !(d.x > 0.0 && d.x < p.world_width && d.y > 0.0 && d.y < p.world_height)
     }
 
     /// Control periods since the start.

@@ -35,7 +35,8 @@ pub struct Lander2dParams {
     pub drone_friction: f64,
     /// Largest thrust of one motor, N. Default 15.
     pub max_thrust: f64,
-    /// Standard deviation of the Gaussian noise on each motor's thrust, N. Default 1.5
+    /// Standard deviation of the Gaussian noise on each motor's thrust at full thrust, N;
+    /// it scales with the commanded thrust, so a stopped motor gives none. Default 1.5
     /// (0.1 · max_thrust); 0 turns the noise off.
     pub thrust_noise_std: f64,
     /// Battery charge at the start, units. Default 100.
@@ -129,7 +130,7 @@ static LANDER_SPECS: [ParamSpec<Lander2dParams>; 29] = [
     param!(real drone_height, "m", 1e-3, 100.0, "Drone height (side of each square motor)"),
     param!(real drone_friction, "1", 0.0, 10.0, "Friction coefficient of the drone's parts"),
     param!(real max_thrust, "N", 0.0, 1e6, "Largest thrust of one motor"),
-    param!(real thrust_noise_std, "N", 0.0, 1e6, "Standard deviation of the Gaussian thrust noise per motor"),
+    param!(real thrust_noise_std, "N", 0.0, 1e6, "Standard deviation of the Gaussian thrust noise per motor at full thrust (it scales with the commanded thrust: none when stopped)"),
     param!(real initial_battery, "1", 0.0, 1e9, "Battery charge at the start"),
     param!(real battery_consumption_rate, "1/(N.s)", 0.0, 1e9, "Battery drain per newton-second of total thrust"),
     param!(boolean wind_enabled, "The episode's constant wind blows"),

@@ -95,6 +95,16 @@ const OUTPUTS: &[OutputRow<Lander2d>] = &[
         "Wind force on the drone along y (episode wind + input)",
         |l| l.wind_force()[1],
     ),
+    OutputRow::flag(
+        "out_of_bounds",
+        "Drone centre outside the world: not (0 < x < world_width and 0 < y < world_height)",
+        |l| flag(l.out_of_bounds()),
+    ),
+    OutputRow::flag(
+        "battery_empty",
+        "Battery exhausted: the motors give no thrust",
+        |l| flag(l.battery() <= 0.0),
+    ),
 ];
 
 /// Inputs; their order fixes the value references.
@@ -184,7 +194,7 @@ mod tests {
     fn names_and_value_references_are_unique_and_every_one_reads() {
         let (l, init) = (lander(), Lander2dInitial::default());
         crate::variables::assert_every_variable_reads(&l, &init, true);
-        assert_eq!(variables::<Lander2d>().len(), 4 + 20 + 29 + 7);
+        assert_eq!(variables::<Lander2d>().len(), 4 + 22 + 29 + 7);
         // 4 lies between the inputs (0..=3) and the outputs: no variable.
         assert_eq!(get(&l, &init, 4), Err(ParamError::UnknownValueReference(4)));
     }

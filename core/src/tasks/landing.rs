@@ -14,13 +14,19 @@
 //! | 10 | ‖err‖/W |
 //! | 11 | platform vx / platform_speed (moving platform only) |
 //!
-//! Reward on the normalised values n: 2·e^(−0.1·n10) − 0.1·(n2² + n3²) − 0.2·|n4| − 0.1·|n5|,
-//! +5 on a step with platform contact; then the first terminal condition in this order adds
-//! its reward and ends the episode: landed (+100 if ‖(n2, n3)‖ < 0.1 and |n5| < 0.1, else
-//! +20), crashed (−50), lost control (|wrapped angle| > max_allowed_tilt_angle_rad, −50),
-//! battery empty (−50), out of bounds (−50). Otherwise the episode is truncated with −10 at
-//! exactly step == max_steps (the reference fired one step late).
+//! The first terminal condition in this order ends the episode: landed, crashed, lost control
+//! (|wrapped angle| > max_allowed_tilt_angle_rad), battery empty, out of bounds. Otherwise the
+//! episode is truncated at exactly step == max_steps (the reference fired one step late).
+//!
+//! The reward is chosen by `reward_version` ([`super::landing_reward`]): 0 = the seed's
+//! (default: on the normalised values n, 2·e^(−0.1·n10) − 0.1·(n2² + n3²) − 0.2·|n4| −
+//! 0.1·|n5|, +5 on a step with platform contact; landed +100 if ‖(n2, n3)‖ < 0.1 and
+//! |n5| < 0.1, else +20; failures −50; time limit −10), 1 = landing (potential-based shaping,
+//! landed +100, failures and the time limit −100).
 
+use super::landing_reward::{
+    self, Ending, REWARD_LANDING, REWARD_SEED, landing_terminal_reward, seed_terminal_reward,
+};
 use super::{ActionError, Info, InfoValue, StepOutcome, Task, check_action, clip_f32};
 use crate::error::ParamError;
 use crate::lander2d::{DroneState, Lander2d, Lander2dParams, wrap_angle};
@@ -49,6 +55,9 @@ pub struct LandingParams {
     pub initial_angle_random_range_rad: f64,
     /// |wrapped angle| beyond which control is lost, rad. Default π/2.
     pub max_allowed_tilt_angle_rad: f64,
+    /// Reward: 0 = `seed` (the reference's, bit for bit; it pays for hovering near the pad),
+    /// 1 = `landing` (potential-based shaping, a safe landing dominates). Default 0.
+    pub reward_version: u32,
 }
 
 impl Default for LandingParams {
@@ -60,17 +69,19 @@ impl Default for LandingParams {
             spawn_y: 40.0,
             initial_angle_random_range_rad: 0.1,
             max_allowed_tilt_angle_rad: PI / 2.0,
+            reward_version: REWARD_SEED,
         }
     }
 }
 
-static LANDING_SPECS: [ParamSpec<LandingParams>; 6] = [
+static LANDING_SPECS: [ParamSpec<LandingParams>; 7] = [
     param!(integer max_steps, "", 1, i32::MAX, "Episode length in steps (truncation at step == max_steps)"),
     param!(real initial_pos_random_range_m, "m", 0.0, 1e4, "Half side of the square spawn zone"),
     param!(real spawn_x, "m", 0.0, 1e4, "Centre of the spawn zone, x"),
     param!(real spawn_y, "m", 0.0, 1e4, "Centre of the spawn zone, y"),
     param!(real initial_angle_random_range_rad, "rad", 0.0, PI, "Half range of the uniform spawn angle"),
     param!(real max_allowed_tilt_angle_rad, "rad", 0.0, PI, "|wrapped angle| beyond which control is lost"),
+    param!(integer reward_version, "", 0, 1, "Reward: 0 = seed (the reference's), 1 = landing (potential-based shaping, landing pays)"),
 ];
 
 impl Parameters for LandingParams {
@@ -112,6 +123,9 @@ pub struct Landing {
     params: LandingParams,
     lander: Lander2d,
     status: LandingStatus,
+    /// Φ of the current state (reward version 1's shaping is Φ(s′) − Φ(s)).
+    #[serde(default)]
+    potential: f64,
 }
 
 impl Landing {
@@ -134,6 +148,7 @@ impl Landing {
             params,
             lander,
             status: LandingStatus::default(),
+            potential: 0.0,
         };
         landing.reset(0);
         Ok(landing)
@@ -162,6 +177,7 @@ impl Landing {
         let model = self.lander.params().clone();
         self.lander = Lander2d::new(model, drone, SimRng::new(seed))?;
         self.status = LandingStatus::default();
+        self.potential = landing_reward::potential(&self.lander);
         Ok(())
     }
 
@@ -222,14 +238,8 @@ impl Landing {
 
 const SNAPSHOT_TAG: &[u8; 8] = b"FLYLND01";
 
-/// The per-step reward on normalised observation values (module docs).
-pub fn shaping_reward(n: &[f64; 12], touched_platform: bool) -> f64 {
-    let r = 2.0 * (-0.1 * n[10]).exp()
-        - 0.1 * (n[2] * n[2] + n[3] * n[3])
-        - 0.2 * n[4].abs()
-        - 0.1 * n[5].abs();
-    if touched_platform { r + 5.0 } else { r }
-}
+/// The seed's per-step reward on normalised observation values (module docs).
+pub use landing_reward::seed_step_reward as shaping_reward;
 
 impl Task for Landing {
     fn action_size(&self) -> usize {
@@ -274,6 +284,7 @@ impl Task for Landing {
         };
         self.lander = Lander2d::new_unchecked(model, drone, rng);
         self.status = LandingStatus::default();
+        self.potential = landing_reward::potential(&self.lander);
     }
 
     fn step(&mut self, action: &[f64]) -> Result<StepOutcome, ActionError> {
@@ -290,27 +301,34 @@ impl Task for Landing {
 
         let (n, _) = self.normalised_observation();
         let l = &self.lander;
-        let mut reward = shaping_reward(&n, l.contact().touched_platform);
-
-        let d = l.drone();
-        let p = l.params();
         let s = &mut self.status;
-        s.lost_control = wrap_angle(d.angle).abs() > self.params.max_allowed_tilt_angle_rad;
+        s.lost_control = wrap_angle(l.drone().angle).abs() > self.params.max_allowed_tilt_angle_rad;
         s.battery_empty = l.battery() <= 0.0;
-        let inside = d.x > 0.0 && d.x < p.world_width && d.y > 0.0 && d.y < p.world_height;
-        s.out_of_bounds = !inside;
-        let calm = n[2].hypot(n[3]) < 0.1 && n[5].abs() < 0.1;
-        let terminal = if l.landed() {
-            Some(if calm { 100.0 } else { 20.0 })
+        s.out_of_bounds = l.out_of_bounds();
+        let ending = if l.landed() {
+            Some(Ending::Landed {
+                calm: n[2].hypot(n[3]) < 0.1 && n[5].abs() < 0.1,
+            })
         } else if l.crashed() || s.lost_control || s.battery_empty || s.out_of_bounds {
-            Some(-50.0)
+            Some(Ending::Failed)
+        } else if s.step >= self.params.max_steps {
+            Some(Ending::TimeLimit)
         } else {
             None
         };
-        s.terminated = terminal.is_some();
-        s.time_limit = !s.terminated && s.step >= self.params.max_steps;
+        s.time_limit = ending == Some(Ending::TimeLimit);
+        s.terminated = ending.is_some() && !s.time_limit;
         s.truncated = s.time_limit;
-        reward += terminal.unwrap_or(if s.time_limit { -10.0 } else { 0.0 });
+        let reward = if self.params.reward_version == REWARD_LANDING {
+            let potential = landing_reward::potential(l);
+            let shaping = potential - self.potential;
+            self.potential = potential;
+            shaping - landing_reward::control_cost(command)
+                + ending.map_or(0.0, landing_terminal_reward)
+        } else {
+            shaping_reward(&n, l.contact().touched_platform)
+                + ending.map_or(0.0, seed_terminal_reward)
+        };
         Ok(StepOutcome {
             reward,
             terminated: s.terminated,
@@ -404,19 +422,5 @@ mod tests {
         let p = LandingParams::from_toml_str("max_steps = 1500\ninitial_pos_random_range_m = 10.0")
             .unwrap();
         assert_eq!((p.max_steps, p.initial_pos_random_range_m), (1500, 10.0));
-    }
-
-    #[test]
-    fn shaping_reward_is_the_reference_formula() {
-        let mut n = [0.0; 12];
-        assert_eq!(shaping_reward(&n, false), 2.0);
-        assert_eq!(shaping_reward(&n, true), 7.0);
-        n[10] = 0.5;
-        n[2] = 0.3;
-        n[3] = -0.4;
-        n[4] = -0.25;
-        n[5] = 0.5;
-        let want = 2.0 * (-0.05f64).exp() - 0.1 * 0.25 - 0.2 * 0.25 - 0.1 * 0.5;
-        assert!((shaping_reward(&n, false) - want).abs() < 1e-15);
     }
 }
