@@ -2,16 +2,21 @@
 
     .venv/bin/python examples/train/evaluate.py runs/hover_ppo --episodes 100
     .venv/bin/python examples/train/evaluate.py runs/hover_ppo --random   # the random bar
+    .venv/bin/python examples/train/evaluate.py policies/lander_static --episodes 100 \
+        --seed-offset 1000000                                # a shipped policy
 
-The folder holds model.zip, vecnormalize.pkl and summary.json (which env and algorithm).
+The folder holds model.zip, vecnormalize.pkl and summary.json (which env and algorithm): a
+train_sb3.py output or a shipped policy under policies/.
 The policy acts deterministically (the mean of its action distribution). Episode k has seed
---seed + k, so two evaluations with the same seeds fly the same episodes; the default seeds
-(1,000,000 and up) are never among the training seeds.
+--seed-offset + k (--seed is the same option), so two evaluations with the same seeds fly
+the same episodes; the default seeds (1,000,000 and up) are never among the training seeds.
 
 What counts as a success:
 - hover (QuadHover-v0): the episode reaches the time limit (truncated: no crash, not out of
   bounds) and ends within 0.5 m of the target;
-- lander (Lander2D-v0): the drone landed on the platform (info['landed']).
+- lander, lander_moving, lander_v0 (Lander2D-v1 static or moving pad, Lander2D-v0): the
+  drone landed on the platform (info['landed']); the touch-down speed relative to the
+  platform and |angle| of the landings are reported too.
 """
 
 from __future__ import annotations
@@ -75,6 +80,7 @@ def evaluate(
     rng = np.random.default_rng(seed)
     e = make_env(p.name, action=action)
     returns, lengths, successes, final_distances = [], [], [], []
+    landing_speeds, landing_angles = [], []
     try:
         for k in range(episodes):
             obs, info = e.reset(seed=seed + k)
@@ -93,6 +99,9 @@ def evaluate(
             successes.append(bool(p.success(terminated, truncated, info)))
             if "distance_to_target" in info:
                 final_distances.append(float(info["distance_to_target"]))
+            if info.get("landed"):
+                landing_speeds.append(float(info["touchdown_speed"]))
+                landing_angles.append(abs(float(info["angle"])))
     finally:
         e.close()
     return dict(
@@ -106,17 +115,35 @@ def evaluate(
         std_return=float(np.std(returns)),
         mean_length=float(np.mean(lengths)),
         median_final_distance_m=float(np.median(final_distances)) if final_distances else None,
+        landings=len(landing_speeds),
+        landing_speed_mean_m_s=_mean(landing_speeds),
+        landing_speed_max_m_s=max(landing_speeds, default=None),
+        landing_angle_mean_rad=_mean(landing_angles),
+        landing_angle_max_rad=max(landing_angles, default=None),
         success=p.success_text,
     )
+
+
+def _mean(values: list[float]) -> float | None:
+    return float(np.mean(values)) if values else None
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("run", type=Path, nargs="?", help="train_sb3.py output folder")
     parser.add_argument("--episodes", type=int, default=100)
-    parser.add_argument("--seed", type=int, default=EVAL_SEED, help="seed of the first episode")
+    parser.add_argument(
+        "--seed-offset",
+        "--seed",
+        dest="seed",
+        type=int,
+        default=EVAL_SEED,
+        help="seed of the first episode (episode k has seed offset + k)",
+    )
     parser.add_argument("--random", action="store_true", help="evaluate random actions instead")
-    parser.add_argument("--env", default="hover", help="with --random: hover or lander")
+    parser.add_argument(
+        "--env", default="hover", help="with --random: hover, lander, lander_moving or lander_v0"
+    )
     parser.add_argument("--json", type=Path, help="also write the figures to this file")
     args = parser.parse_args(argv)
     if args.episodes < 1:
@@ -137,6 +164,12 @@ def main(argv: list[str] | None = None) -> int:
     print(f"  mean episode length {result['mean_length']:.0f} steps")
     if result["median_final_distance_m"] is not None:
         print(f"  median final distance to target {result['median_final_distance_m']:.3f} m")
+    if result["landings"]:
+        print(
+            f"  landings: touch-down speed mean {result['landing_speed_mean_m_s']:.2f} m/s, "
+            f"max {result['landing_speed_max_m_s']:.2f} m/s; |angle| mean "
+            f"{result['landing_angle_mean_rad']:.3f} rad, max {result['landing_angle_max_rad']:.3f}"
+        )
     if args.json is not None:
         args.json.write_text(json.dumps(result, indent=2) + "\n")
     return 0

@@ -104,8 +104,26 @@ PRESETS: dict[str, Preset] = {
             f"{HOVER_SUCCESS_DISTANCE_M} m of the target"
         ),
     ),
+    # Lander2D-v1 (the landing reward; v0's seed reward pays for hovering, see its docstring).
     "lander": Preset(
         name="lander",
+        env_id="flyloop/Lander2D-v1",
+        env_kwargs={"max_steps": 1000},
+        actions=None,
+        success=lander_success,
+        success_text="landed on the platform (info['landed'])",
+    ),
+    "lander_moving": Preset(
+        name="lander_moving",
+        env_id="flyloop/Lander2D-v1",
+        env_kwargs={"max_steps": 1000, "moving_platform": True},
+        actions=None,
+        success=lander_success,
+        success_text="landed on the moving platform (info['landed'])",
+    ),
+    # The seed's reward, to reproduce its defect (PPO learns to hover beside the pad).
+    "lander_v0": Preset(
+        name="lander_v0",
         env_id="flyloop/Lander2D-v0",
         env_kwargs={"max_steps": 1000},
         actions=None,
@@ -118,7 +136,8 @@ ALIASES = {
     "QuadHover": "hover",
     "flyloop/QuadHover-v0": "hover",
     "Lander2D": "lander",
-    "flyloop/Lander2D-v0": "lander",
+    "flyloop/Lander2D-v1": "lander",
+    "flyloop/Lander2D-v0": "lander_v0",
 }
 
 

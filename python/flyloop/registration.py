@@ -11,6 +11,10 @@ ENVS = {
         "flyloop.vector:quad_waypoints_vector",
     ),
     "flyloop/Lander2D-v0": ("flyloop.envs:Lander2DEnv", "flyloop.vector:lander2d_vector"),
+    "flyloop/Lander2D-v1": (
+        "flyloop.envs:Lander2DLandingEnv",
+        "flyloop.vector:lander2d_landing_vector",
+    ),
 }
 
 

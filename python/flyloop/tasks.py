@@ -244,6 +244,9 @@ class TaskSpec:
     name: str  # the core's task name: the SITL's --task and the frame's DEBUG_FLOAT_ARRAY name
     env_id: str
     arguments: tuple[Argument, ...]
+    # Core parameters the env id fixes, not the caller: (name, value) pairs, e.g.
+    # Lander2D-v1's reward_version. resolve_config adds them to every config.
+    fixed: tuple[tuple[str, float], ...] = ()
 
     @property
     def parameters(self) -> tuple[dict[str, Any], ...]:
@@ -288,7 +291,13 @@ HOVER = TaskSpec("hover", "flyloop/QuadHover-v0", tuple(FLIGHT_ARGUMENTS))
 WAYPOINTS = TaskSpec(
     "waypoints", "flyloop/QuadWaypoints-v0", tuple(FLIGHT_ARGUMENTS + WAYPOINT_ARGUMENTS)
 )
-LANDING = TaskSpec("landing", "flyloop/Lander2D-v0", tuple(LANDING_ARGUMENTS))
+# The seed's reward (reward_version 0) and the landing reward (1): one task, two env ids.
+LANDING = TaskSpec(
+    "landing", "flyloop/Lander2D-v0", tuple(LANDING_ARGUMENTS), (("reward_version", 0),)
+)
+LANDING_V1 = TaskSpec(
+    "landing", "flyloop/Lander2D-v1", tuple(LANDING_ARGUMENTS), (("reward_version", 1),)
+)
 TASKS = {t.name: t for t in (HOVER, WAYPOINTS, LANDING)}
 
 
@@ -303,7 +312,7 @@ def resolve_config(
     """The core parameters (name -> value) for the env arguments and extra model parameters.
     Types are checked here; ranges and relations are checked by the core when the SITL
     starts (errors name the env argument, see `argument_for`)."""
-    config: dict[str, bool | int | float] = {}
+    config: dict[str, bool | int | float] = dict(spec.fixed)
     by_name = {a.name: a for a in spec.arguments}
     for name, value in arguments.items():
         arg = by_name[name]

@@ -30,7 +30,7 @@ from .envs.base import (
     spaces_of,
     start_sitl,
 )
-from .envs.lander2d import Lander2DEnv
+from .envs.lander2d import Lander2DEnv, Lander2DLandingEnv
 from .envs.quad_hover import QuadHoverEnv
 from .envs.quad_waypoints import QuadWaypointsEnv
 from .errors import SitlError
@@ -263,6 +263,14 @@ class Lander2DVectorEnv(FlyloopVectorEnv):
     SINGLE = Lander2DEnv
 
 
+class Lander2DLandingVectorEnv(FlyloopVectorEnv):
+    """`num_envs` Lander2D-v1 vehicles (landing reward) in one SITL (arguments as
+    Lander2DLandingEnv)."""
+
+    SPEC = Lander2DLandingEnv.SPEC
+    SINGLE = Lander2DLandingEnv
+
+
 def _vector_entry(sitl_class: type[FlyloopVectorEnv]):
     """The vector entry point of an env id: `backend="sitl"` (default) or `"native"`."""
 
@@ -279,3 +287,4 @@ def _vector_entry(sitl_class: type[FlyloopVectorEnv]):
 quad_hover_vector = _vector_entry(QuadHoverVectorEnv)
 quad_waypoints_vector = _vector_entry(QuadWaypointsVectorEnv)
 lander2d_vector = _vector_entry(Lander2DVectorEnv)
+lander2d_landing_vector = _vector_entry(Lander2DLandingVectorEnv)

@@ -9,7 +9,7 @@ import gymnasium as gym
 import pytest
 from gymnasium.utils.env_checker import check_env as gym_check_env
 
-from flyloop.envs import Lander2DEnv, QuadHoverEnv, QuadWaypointsEnv
+from flyloop.envs import Lander2DEnv, Lander2DLandingEnv, QuadHoverEnv, QuadWaypointsEnv
 from flyloop.wrappers import MotionPrimitiveActionWrapper, ThrustChangeController
 
 MAKERS = {
@@ -17,6 +17,8 @@ MAKERS = {
     "QuadWaypoints": lambda: QuadWaypointsEnv(),
     "Lander2D": lambda: Lander2DEnv(),
     "Lander2D-moving": lambda: Lander2DEnv(moving_platform=True),
+    "Lander2D-v1": lambda: Lander2DLandingEnv(),
+    "Lander2D-v1-moving": lambda: Lander2DLandingEnv(moving_platform=True),
     "ThrustChangeController": lambda: ThrustChangeController(QuadHoverEnv()),
     "MotionPrimitive": lambda: MotionPrimitiveActionWrapper(QuadWaypointsEnv()),
 }
@@ -59,7 +61,9 @@ def test_stable_baselines3_check_env_passes_without_a_warning(built, name):
         sb3_checker.check_env(env, warn=True)
 
 
-@pytest.mark.parametrize("env_id", ["flyloop/QuadHover-v0", "flyloop/Lander2D-v0"])
+@pytest.mark.parametrize(
+    "env_id", ["flyloop/QuadHover-v0", "flyloop/Lander2D-v0", "flyloop/Lander2D-v1"]
+)
 def test_the_made_env_passes_with_its_passive_checker_and_rendering(sitl_binary, env_id):
     env = gym.make(env_id, render_mode="rgb_array")
     try:

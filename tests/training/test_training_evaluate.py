@@ -69,7 +69,7 @@ def test_evaluate_loads_sac_and_lander_runs(sitl_binary, tmp_path):
     summary = train_tiny(lander, "lander", "ppo", 1024)
     assert summary["action"] is None
     result = evaluate.evaluate(lander, 2)
-    assert result["env_id"] == "flyloop/Lander2D-v0"
+    assert result["env_id"] == "flyloop/Lander2D-v1"
     assert result["median_final_distance_m"] is None  # hover-only figure
     assert np.isfinite(result["mean_return"])
 

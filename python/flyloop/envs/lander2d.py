@@ -1,11 +1,12 @@
-"""flyloop/Lander2D-v0: land a 2D two-motor drone on a (possibly moving) platform."""
+"""flyloop/Lander2D-v0 and -v1: land a 2D two-motor drone on a (possibly moving) platform.
+v0 keeps the seed's reward, v1 pays for landing."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from typing import Any
 
-from ..tasks import LANDING, parameter_values
+from ..tasks import LANDING, LANDING_V1, parameter_values
 from .base import FlyloopEnv
 
 
@@ -25,9 +26,11 @@ class Lander2DEnv(FlyloopEnv):
 
     ## Action space
 
-    ``Box(-1, 1, (2,), float32)``: left and right motor; a maps to thrust (a + 1)/2 · 15 N,
-    plus Gaussian noise (σ = 1.5 N, seeded), along the body's +y at x = ∓0.4 m. Values outside
-    [−1, 1] are clipped by the core; a non-finite value raises ``ValueError``.
+    ``Box(-1, 1, (2,), float32)``: left and right motor; a maps to thrust T = (a + 1)/2 · 15 N,
+    times (1 + seeded Gaussian noise of σ = ``thrust_noise_std``/15 N = 10 %), clipped to
+    [0, 15] N, along the body's +y at x = ∓0.4 m: a stopped motor (a = −1) gives exactly zero
+    thrust. Values outside [−1, 1] are clipped by the core; a non-finite value raises
+    ``ValueError``.
 
     ## Observation space
 
@@ -45,12 +48,18 @@ class Lander2DEnv(FlyloopEnv):
     | 10 | distance to the platform / 50 |
     | 11 | platform vx / platform_speed (only with ``moving_platform=True``) |
 
-    ## Reward
+    ## Reward (the seed's, exactly)
 
     Per step on the observation values n: ``2·exp(−0.1·n10) − 0.1·(n2² + n3²) − 0.2·|n4| −
     0.1·|n5|``, +5 on a step touching the platform. The first terminal condition adds: landed
     +100 if calm (‖(n2, n3)‖ < 0.1 and |n5| < 0.1) else +20; crashed −50; lost control −50;
     battery empty −50; out of bounds −50; time limit −10.
+
+    This reward does not teach landing: it pays ≈ 2 per step for being near the pad, ≈ 2,000
+    over a 1,000-step episode, against +100 for a landing that ends the episode early. Hovering
+    beside the pad until the time limit is its optimum, and PPO finds it (0 % landings).
+    ``flyloop/Lander2D-v1`` (:class:`Lander2DLandingEnv`) is the same env with a reward under
+    which landing pays; v0 stays for reproducing the seed's results.
 
     ## Starting state
 
@@ -102,6 +111,14 @@ class Lander2DEnv(FlyloopEnv):
     - v0: first version. Differs from the seed on purpose: a rigid drone by construction, a
       pad landing no longer also counts as a ground crash, the time limit fires at exactly
       ``max_steps`` and is a truncation, wind can be switched off, seeded resets.
+    - v0, physics fix (issue 13): the thrust noise scales with the commanded thrust (σ 10 % of
+      it, the seed's 1.5 N at full thrust) instead of adding 1.5 N at every level. In the seed
+      a stopped motor (a = −1) still pushed ≈ 0.6 N on average, up to ~4 N, and drained the
+      battery; now it gives zero thrust and drains nothing. The reward *formula* is the
+      seed's, bit for bit (same function of the same observation; a core test checks it on
+      every step), but the dynamics it is computed on are the fixed ones, so returns of the
+      same seeds and actions differ from before the fix. The id stays v0 because its contract
+      — the seed's reward — is unchanged, and a physics bug is not behaviour worth keeping.
     """
 
     SPEC = LANDING
@@ -183,3 +200,40 @@ class Lander2DEnv(FlyloopEnv):
             max_steps=int(values["max_steps"]),
             params=values,
         )
+
+
+class Lander2DLandingEnv(Lander2DEnv):
+    """``flyloop/Lander2D-v1``: Lander2D with a reward that pays for landing.
+
+    Everything — arguments, spaces, physics, starts, episode ends, info, rendering, both
+    backends — is :class:`Lander2DEnv`'s (``flyloop/Lander2D-v0``); only the reward differs
+    (core parameter ``reward_version`` = 1, core/src/tasks/landing_reward.rs).
+
+    ## Reward
+
+    Potential-based shaping (Ng, Harada & Russell 1999; as gymnasium's LunarLander) plus a
+    control cost and terminal rewards::
+
+        Φ(s) = −(4·d + 10·v_rel + 50·|angle| + 10·|ω|)
+        r    = Φ(s′) − Φ(s) − 0.05·((a_left + 1)/2 + (a_right + 1)/2)/2 + terminal
+
+    with d the distance (m) from the drone's centre to the platform's top centre, v_rel the
+    speed (m/s) relative to the platform, angle (rad) wrapped, ω (rad/s). Terminal: landed
+    +100; crashed, lost control, battery empty, out of the world −100 each; the time limit
+    (truncation at ``max_steps``) −100 too: not landing is a failure.
+
+    The shaping sums to Φ(end) − Φ(start) over an episode, so it cannot pay for hovering:
+    from a spawn ≈ 30 m away, landing earns ≈ +200, hovering near the pad until the time limit
+    ≈ −15, a crash ≈ −100 + what the approach earned. A core test checks with two scripted
+    pilots over 40 seeds that every safe landing beats every hover by more than 100.
+
+    Success is ``info["landed"]``. Scripted baseline: examples/lander_pilot.py.
+
+    ## Version history
+
+    - v1 (issue 13): the landing reward above; v0's physics (including v0's physics fix:
+      thrust noise proportional to thrust, a stopped motor gives zero thrust and drains
+      nothing).
+    """
+
+    SPEC = LANDING_V1
