@@ -71,7 +71,7 @@ class LanderPilot:
         ax = 1.5 * err[0] + self.integral[0]
         ay = 2.0 * err[1] + self.integral[1]
         # Touch down nearly level (the limit is 0.2 rad): drifting with the wind is safer.
-        max_tilt = 0.12 if height < 1.0 else 0.35
+        max_tilt = 0.16 if height < 1.0 else 0.35
         tilt = _clamp(-math.atan2(ax, GRAVITY + ay), -max_tilt, max_tilt)
         collective = _clamp(MASS * (GRAVITY + ay) / math.cos(tilt), 0.0, 2.0 * MAX_THRUST)
         torque = INERTIA * (20.0 * (tilt - angle) - 8.0 * rate)

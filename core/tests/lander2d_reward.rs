@@ -221,7 +221,7 @@ impl Pilot {
         let ax = 1.5 * err[0] + 1.0 * self.integral[0];
         let ay = 2.0 * err[1] + 1.0 * self.integral[1];
         // Touch down nearly level (the limit is 0.2 rad): drifting with the wind is safer.
-        let max_tilt = if height < 1.0 { 0.12 } else { 0.35 };
+        let max_tilt = if height < 1.0 { 0.16 } else { 0.35 };
         let tilt = (-ax.atan2(p.gravity + ay)).clamp(-max_tilt, max_tilt);
         let collective =
             (p.drone_mass * (p.gravity + ay) / tilt.cos()).clamp(0.0, 2.0 * p.max_thrust);
