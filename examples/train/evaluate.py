@@ -67,6 +67,7 @@ def evaluate(
     seed: int = EVAL_SEED,
     *,
     env: str | None = None,
+    backend: str = "native",
 ) -> dict[str, Any]:
     """Runs `episodes` episodes of the saved policy in `folder` (or of uniformly random
     actions when folder is None; then `env` names the preset) and returns the figures."""
@@ -78,7 +79,7 @@ def evaluate(
     p = run.preset if run is not None else preset(env or "hover")
     action = run.summary.get("action") if run is not None else None
     rng = np.random.default_rng(seed)
-    e = make_env(p.name, action=action)
+    e = make_env(p.name, action=action, backend=backend)
     returns, lengths, successes, final_distances = [], [], [], []
     landing_speeds, landing_angles = [], []
     try:
@@ -144,6 +145,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--env", default="hover", help="with --random: hover, lander, lander_moving or lander_v0"
     )
+    parser.add_argument(
+        "--backend",
+        default="native",
+        choices=("native", "sitl"),
+        help="the core in this process (default) or a flyloop-sitl process: same episodes",
+    )
     parser.add_argument("--json", type=Path, help="also write the figures to this file")
     args = parser.parse_args(argv)
     if args.episodes < 1:
@@ -151,7 +158,13 @@ def main(argv: list[str] | None = None) -> int:
     if args.random == (args.run is not None):
         parser.error("give either a run folder or --random")
     try:
-        result = evaluate(None if args.random else args.run, args.episodes, args.seed, env=args.env)
+        result = evaluate(
+            None if args.random else args.run,
+            args.episodes,
+            args.seed,
+            env=args.env,
+            backend=args.backend,
+        )
     except (FileNotFoundError, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -69,11 +69,11 @@ class EpisodeRecorder(BaseCallback):
 
 
 def make_vec_env(
-    env: str, action: str | None, n_envs: int, seed: int, gamma: float
+    env: str, action: str | None, n_envs: int, seed: int, gamma: float, backend: str = "native"
 ) -> VecNormalize:
-    """n_envs preset envs (one SITL each), monitored and normalised; env i's first episode
-    has seed `seed + i`."""
-    venv = DummyVecEnv([lambda: make_success_env(env, action=action)] * n_envs)
+    """n_envs preset envs (one SITL each, or in-process with backend="native"), monitored
+    and normalised; env i's first episode has seed `seed + i`."""
+    venv = DummyVecEnv([lambda: make_success_env(env, action=action, backend=backend)] * n_envs)
     venv.seed(seed)
     return VecNormalize(VecMonitor(venv), gamma=gamma)
 
@@ -89,6 +89,8 @@ def train(
     progress_bar: bool = True,
     baseline_episodes: int = 20,
     n_envs: int | None = None,
+    backend: str = "native",
+    hyper_overrides: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Trains, saves everything under `out` and returns the summary (also in summary.json)."""
     torch.set_num_threads(1)
@@ -96,20 +98,20 @@ def train(
     if algo not in ALGORITHMS:
         raise ValueError(f"unknown algorithm {algo!r}; choose one of {sorted(ALGORITHMS)}")
     action = check_action(p, action)
-    hyper = dict(HYPERPARAMETERS[(p.name, algo)])
+    hyper = {**HYPERPARAMETERS[(p.name, algo)], **(hyper_overrides or {})}
     n = int(hyper.pop("n_envs"))
     n = n if n_envs is None else int(n_envs)
     out.mkdir(parents=True, exist_ok=True)
 
     random_return, random_success = random_policy_baseline(
-        p.name, episodes=baseline_episodes, seed=10_000 + seed, action=action
+        p.name, episodes=baseline_episodes, seed=10_000 + seed, action=action, backend=backend
     )
     print(
         f"random policy on {p.env_id}: mean return {random_return:.1f}, "
         f"success {100 * random_success:.0f} % ({baseline_episodes} episodes)"
     )
 
-    venv = make_vec_env(p.name, action, n, seed, gamma=hyper.get("gamma", 0.99))
+    venv = make_vec_env(p.name, action, n, seed, gamma=hyper.get("gamma", 0.99), backend=backend)
     log = EpisodeLog()
     try:
         model = ALGORITHMS[algo](
@@ -145,6 +147,7 @@ def train(
         env_kwargs=dict(p.env_kwargs),
         action=action,
         algo=algo,
+        backend=backend,
         seed=seed,
         n_envs=n,
         timesteps=steps,

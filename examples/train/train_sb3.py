@@ -10,9 +10,10 @@ rollout/ep_rew_mean, rollout/success_rate, losses), episodes.csv (every training
 learning_curve.png and summary.json (wall time, env steps/s, the random policy's mean
 return). Prints a progress bar while it trains, then the wall time and env steps/s.
 
-Each of the --n-envs envs runs its own flyloop-sitl process (found through FLYLOOP_SITL, PATH
-or the workspace build; see the flyloop package's README). Torch runs on one CPU thread: the
-policy is small and the envs need the other core.
+The --n-envs envs run the core in this process (--backend native, the default) or each its
+own flyloop-sitl process (--backend sitl; found through FLYLOOP_SITL, PATH or the workspace
+build; see the flyloop package's README): the same episodes bit for bit. Torch runs on one
+CPU thread: the policy is small and the envs need the other core.
 """
 
 from __future__ import annotations
@@ -29,7 +30,10 @@ ALGORITHMS = ("ppo", "sac")
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
-        "--env", default="hover", help="hover (QuadHover-v0) or lander (Lander2D-v0)"
+        "--env",
+        default="hover",
+        help="hover (QuadHover-v0), lander (Lander2D-v1, static pad), lander_moving "
+        "(Lander2D-v1, moving pad) or lander_v0 (Lander2D-v0, the seed's reward)",
     )
     parser.add_argument("--algo", default="ppo", choices=ALGORITHMS)
     parser.add_argument(
@@ -46,6 +50,13 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument(
         "--baseline-episodes", type=int, default=20, help="episodes of the random policy's bar"
+    )
+    parser.add_argument(
+        "--backend",
+        default="native",
+        choices=("native", "sitl"),
+        help="sitl: one flyloop-sitl process per env; native: the core in this process "
+        "(same episodes bit for bit, several times faster)",
     )
     parser.add_argument("--no-progress-bar", action="store_true")
     args = parser.parse_args(argv)
@@ -73,6 +84,7 @@ def main(argv: list[str] | None = None) -> int:
         progress_bar=not args.no_progress_bar,
         baseline_episodes=args.baseline_episodes,
         n_envs=args.n_envs,
+        backend=args.backend,
     )
     print(
         f"trained {s['algo'].upper()} on {s['env_id']} for {s['timesteps']:,} env steps "

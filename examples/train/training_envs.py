@@ -165,13 +165,15 @@ def make_env(
     action: str | None = None,
     render_mode: str | None = None,
     overrides: Mapping[str, Any] | None = None,
+    backend: str = "native",
 ) -> gym.Env:
     """The preset's env with its action interface (default: the preset's first), as it is
-    trained; each env starts its own SITL."""
+    trained; with backend="sitl" each env starts its own SITL, with "native" the core runs
+    in this process (same episodes, bit for bit)."""
     p = preset(name)
     action = check_action(p, action)
     kwargs = {**p.env_kwargs, **(overrides or {})}
-    env = gym.make(p.env_id, render_mode=render_mode, **kwargs)
+    env = gym.make(p.env_id, render_mode=render_mode, backend=backend, **kwargs)
     return p.actions[action](env) if action is not None else env
 
 
@@ -181,11 +183,11 @@ def make_success_env(name: str, **kwargs: Any) -> gym.Env:
 
 
 def random_policy_baseline(
-    name: str, episodes: int, seed: int, action: str | None = None
+    name: str, episodes: int, seed: int, action: str | None = None, backend: str = "native"
 ) -> tuple[float, float]:
     """Mean return and success rate of uniformly random actions (the bar training must
     clear), over `episodes` episodes seeded seed, seed + 1, ..."""
-    env = make_env(name, action=action)
+    env = make_env(name, action=action, backend=backend)
     rng = np.random.default_rng(seed)
     p = preset(name)
     returns, successes = [], 0
