@@ -1,0 +1,27 @@
+"""The trained policies shipped under policies/ load with evaluate.py and do what their
+summary says, on seeded episodes that training never saw (training used seeds from 0; these
+start at 2,000,000). No training here: 20 episodes of a saved policy, seconds."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from training_support import REPO
+
+POLICIES = REPO / "policies"
+HELD_BACK_SEEDS = 2_000_000
+
+
+@pytest.mark.parametrize("name", ["lander_static"])
+def test_a_shipped_lander_policy_lands_on_held_back_seeds(name: str):
+    import evaluate
+
+    folder: Path = POLICIES / name
+    result = evaluate.evaluate(folder, 20, HELD_BACK_SEEDS)
+    assert result["env_id"] == "flyloop/Lander2D-v1"
+    print(result)
+    # 92 % on 100 held-out episodes (seeds 1,000,000..1,000,099) when it was shipped.
+    assert result["success_rate"] >= 0.85, result
+    # Safe landings only count: slower than 1.5 m/s, within 0.2 rad of level.
+    assert result["landing_speed_max_m_s"] < 1.5 and result["landing_angle_max_rad"] < 0.2
