@@ -55,6 +55,8 @@ def env_creator(env_config: dict[str, Any]):
         env_config.get("env", "hover"),
         action=env_config.get("action"),
         overrides=env_config.get("env_kwargs"),
+        # Each env runner flies its own SITL process (make_env's default is in-process).
+        backend=env_config.get("backend", "sitl"),
     )
 
 

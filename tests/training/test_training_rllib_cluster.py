@@ -92,8 +92,10 @@ def test_the_readme_cluster_commands_train_on_a_two_node_cluster(sitl_binary, tm
     env = dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}")
     env["RAY_ADDRESS"] = f"127.0.0.1:{port}"  # what `--address auto` finds
     env["FLYLOOP_SITL"] = str(sitl_binary)
-    # A home of its own: Ray reads ~/.ray (e.g. an auth_token left by another Ray on this
-    # machine), and the nodes and the driver must agree on it.
+    # Ray >= 2.60 turns token authentication on for a new local cluster (and an in-process
+    # ray.init() earlier in this test run exports RAY_AUTH_MODE=token); nodes and driver must
+    # agree. This loopback cluster runs without it, in a home of its own (no ~/.ray token).
+    env["RAY_AUTH_MODE"] = "disabled"
     (tmp_path / "home").mkdir()
     env["HOME"] = str(tmp_path / "home")
 
