@@ -22,6 +22,7 @@ from pathlib import Path
 import flyloop  # noqa: F401  (registers the envs)
 import gymnasium as gym
 import numpy as np
+from flyloop.rendering import save_video
 
 ROOT = Path(__file__).resolve().parents[1]
 # runs/ is git-ignored: running the demo leaves the checkout clean.
@@ -131,32 +132,6 @@ def fly(
         env.close()
 
 
-def save_gif(frames: list[np.ndarray], path: Path, fps: float, colors: int = 128) -> Path:
-    """Writes frames as a looping GIF with ONE palette drawn from a sample of the frames, so
-    Pillow can store each frame as its difference to the last (about 7 kB a frame here,
-    against 50 kB with a palette per frame)."""
-    from PIL import Image
-
-    images = [Image.fromarray(f) for f in frames]
-    sample = images[:: max(1, len(images) // 10)]
-    width, height = images[0].size
-    sheet = Image.new("RGB", (width, height * len(sample)))
-    for i, image in enumerate(sample):
-        sheet.paste(image, (0, height * i))
-    palette = sheet.quantize(colors=colors, method=Image.Quantize.MAXCOVERAGE)
-    quantized = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
-    path.parent.mkdir(parents=True, exist_ok=True)
-    quantized[0].save(
-        path,
-        save_all=True,
-        append_images=quantized[1:],
-        duration=round(1000.0 / fps),
-        loop=0,
-        optimize=True,
-    )
-    return path
-
-
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seed", type=int, default=3, help="episode seed (target and wind)")
@@ -168,7 +143,7 @@ def main(argv: list[str] | None = None) -> int:
     start = time.perf_counter()
     kwargs = {"use_wind": False} if args.no_wind else {}
     flight = fly(seed=args.seed, seconds=args.seconds, **kwargs)
-    save_gif(flight["frames"], args.out, fps=flight["fps"])
+    save_video(flight["frames"], args.out, fps=flight["fps"])
     d = flight["distances"]
     ending = "time limit reached" if flight["truncated"] else "terminated (crash/out of bounds)"
     print(f"QuadHover-v0, seed {args.seed}, PD controller through the gym env and the SITL:")

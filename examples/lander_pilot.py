@@ -100,10 +100,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed-offset", type=int, default=0)
     parser.add_argument("--moving", action="store_true", help="moving platform")
     parser.add_argument("--env", default="flyloop/Lander2D-v1")
+    parser.add_argument(
+        "--backend",
+        default="native",
+        choices=("native", "sitl"),
+        help="the core in this process (default) or a flyloop-sitl process: same episodes",
+    )
     args = parser.parse_args(argv)
     if args.episodes < 1:
         parser.error("--episodes must be >= 1")
-    env = gym.make(args.env, moving_platform=args.moving)
+    env = gym.make(args.env, moving_platform=args.moving, backend=args.backend)
     try:
         flights = [fly(env, args.seed_offset + i) for i in range(args.episodes)]
     finally:

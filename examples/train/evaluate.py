@@ -152,6 +152,11 @@ def main(argv: list[str] | None = None) -> int:
         help="the core in this process (default) or a flyloop-sitl process: same episodes",
     )
     parser.add_argument("--json", type=Path, help="also write the figures to this file")
+    parser.add_argument(
+        "--gif",
+        type=Path,
+        help="also record the first episode (seed --seed-offset) of the policy to this GIF/MP4",
+    )
     args = parser.parse_args(argv)
     if args.episodes < 1:
         parser.error("--episodes must be >= 1")
@@ -185,7 +190,62 @@ def main(argv: list[str] | None = None) -> int:
         )
     if args.json is not None:
         args.json.write_text(json.dumps(result, indent=2) + "\n")
+    if args.gif is not None:
+        shot = record(None if args.random else args.run, args.gif, args.seed, env=args.env)
+        ending = "landed" if shot["success"] else "did not succeed"
+        print(f"  recorded seed {args.seed} ({shot['steps']} steps, {ending}) to {args.gif}")
     return 0
+
+
+def record(
+    folder: Path | None,
+    path: Path,
+    seed: int,
+    *,
+    env: str | None = None,
+    frame_every: int = 2,
+    scale: float = 0.5,
+) -> dict[str, Any]:
+    """Records one episode (seed `seed`) of the saved policy in `folder` (random actions when
+    None), acting as in evaluate(), rendered with render_mode="rgb_array": every
+    `frame_every`-th step, scaled by `scale`, played at real time, to a GIF or MP4."""
+    from flyloop.rendering import save_video
+    from PIL import Image
+
+    run = SavedRun(folder) if folder is not None else None
+    p = run.preset if run is not None else preset(env or "hover")
+    action = run.summary.get("action") if run is not None else None
+    e = make_env(p.name, action=action, render_mode="rgb_array")
+    rng = np.random.default_rng(seed)
+
+    def shrink(frame: np.ndarray) -> np.ndarray:
+        image = Image.fromarray(frame)
+        size = (round(image.width * scale), round(image.height * scale))
+        return np.asarray(image.resize(size, Image.Resampling.LANCZOS))
+
+    try:
+        obs, info = e.reset(seed=seed)
+        frames, steps, done = [shrink(e.render())], 0, False
+        while not done:
+            if run is not None:
+                a = run.act(obs)
+            else:
+                a = rng.uniform(e.action_space.low, e.action_space.high)
+            obs, _, terminated, truncated, info = e.step(a.astype(np.float32))
+            steps += 1
+            done = terminated or truncated
+            if done or steps % frame_every == 0:
+                frames.append(shrink(e.render()))
+        fps = 1.0 / (e.unwrapped.dt * frame_every)
+    finally:
+        e.close()
+    save_video(frames, path, fps=fps)
+    return dict(
+        path=path,
+        frames=len(frames),
+        steps=steps,
+        success=bool(p.success(terminated, truncated, info)),
+    )
 
 
 if __name__ == "__main__":

@@ -25,3 +25,21 @@ def test_a_shipped_lander_policy_lands_on_held_back_seeds(name: str):
     assert result["success_rate"] >= 0.85, result
     # Safe landings only count: slower than 1.5 m/s, within 0.2 rad of level.
     assert result["landing_speed_max_m_s"] < 1.5 and result["landing_angle_max_rad"] < 0.2
+
+
+def test_evaluate_records_the_evaluated_episode_as_a_gif(tmp_path):
+    """--gif records the first evaluation episode, acting exactly as the evaluation does: the
+    recording's ending (landed or not) and length agree with a one-episode evaluation."""
+    import evaluate
+    from PIL import Image
+
+    folder = POLICIES / "lander_static"
+    seed = HELD_BACK_SEEDS
+    shot = evaluate.record(folder, tmp_path / "landing.gif", seed)
+    result = evaluate.evaluate(folder, 1, seed)
+    assert shot["success"] == (result["success_rate"] == 1.0)
+    assert shot["steps"] == result["mean_length"]
+    with Image.open(shot["path"]) as gif:
+        assert gif.size == (400, 400)  # the 800 x 800 view, halved
+        # Every 2nd step plus the first and the last frame.
+        assert gif.n_frames == shot["frames"] == 1 + (shot["steps"] + 1) // 2
