@@ -69,13 +69,28 @@ class EpisodeRecorder(BaseCallback):
 
 
 def make_vec_env(
-    env: str, action: str | None, n_envs: int, seed: int, gamma: float, backend: str = "native"
+    env: str,
+    action: str | None,
+    n_envs: int,
+    seed: int,
+    gamma: float,
+    backend: str = "native",
+    statistics: Path | None = None,
 ) -> VecNormalize:
     """n_envs preset envs (one SITL each, or in-process with backend="native"), monitored
-    and normalised; env i's first episode has seed `seed + i`."""
+    and normalised (starting from the normalisation `statistics` of an earlier run, if
+    given); env i's first episode has seed `seed + i`."""
     venv = DummyVecEnv([lambda: make_success_env(env, action=action, backend=backend)] * n_envs)
     venv.seed(seed)
+    if statistics is not None:
+        return VecNormalize.load(str(statistics), VecMonitor(venv))
     return VecNormalize(VecMonitor(venv), gamma=gamma)
+
+
+def linear_decay(start: float):
+    """A learning rate falling linearly from `start` to 0 over the run (stable-baselines3
+    calls it with the fraction of the run remaining)."""
+    return lambda remaining: start * remaining
 
 
 def train(
@@ -91,8 +106,12 @@ def train(
     n_envs: int | None = None,
     backend: str = "native",
     hyper_overrides: dict[str, Any] | None = None,
+    init_from: Path | None = None,
+    lr_decay: bool = False,
 ) -> dict[str, Any]:
-    """Trains, saves everything under `out` and returns the summary (also in summary.json)."""
+    """Trains, saves everything under `out` and returns the summary (also in summary.json).
+    `init_from`: continue from the policy and normalisation of an earlier run's folder;
+    `lr_decay`: the learning rate falls linearly to 0 over this run."""
     torch.set_num_threads(1)
     p = preset(env)
     if algo not in ALGORITHMS:
@@ -111,18 +130,33 @@ def train(
         f"success {100 * random_success:.0f} % ({baseline_episodes} episodes)"
     )
 
-    venv = make_vec_env(p.name, action, n, seed, gamma=hyper.get("gamma", 0.99), backend=backend)
+    if lr_decay:
+        hyper["learning_rate"] = linear_decay(hyper["learning_rate"])
+    statistics = Path(init_from) / "vecnormalize.pkl" if init_from is not None else None
+    gamma = hyper.get("gamma", 0.99)
+    venv = make_vec_env(p.name, action, n, seed, gamma, backend=backend, statistics=statistics)
     log = EpisodeLog()
     try:
-        model = ALGORITHMS[algo](
-            "MlpPolicy",
-            venv,
-            seed=seed,
-            verbose=0,
-            tensorboard_log=str(out / "tb"),
-            device="cpu",
-            **hyper,
-        )
+        if init_from is None:
+            model = ALGORITHMS[algo](
+                "MlpPolicy",
+                venv,
+                seed=seed,
+                verbose=0,
+                tensorboard_log=str(out / "tb"),
+                device="cpu",
+                **hyper,
+            )
+        else:
+            model = ALGORITHMS[algo].load(
+                Path(init_from) / "model.zip",
+                env=venv,
+                device="cpu",
+                seed=seed,
+                tensorboard_log=str(out / "tb"),
+                custom_objects={"learning_rate": hyper["learning_rate"]},
+            )
+            model.set_random_seed(seed)
         start = time.perf_counter()
         model.learn(
             total_timesteps=timesteps,
@@ -159,6 +193,8 @@ def train(
         last_tenth_mean_return=float(np.mean(log.returns[last])) if len(log) else None,
         last_tenth_success_rate=float(np.mean(log.successes[last])) if len(log) else None,
         success=p.success_text,
+        init_from=str(init_from) if init_from is not None else None,
+        lr_decay=lr_decay,
     )
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
     return summary

@@ -58,6 +58,16 @@ def main(argv: list[str] | None = None) -> int:
         help="sitl: one flyloop-sitl process per env; native: the core in this process "
         "(same episodes bit for bit, several times faster)",
     )
+    parser.add_argument(
+        "--init-from",
+        type=Path,
+        help="continue from an earlier run's folder (its policy and normalisation statistics)",
+    )
+    parser.add_argument(
+        "--lr-decay",
+        action="store_true",
+        help="learning rate falling linearly to 0 over this run (settles a policy at the end)",
+    )
     parser.add_argument("--no-progress-bar", action="store_true")
     args = parser.parse_args(argv)
     if args.timesteps <= 0:
@@ -85,6 +95,8 @@ def main(argv: list[str] | None = None) -> int:
         baseline_episodes=args.baseline_episodes,
         n_envs=args.n_envs,
         backend=args.backend,
+        init_from=args.init_from,
+        lr_decay=args.lr_decay,
     )
     print(
         f"trained {s['algo'].upper()} on {s['env_id']} for {s['timesteps']:,} env steps "

@@ -90,3 +90,37 @@ def test_train_refuses_bad_arguments(tmp_path):
         assert done.returncode == 2, args
         assert message in done.stderr, done.stderr
         assert not (tmp_path / "x").exists()
+
+
+@pytest.mark.training
+def test_training_continues_from_a_saved_run_with_a_decaying_learning_rate(tmp_path):
+    """--init-from starts from the saved policy and normalisation statistics (not from
+    scratch), --lr-decay anneals the learning rate to 0 over the continued run."""
+    import evaluate
+    from sb3_training import train
+
+    first = tmp_path / "first"
+    train("lander", "ppo", 4096, 0, first, n_envs=2, progress_bar=False, baseline_episodes=1)
+    before = evaluate.SavedRun(first)
+    second = tmp_path / "second"
+    s = train(
+        "lander",
+        "ppo",
+        2048,
+        1,
+        second,
+        n_envs=2,
+        progress_bar=False,
+        baseline_episodes=1,
+        init_from=first,
+        lr_decay=True,
+    )
+    assert s["init_from"] == str(first) and s["lr_decay"] is True
+    assert s["timesteps"] == 2048  # counted from 0 again
+    after = evaluate.SavedRun(second)
+    # The statistics went on from the first run's count, not from a fresh VecNormalize (the
+    # 2048 steps' observations and the first reset's 2).
+    assert after.norm.obs_rms.count == before.norm.obs_rms.count + 2048 + 2
+    # The learning rate fell linearly to 0: the last update ran at (almost) 0.
+    assert after.model.lr_schedule(0.0) == 0.0
+    assert after.model.lr_schedule(1.0) == pytest.approx(3e-4)
