@@ -1,9 +1,18 @@
 """Episode log of a training run and its learning-curve plot (PNG, matplotlib without a
-display)."""
+display).
+
+As a command it redraws the curve of one run, or of consecutive runs (a run continued with
+train_sb3.py --init-from) as one curve, from their episodes.csv and summary.json:
+
+    .venv/bin/python examples/train/learning_curve.py RUN [RUN ...] --out curve.png
+"""
 
 from __future__ import annotations
 
+import argparse
 import csv
+import json
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -35,6 +44,25 @@ class EpisodeLog:
             out.writerows(
                 zip(self.steps, self.returns, self.lengths, map(int, self.successes), strict=True)
             )
+
+
+def read_runs(folders: list[Path]) -> tuple[EpisodeLog, list[dict]]:
+    """The episode logs of consecutive runs as one log (each run's env steps counted on from
+    the end of the run before), and the runs' summaries."""
+    log, summaries, offset = EpisodeLog(), [], 0
+    for folder in folders:
+        summary = json.loads((Path(folder) / "summary.json").read_text())
+        with open(Path(folder) / "episodes.csv", newline="") as f:
+            for row in csv.DictReader(f):
+                log.add(
+                    offset + int(row["env_steps"]),
+                    float(row["return"]),
+                    int(row["length"]),
+                    row["success"] == "1",
+                )
+        offset += int(summary["timesteps"])
+        summaries.append(summary)
+    return log, summaries
 
 
 def rolling_mean(values: list[float], window: int) -> np.ndarray:
@@ -87,3 +115,27 @@ def plot_learning_curve(
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=100)
     return path
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[1])
+    parser.add_argument("runs", type=Path, nargs="+", help="train_sb3.py output folders, in order")
+    parser.add_argument("--out", type=Path, required=True, help="PNG to write")
+    args = parser.parse_args(argv)
+    log, summaries = read_runs(args.runs)
+    first = summaries[0]
+    steps = sum(int(s["timesteps"]) for s in summaries)
+    wall = sum(float(s["wall_time_s"]) for s in summaries)
+    runs = f"{len(summaries)} runs, " if len(summaries) > 1 else ""
+    title = (
+        f"{first['algo'].upper()} on {first['env_id']} ({first['env']}, {runs}"
+        f"{first['n_envs']} envs, {steps:,} steps, {wall:.0f} s)"
+    )
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    plot_learning_curve(log, args.out, title=title, random_return=first["random_mean_return"])
+    print(f"{len(log)} episodes of {len(summaries)} run(s) drawn to {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -13,16 +13,23 @@ POLICIES = REPO / "policies"
 HELD_BACK_SEEDS = 2_000_000
 
 
-@pytest.mark.parametrize("name", ["lander_static"])
-def test_a_shipped_lander_policy_lands_on_held_back_seeds(name: str):
+# (policy, held-back episodes, landing rate required). Measured when shipped — lander_static:
+# 92 % on seeds 1,000,000.. (100 episodes), 18/20 here; lander_moving: 97 % on seeds
+# 1,000,000.., 88 % on 2,000,000.. and 83 % on 3,000,000.. (100 each), 42/50 here. 20 episodes
+# cannot tell an 89 % policy from a 75 % one (the moving policy lands 15 of the first 20 of
+# these seeds), so the moving policy is checked on 50.
+SHIPPED = [("lander_static", 20, 0.85), ("lander_moving", 50, 0.75)]
+
+
+@pytest.mark.parametrize(("name", "episodes", "required"), SHIPPED)
+def test_a_shipped_lander_policy_lands_on_held_back_seeds(name, episodes, required):
     import evaluate
 
     folder: Path = POLICIES / name
-    result = evaluate.evaluate(folder, 20, HELD_BACK_SEEDS)
+    result = evaluate.evaluate(folder, episodes, HELD_BACK_SEEDS)
     assert result["env_id"] == "flyloop/Lander2D-v1"
     print(result)
-    # 92 % on 100 held-out episodes (seeds 1,000,000..1,000,099) when it was shipped.
-    assert result["success_rate"] >= 0.85, result
+    assert result["success_rate"] >= required, result
     # Safe landings only count: slower than 1.5 m/s, within 0.2 rad of level.
     assert result["landing_speed_max_m_s"] < 1.5 and result["landing_angle_max_rad"] < 0.2
 

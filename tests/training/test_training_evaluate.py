@@ -124,3 +124,14 @@ def test_training_continues_from_a_saved_run_with_a_decaying_learning_rate(tmp_p
     # The learning rate fell linearly to 0: the last update ran at (almost) 0.
     assert after.model.lr_schedule(0.0) == 0.0
     assert after.model.lr_schedule(1.0) == pytest.approx(3e-4)
+
+    # learning_curve.py draws the two runs as one curve, the second counted on from the first.
+    from learning_curve import read_runs
+
+    log, summaries = read_runs([first, second])
+    assert [s["timesteps"] for s in summaries] == [4096, 2048]
+    assert log.steps == sorted(log.steps) and log.steps[-1] > 4096
+    curve = tmp_path / "curve.png"
+    done = run_script(TRAIN / "learning_curve.py", str(first), str(second), "--out", str(curve))
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert f"{len(log)} episodes of 2 run(s)" in done.stdout and curve.stat().st_size > 10_000
