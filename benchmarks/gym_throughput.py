@@ -21,8 +21,9 @@ Wall-clock time, so run it on a quiet machine (`uptime` load < 1).
 from __future__ import annotations
 
 import argparse
-import gc
 import os
+import subprocess
+import sys
 import time
 
 import flyloop  # noqa: F401  (registers the env ids)
@@ -80,18 +81,27 @@ def _rss_bytes() -> int:
 
 
 def memory_per_env(env_id: str, n: int) -> tuple[float, float]:
-    """(bytes per env, total MB) of a native vector env of `n` envs, after a reset."""
-    gc.collect()
-    before = _rss_bytes()
-    envs = gym.make_vec(
-        env_id, num_envs=n, vectorization_mode="vector_entry_point", backend="native", copy=False
+    """(bytes per env, total MB) of a native vector env of `n` envs after a reset and one
+    step, measured in a fresh interpreter (in this one, heap freed by the throughput runs
+    would be reused and hide the growth)."""
+    child = subprocess.run(
+        [sys.executable, __file__, "--memory-child", env_id, str(n)],
+        capture_output=True,
+        text=True,
+        check=True,
     )
-    envs.reset(seed=0)
-    grown = _rss_bytes() - before
-    envs.close()
-    del envs
-    gc.collect()
+    grown = int(child.stdout.split()[-1])
     return grown / n, grown / 1e6
+
+
+def memory_child(env_id: str, n: int) -> None:
+    """Prints the resident-set growth, bytes, of making, resetting and stepping the env."""
+    before = _rss_bytes()
+    kwargs = dict(num_envs=n, vectorization_mode="vector_entry_point", backend="native")
+    envs = gym.make_vec(env_id, **kwargs)
+    envs.reset(seed=0)
+    envs.step(_actions(envs.single_action_space, np.random.default_rng(0), n))
+    print(_rss_bytes() - before)
 
 
 def main() -> None:
@@ -102,7 +112,11 @@ def main() -> None:
     parser.add_argument("--memory-envs", type=int, default=100_000)
     parser.add_argument("--sample-actions", action="store_true")
     parser.add_argument("--env", action="append", choices=sorted(ENVS), help="default: all")
+    parser.add_argument("--memory-child", nargs=2, help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.memory_child:
+        memory_child(args.memory_child[0], int(args.memory_child[1]))
+        return
     load = os.getloadavg()[0]
     print(f"load average {load:.2f}{'  (busy machine: figures are low)' if load > 1 else ''}")
     print(
@@ -123,7 +137,7 @@ def main() -> None:
         )
     print("\n| native vector env | envs | memory per env | total |")
     print("|---|---|---|---|")
-    sizes = [("flyloop/QuadHover-v0", 10_000), ("flyloop/Lander2D-v0", 1_000)]
+    sizes = [("flyloop/QuadHover-v0", 10_000), ("flyloop/Lander2D-v1", 10_000)]
     if args.memory_envs:
         sizes.append(("flyloop/QuadHover-v0", args.memory_envs))
     for env_id, n in sizes:

@@ -48,9 +48,19 @@ ENV_NAME = "flyloop-preset"
 
 
 def env_creator(env_config: dict[str, Any]):
-    """RLlib's env factory: one preset env (one SITL process) from env_config."""
-    from training_envs import make_env
+    """RLlib's env factory: one preset env (one SITL process) from env_config; with
+    {"backend": "native"} and RLlib's "num_envs" (gym_env_vectorize_mode VECTOR_ENTRY_POINT),
+    the native vector env: all the runner's envs in-process, stepped in one call."""
+    from training_envs import make_env, make_native_vector_env
 
+    if env_config.get("backend") == "native" and "num_envs" in env_config:
+        return make_native_vector_env(
+            env_config.get("env", "hover"),
+            int(env_config["num_envs"]),
+            overrides=env_config.get("env_kwargs"),
+            # One thread: an env runner has one CPU (num_cpus_per_env_runner=1).
+            num_threads=1,
+        )
     return make_env(
         env_config.get("env", "hover"),
         action=env_config.get("action"),
@@ -80,19 +90,25 @@ def build_config(
     envs_per_env_runner: int = 1,
     env_kwargs: dict[str, Any] | None = None,
     num_learners: int = 0,
+    backend: str = "sitl",
 ):
     """A small PPO config: fully connected 64×64 policy, torch, observation filter, and
-    `envs_per_env_runner` envs (SITL processes) in each env runner."""
+    `envs_per_env_runner` envs in each env runner: SITL processes (backend "sitl",
+    vectorised by gymnasium's SyncVectorEnv) or one native vector env (backend "native")."""
+    import gymnasium as gym
     from ray.rllib.algorithms.ppo import PPOConfig
     from ray.rllib.core.rl_module.default_model_config import DefaultModelConfig
 
+    mode = gym.VectorizeMode.VECTOR_ENTRY_POINT if backend == "native" else gym.VectorizeMode.SYNC
+    env_config = {"env": env, "env_kwargs": env_kwargs or {}, "backend": backend}
     return (
         PPOConfig()
-        .environment(ENV_NAME, env_config={"env": env, "env_kwargs": env_kwargs or {}})
+        .environment(ENV_NAME, env_config=env_config)
         .framework("torch")
         .env_runners(
             num_env_runners=num_env_runners,
             num_envs_per_env_runner=envs_per_env_runner,
+            gym_env_vectorize_mode=mode,
             num_cpus_per_env_runner=1,
             rollout_fragment_length="auto",
             env_to_module_connector=observation_filter,
@@ -193,6 +209,7 @@ def train(
     checkpoint: Path | None = None,
     measure_sampling: int = 0,
     on_iteration=None,
+    backend: str = "sitl",
 ) -> dict[str, Any]:
     """Starts (or joins) Ray, trains for `iterations` iterations, optionally measures
     sampling alone (`measure_sampling` env steps per env runner), stops the algorithm (and so
@@ -220,6 +237,7 @@ def train(
             envs_per_env_runner=envs_per_env_runner,
             env_kwargs=env_kwargs,
             num_learners=num_learners,
+            backend=backend,
         )
         algo = config.build_algo()
         for i in range(iterations):
@@ -252,7 +270,15 @@ def main(argv: list[str] | None = None) -> int:
         "--envs-per-env-runner",
         type=int,
         default=1,
-        help="envs (each with its SITL) stepped together by one env runner",
+        help="envs stepped together by one env runner (each with its SITL, or all in one "
+        "native vector env)",
+    )
+    parser.add_argument(
+        "--backend",
+        default="sitl",
+        choices=("sitl", "native"),
+        help="sitl: each env flies its own flyloop-sitl process; native: each env runner "
+        "steps its envs in-process in one native vector env (no SITL)",
     )
     parser.add_argument("--num-learners", type=int, default=0, help="0: learn in this process")
     parser.add_argument("--address", default=None, help='a running cluster, e.g. "auto"')
@@ -282,9 +308,10 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as exc:
         parser.error(str(exc))
 
+    each = "each env with its own SITL" if args.backend == "sitl" else "native vector envs"
     print(
         f"RLlib PPO on {p.env_id}: {args.num_env_runners} env runners × "
-        f"{args.envs_per_env_runner} envs, each env with its own SITL"
+        f"{args.envs_per_env_runner} envs, {each}"
     )
     start = time.perf_counter()
 
@@ -312,6 +339,7 @@ def main(argv: list[str] | None = None) -> int:
         checkpoint=args.checkpoint,
         measure_sampling=args.measure_sampling,
         on_iteration=report,
+        backend=args.backend,
     )
     history = result["iterations"]
     steps = sum(f["env_steps"] for f in history)

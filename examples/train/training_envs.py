@@ -177,6 +177,32 @@ def make_env(
     return p.actions[action](env) if action is not None else env
 
 
+def make_native_vector_env(
+    name: str,
+    num_envs: int,
+    *,
+    overrides: Mapping[str, Any] | None = None,
+    num_threads: int | None = None,
+) -> gym.vector.VectorEnv:
+    """The preset's env as one native vector env of `num_envs` sub-envs with the preset's
+    default action interface (the quadrotor's motor commands rescaled to [-1, 1]; the other
+    interfaces are single-env wrappers)."""
+    p = preset(name)
+    kwargs = {**p.env_kwargs, **(overrides or {})}
+    envs = gym.make_vec(
+        p.env_id,
+        num_envs=num_envs,
+        vectorization_mode="vector_entry_point",
+        backend="native",
+        num_threads=num_threads,
+        **kwargs,
+    )
+    if p.actions is None:
+        return envs
+    unit = np.ones(envs.single_action_space.shape, np.float32)
+    return gym.wrappers.vector.RescaleAction(envs, -unit, unit)
+
+
 def make_success_env(name: str, **kwargs: Any) -> gym.Env:
     """make_env, with info['is_success'] at the end of each episode."""
     return SuccessInfo(make_env(name, **kwargs), preset(name).success)

@@ -113,6 +113,7 @@ class QuadWaypointsEnv(QuadHoverEnv):
             sitl_address=sitl_address,
             vehicle=vehicle,
             timeout=timeout,
+            backend=backend,
             max_num_waypoints=max_num_waypoints,
             waypoint_reach_threshold_m=waypoint_reach_threshold_m,
             checkpoint_bonus=checkpoint_bonus,
