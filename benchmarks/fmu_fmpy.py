@@ -1,10 +1,12 @@
-"""Per-step cost of Quadrotor.fmu through fmpy (a real importer, ctypes), to put next to the
-Rust-side cost of the same doStep (cargo bench -p flyloop-fmu --bench fmu_do_step).
+"""Per-step cost of Quadrotor.fmu (FMI 2.0) and Quadrotor-fmi3.fmu (FMI 3.0) through fmpy (a
+real importer, ctypes), in one run, to put next to the Rust-side cost of the same doStep
+(cargo bench -p flyloop-fmu --bench fmu_do_step).
 
     bash scripts/pack-fmus.sh && .venv/bin/python benchmarks/fmu_fmpy.py [--steps N]
 
-Prints microseconds per call for: doStep alone; setReal(4) + doStep + getReal(13);
-and an empty ctypes call into the same library (fmi2GetVersion) as the floor of any call.
+Prints microseconds per call for: doStep alone; set 4 commands + doStep + get 13 outputs;
+an empty ctypes call into the same library (fmi2GetVersion) as the floor of any call; and the
+FMI 3.0 / FMI 2.0 ratio of each.
 """
 
 import argparse
@@ -14,6 +16,7 @@ from pathlib import Path
 
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi3 import FMU3Slave
 
 ROOT = Path(__file__).resolve().parents[1]
 HOVER = (9.81 / 40.0) ** 0.5
@@ -30,29 +33,33 @@ def per_call(loop, steps: int, repeats: int = 5) -> float:
     return best / steps * 1e6
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--fmu", default=str(ROOT / "dist" / "fmu" / "Quadrotor.fmu"))
-    parser.add_argument("--steps", type=int, default=100_000)
-    args = parser.parse_args()
-
-    md = read_model_description(args.fmu)
+def measure(fmu: str, steps: int) -> dict[str, float]:
+    """Microseconds per call for one FMU (FMI 2.0 or 3.0, from its modelDescription)."""
+    md = read_model_description(fmu)
+    fmi3 = md.fmiVersion.startswith("3")
     vrs = {v.name: v.valueReference for v in md.modelVariables}
-    directory = extract(args.fmu)
-    slave = FMU2Slave(
+    directory = extract(fmu)
+    slave = (FMU3Slave if fmi3 else FMU2Slave)(
         guid=md.guid,
         unzipDirectory=directory,
         modelIdentifier=md.coSimulation.modelIdentifier,
         instanceName="bench",
     )
     slave.instantiate()
-    slave.setupExperiment(startTime=0.0)
-    slave.enterInitializationMode()
-    slave.setReal([vrs["initial_motor"]], [HOVER])
+    if fmi3:
+        slave.enterInitializationMode(startTime=0.0)
+        slave.setFloat64([vrs["initial_motor"]], [HOVER])
+        set_real, get_real = slave.setFloat64, slave.getFloat64
+        inputs = [vrs["motor_command"]]
+    else:
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        slave.setReal([vrs["initial_motor"]], [HOVER])
+        set_real, get_real = slave.setReal, slave.getReal
+        inputs = [vrs[f"motor_command_{i}"] for i in range(4)]
     slave.exitInitializationMode()
     h = 0.01
     n = 0
-    inputs = [vrs[f"motor_command_{i}"] for i in range(4)]
     outputs = [vrs[name] for name in OUTPUTS]
 
     def steps_only(count: int) -> None:
@@ -65,9 +72,9 @@ def main() -> None:
         nonlocal n
         command = [HOVER] * 4
         for _ in range(count):
-            slave.setReal(inputs, command)
+            set_real(inputs, command)
             slave.doStep(currentCommunicationPoint=n * h, communicationStepSize=h)
-            slave.getReal(outputs)
+            get_real(outputs)
             n += 1
 
     version = slave.dll.fmi2GetVersion
@@ -77,15 +84,28 @@ def main() -> None:
             version()
 
     results = {
-        "fmpy doStep (10 ms)": per_call(steps_only, args.steps),
-        "fmpy setReal(4) + doStep + getReal(13)": per_call(set_step_get, args.steps // 4),
-        "ctypes empty call (fmi2GetVersion)": per_call(empty_call, args.steps),
+        "doStep (10 ms)": per_call(steps_only, steps),
+        "set 4 + doStep + get 13": per_call(set_step_get, steps // 4),
+        "ctypes empty call (fmi2GetVersion)": per_call(empty_call, steps),
     }
-    for name, micros in results.items():
-        print(f"{name:42s} {micros:8.3f} us")
     slave.terminate()
     slave.freeInstance()
     shutil.rmtree(directory, ignore_errors=True)
+    return results
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--fmu", default=str(ROOT / "dist" / "fmu" / "Quadrotor.fmu"))
+    parser.add_argument("--fmu3", default=str(ROOT / "dist" / "fmu" / "Quadrotor-fmi3.fmu"))
+    parser.add_argument("--steps", type=int, default=100_000)
+    args = parser.parse_args()
+    fmi2 = measure(args.fmu, args.steps)
+    fmi3 = measure(args.fmu3, args.steps)
+    print(f"{'fmpy, microseconds per call':42s} {'FMI 2.0':>8s} {'FMI 3.0':>8s} {'3.0/2.0':>8s}")
+    for name in fmi2:
+        ratio = fmi3[name] / fmi2[name]
+        print(f"{name:42s} {fmi2[name]:8.3f} {fmi3[name]:8.3f} {ratio:8.3f}")
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
-//! Rust-side cost of one 10 ms fmi2DoStep of Quadrotor through the C ABI, next to the
-//! core's own step (the difference is the FMI layer), and of a typical co-simulation step
-//! (set 4 inputs, doStep, get 13 outputs). The importer's own cost (fmpy) is measured by
-//! benchmarks/fmu_fmpy.py.
+//! Rust-side cost of one 10 ms fmi2DoStep / fmi3DoStep of Quadrotor through the C ABI, next
+//! to the core's own step (the difference is the FMI layer), and of a typical co-simulation
+//! step (set 4 inputs, doStep, get 13 outputs) in both FMI versions. The importer's own cost
+//! (fmpy) is measured by benchmarks/fmu_fmpy.py.
 //!
 //!     cargo bench -p flyloop-fmu --bench fmu_do_step
 // Bench code: a failed setup is a failed benchmark.
@@ -11,6 +11,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial, QuadrotorParams};
 use flyloop_fmu::exports::*;
 use flyloop_fmu::fmi2_types::*;
+use flyloop_fmu::fmi3_types::{fmi3Instance, fmi3Status};
 use flyloop_fmu::importer_logger;
 use flyloop_fmu::models::tables;
 use std::hint::black_box;
@@ -51,6 +52,90 @@ fn instance(hover: f64) -> fmi2Component {
     }
 }
 
+fn instance3(hover: f64) -> fmi3Instance {
+    let table = tables()[0];
+    let vr = |name: &str| table.by_name(name).unwrap().value_reference;
+    // SAFETY: valid strings; no logger (FMI 3.0 allows NULL).
+    unsafe {
+        let c = fmi3InstantiateCoSimulation(
+            c"bench".as_ptr(),
+            table.token3_c.as_ptr(),
+            std::ptr::null(),
+            0,
+            0,
+            0,
+            0,
+            std::ptr::null(),
+            0,
+            std::ptr::null_mut(),
+            None,
+            None,
+        );
+        assert!(!c.is_null());
+        assert_eq!(
+            fmi3EnterInitializationMode(c, 0, 0.0, 0.0, 0, 0.0),
+            fmi3Status::fmi3OK
+        );
+        let (motor, seed) = (vr("initial_motor"), vr("seed"));
+        assert_eq!(fmi3SetFloat64(c, &motor, 1, &hover, 1), fmi3Status::fmi3OK);
+        assert_eq!(fmi3SetInt32(c, &seed, 1, &1, 1), fmi3Status::fmi3OK);
+        assert_eq!(fmi3ExitInitializationMode(c), fmi3Status::fmi3OK);
+        c
+    }
+}
+
+fn do_step3(c: &mut Criterion, hover: f64, outputs: &[u32]) {
+    let fmu = instance3(hover);
+    let mut n = 0u64;
+    let (mut flag, mut last) = (0u8, 0.0);
+    c.bench_function("fmi3DoStep_quadrotor_10ms", |b| {
+        b.iter(|| {
+            // SAFETY: live instance, writable outputs; t is the instance's own grid time.
+            let status = unsafe {
+                fmi3DoStep(
+                    fmu,
+                    black_box(n as f64 * 0.01),
+                    0.01,
+                    0,
+                    &mut flag,
+                    &mut flag,
+                    &mut flag,
+                    &mut last,
+                )
+            };
+            debug_assert_eq!(status, fmi3Status::fmi3OK);
+            n += 1;
+        })
+    });
+
+    let fmu = instance3(hover);
+    let command = [hover; 4];
+    let mut values = [0.0; 13];
+    let mut n = 0u64;
+    c.bench_function("fmi3_set4_doStep_get13_quadrotor_10ms", |b| {
+        b.iter(|| {
+            // SAFETY: live instance, arrays of the given lengths (motor_command is one
+            // array variable of 4).
+            unsafe {
+                fmi3SetFloat64(fmu, &0, 1, command.as_ptr(), 4);
+                fmi3DoStep(
+                    fmu,
+                    n as f64 * 0.01,
+                    0.01,
+                    0,
+                    &mut flag,
+                    &mut flag,
+                    &mut flag,
+                    &mut last,
+                );
+                fmi3GetFloat64(fmu, outputs.as_ptr(), 13, values.as_mut_ptr(), 13);
+            }
+            black_box(&values);
+            n += 1;
+        })
+    });
+}
+
 fn do_step(c: &mut Criterion) {
     let hover = QuadrotorParams::default().hover_motor_state().unwrap();
     let table = tables()[0];
@@ -89,6 +174,8 @@ fn do_step(c: &mut Criterion) {
             n += 1;
         })
     });
+
+    do_step3(c, hover, &outputs);
 
     let initial = QuadrotorInitial {
         seed: 1,

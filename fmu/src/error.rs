@@ -26,13 +26,15 @@ pub enum FmuError {
     /// The variable exists but has another type than the function's.
     #[error(
         "variable `{name}` (value reference {vr}) is of type {actual}, not {requested}: \
-         use fmi2Get{actual}/fmi2Set{actual}"
+         use {api}Get{actual}/{api}Set{actual}"
     )]
     WrongType {
         name: &'static str,
         vr: u32,
         actual: &'static str,
         requested: &'static str,
+        /// "fmi2" or "fmi3": the function prefix of the caller's FMI version.
+        api: &'static str,
     },
     /// The variable exists but cannot be set now (an output, or a fixed parameter after
     /// initialisation).
@@ -92,7 +94,7 @@ pub enum FmuError {
     /// The dynamics produced a non-finite state; the instance stops in the Error stage.
     #[error(
         "the model state became non-finite at t = {t}; the instance is in the \
-         Error stage (fmi2Reset or fmi2SetFMUstate to go on)",
+         Error stage (reset it or set an FMU state to go on)",
         t = Compact(*.time)
     )]
     Diverged { time: f64 },

@@ -13,9 +13,19 @@ fn fnv1a64(basis: u64, bytes: &[u8]) -> u64 {
     })
 }
 
-/// `{xxxxxxxx-xxxx-xxxx-xxxx-xxxxxxxxxxxx}` for the interface of `identifier`.
+/// `{xxxxxxxx-xxxx-xxxx-xxxx-xxxxxxxxxxxx}` for the FMI 2.0 interface of `identifier`.
 pub fn of_interface(identifier: &str, variables: &[Variable]) -> String {
-    let mut text = format!("flyloop FMI 2.0 CS {identifier}\n");
+    hash_interface(&format!("flyloop FMI 2.0 CS {identifier}\n"), variables)
+}
+
+/// The same for the FMI 3.0 interface (instantiationToken): another header, so that an FMI
+/// 2.0 modelDescription never instantiates through FMI 3.0 or the other way round.
+pub fn of_fmi3_interface(identifier: &str, variables: &[Variable]) -> String {
+    hash_interface(&format!("flyloop FMI 3.0 {identifier}\n"), variables)
+}
+
+fn hash_interface(header: &str, variables: &[Variable]) -> String {
+    let mut text = header.to_string();
     for v in variables {
         // Debug of f64 is the shortest exact form: equal text ⇔ equal values.
         let _ = writeln!(

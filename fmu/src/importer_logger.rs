@@ -9,6 +9,7 @@
 use crate::fmi2_types::{
     fmi2CallbackFunctions, fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status, fmi2String,
 };
+use crate::fmi3_types::{fmi3InstanceEnvironment, fmi3LogMessageCallback, fmi3Status};
 use std::ffi::{CStr, c_char, c_void};
 use std::sync::Mutex;
 
@@ -83,6 +84,12 @@ impl Recorder {
         callbacks(record, self as *const Recorder as *mut c_void)
     }
 
+    /// FMI 3.0's logger and environment recording into this recorder, which must outlive
+    /// every instance they are given to.
+    pub fn fmi3_logger(&self) -> (fmi3LogMessageCallback, fmi3InstanceEnvironment) {
+        (record3, self as *const Recorder as *mut c_void)
+    }
+
     /// The last message logged, if any.
     pub fn last(&self) -> Option<Entry> {
         self.entries.lock().ok()?.last().cloned()
@@ -122,6 +129,36 @@ pub unsafe extern "C" fn record(
     if let Ok(mut entries) = recorder.entries.lock() {
         entries.push(Entry {
             instance: text(instance),
+            status,
+            category: text(category),
+            message: text(message),
+        });
+    }
+}
+
+/// The FMI 3.0 receiver behind [`Recorder::fmi3_logger`] (no instance name: recorded as "").
+///
+/// # Safety
+///
+/// `env` must be a live [`Recorder`] and the strings NUL-terminated or NULL.
+pub unsafe extern "C" fn record3(
+    env: fmi3InstanceEnvironment,
+    status: fmi3Status,
+    category: fmi2String,
+    message: fmi2String,
+) {
+    // SAFETY: the caller's contract (env is a Recorder).
+    let recorder = unsafe { &*(env as *const Recorder) };
+    let status = match status {
+        fmi3Status::fmi3OK => fmi2Status::fmi2OK,
+        fmi3Status::fmi3Warning => fmi2Status::fmi2Warning,
+        fmi3Status::fmi3Discard => fmi2Status::fmi2Discard,
+        fmi3Status::fmi3Error => fmi2Status::fmi2Error,
+        fmi3Status::fmi3Fatal => fmi2Status::fmi2Fatal,
+    };
+    if let Ok(mut entries) = recorder.entries.lock() {
+        entries.push(Entry {
+            instance: String::new(),
             status,
             category: text(category),
             message: text(message),

@@ -65,6 +65,23 @@ impl Stage {
     }
 }
 
+/// The FMI version an instance was created through.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Api {
+    Fmi2,
+    Fmi3,
+}
+
+impl Api {
+    /// What the modelDescription calls the string that ties it to the binary.
+    pub fn token_name(self) -> &'static str {
+        match self {
+            Api::Fmi2 => "fmuGUID",
+            Api::Fmi3 => "instantiationToken",
+        }
+    }
+}
+
 /// The interface an instance was created for (fmi2Instantiate's fmuType).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Interface {
@@ -175,6 +192,48 @@ pub mod masks {
         mask!(Instantiated | EventMode | ContinuousTimeMode | Terminated | Error);
 }
 
+/// Per-function masks of FMI 3.0 (Reference-FMUs' fmi3Functions.c), in the stages of
+/// [`Stage`]: FMI 3.0's StepMode is `StepComplete`. Functions with the same mask as in FMI
+/// 2.0 use [`masks`].
+pub mod masks3 {
+    use super::{Mask, Stage};
+
+    pub const ENTER_INITIALIZATION_MODE: Mask = mask!(Instantiated);
+    /// FMI 3.0 allows reading in every stage but the step in progress.
+    pub const GET_VALUE: Mask = mask!(
+        Instantiated
+            | InitializationMode
+            | EventMode
+            | ContinuousTimeMode
+            | StepComplete
+            | StepFailed
+            | StepCanceled
+            | Terminated
+            | Error
+    );
+    pub const SET_FLOAT64: Mask =
+        mask!(Instantiated | InitializationMode | EventMode | ContinuousTimeMode | StepComplete);
+    pub const SET_OTHER: Mask = mask!(Instantiated | InitializationMode | EventMode | StepComplete);
+    pub const ENTER_STEP_MODE: Mask = mask!(InitializationMode | EventMode);
+    pub const GET_OUTPUT_DERIVATIVES: Mask = mask!(StepComplete | StepFailed | Terminated);
+    pub const UPDATE_DISCRETE_STATES: Mask = mask!(EventMode);
+    pub const GET_DERIVATIVES: Mask =
+        mask!(InitializationMode | EventMode | ContinuousTimeMode | Terminated | Error);
+    /// Functions that ask nothing of the stage (counts, unsupported capabilities).
+    pub const ANY: Mask = mask!(
+        Instantiated
+            | InitializationMode
+            | StepComplete
+            | StepInProgress
+            | StepFailed
+            | StepCanceled
+            | Terminated
+            | Error
+            | EventMode
+            | ContinuousTimeMode
+    );
+}
+
 /// A saved FMU state: the bytes of [`Simulation::save`]. Boxed; the box's address is the
 /// `fmi2FMUstate` the importer holds.
 #[derive(Debug)]
@@ -184,6 +243,7 @@ pub struct SavedState {
 
 /// One FMU instance.
 pub struct Instance {
+    pub api: Api,
     pub interface: Interface,
     pub logger: Logger,
     pub filter: LogFilter,
@@ -207,12 +267,14 @@ impl std::fmt::Debug for Instance {
 
 impl Instance {
     pub fn new(
+        api: Api,
         interface: Interface,
         logger: Logger,
         logging_on: bool,
         sim: Box<dyn Simulation>,
     ) -> Self {
         Instance {
+            api,
             interface,
             logger,
             filter: LogFilter::at_instantiation(logging_on),
@@ -260,15 +322,31 @@ impl Instance {
         }
     }
 
+    /// Fails unless this is a Co-Simulation instance.
+    pub fn check_co_simulation(&self) -> Result<(), FmuError> {
+        match self.interface {
+            Interface::CoSimulation => Ok(()),
+            Interface::ModelExchange => Err(FmuError::NotSupported(
+                "Co-Simulation functions on a Model Exchange instance",
+            )),
+        }
+    }
+
     /// Fails unless this is a Model Exchange instance (the Model Exchange masks share
     /// InitializationMode and Terminated with Co-Simulation).
     pub fn check_model_exchange(&self) -> Result<(), FmuError> {
         match self.interface {
             Interface::ModelExchange => Ok(()),
-            Interface::CoSimulation => Err(FmuError::NotSupported(
-                "Model Exchange functions on a Co-Simulation instance (instantiate with \
-                 fmuType fmi2ModelExchange)",
-            )),
+            Interface::CoSimulation => Err(FmuError::NotSupported(match self.api {
+                Api::Fmi2 => {
+                    "Model Exchange functions on a Co-Simulation instance (instantiate with \
+                     fmuType fmi2ModelExchange)"
+                }
+                Api::Fmi3 => {
+                    "Model Exchange functions on a Co-Simulation instance (instantiate with \
+                     fmi3InstantiateModelExchange)"
+                }
+            })),
         }
     }
 

@@ -1,5 +1,6 @@
-//! FMI 2.0 front end of flyloop-core: `Quadrotor.fmu` (Co-Simulation and Model Exchange) and
-//! `Lander2D.fmu` (Co-Simulation) from one cdylib.
+//! FMI front end of flyloop-core: `Quadrotor.fmu` (FMI 2.0 Co-Simulation and Model Exchange),
+//! `Lander2D.fmu` (FMI 2.0 Co-Simulation) and their FMI 3.0 twins `Quadrotor-fmi3.fmu` and
+//! `Lander2D-fmi3.fmu`, all from one cdylib that exports both APIs.
 //!
 //! Layers, from the C boundary down:
 //! - [`exports`]: every `fmi2*` function, each inside `catch_unwind` (a panic becomes
@@ -11,19 +12,23 @@
 //! - [`exchange`]: Model Exchange on top of the engine (time, states, events).
 //! - [`models`]: the quadrotor and the lander behind `FmuModel`; the GUID picks one.
 //!
-//! [`model_description`] writes each modelDescription.xml from the core's variable tables;
+//! [`model_description`] and [`model_description3`] write each modelDescription.xml from the
+//! core's variable tables ([`fmi3_variables`]: the FMI 3.0 view, with arrays);
 //! [`pack`] zips the FMUs (binary `flyloop-fmu-pack`).
 
 pub mod error;
 pub mod exchange;
 pub mod exports;
 pub mod fmi2_types;
+pub mod fmi3_types;
+pub mod fmi3_variables;
 pub mod guid;
 pub mod importer_logger;
 pub mod instance;
 pub mod log;
 pub mod model;
 pub mod model_description;
+pub mod model_description3;
 pub mod models;
 pub mod pack;
 pub mod simulation;

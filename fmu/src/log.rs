@@ -1,4 +1,5 @@
-//! Logging through the importer's variadic logger, by category.
+//! Logging through the importer's logger (FMI 2.0's variadic one or FMI 3.0's
+//! `fmi3LogMessageCallback`), by category.
 //!
 //! Categories (declared in the modelDescription's LogCategories): `logEvents` (lifecycle),
 //! `logStatusWarning`, `logStatusError` and `logStatusFatal`. fmi2Instantiate's loggingOn
@@ -7,6 +8,7 @@
 //! categories it names (all of them when it names none), errors included.
 
 use crate::fmi2_types::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status};
+use crate::fmi3_types::{fmi3InstanceEnvironment, fmi3LogMessageCallback, fmi3Status};
 use std::ffi::{CStr, CString};
 
 /// A log category.
@@ -83,23 +85,31 @@ impl LogFilter {
     }
 }
 
+/// The importer's logging callback and the environment it wants back.
+#[derive(Debug, Clone, Copy)]
+pub enum Sink {
+    Fmi2 {
+        callback: fmi2CallbackLogger,
+        environment: fmi2ComponentEnvironment,
+    },
+    /// FMI 3.0 allows a NULL logger: then nothing is logged.
+    Fmi3 {
+        callback: Option<fmi3LogMessageCallback>,
+        environment: fmi3InstanceEnvironment,
+    },
+}
+
 /// The importer's logger with what it needs on every call.
 #[derive(Debug)]
 pub struct Logger {
-    callback: fmi2CallbackLogger,
-    environment: fmi2ComponentEnvironment,
+    sink: Sink,
     instance_name: CString,
 }
 
 impl Logger {
-    pub fn new(
-        callback: fmi2CallbackLogger,
-        environment: fmi2ComponentEnvironment,
-        instance_name: CString,
-    ) -> Self {
+    pub fn new(sink: Sink, instance_name: CString) -> Self {
         Logger {
-            callback,
-            environment,
+            sink,
             instance_name,
         }
     }
@@ -108,20 +118,63 @@ impl Logger {
         &self.instance_name
     }
 
-    /// Sends `message`, always through a "%s" format so that a '%' in it is printed, never
-    /// interpreted.
+    /// Sends `message` (FMI 2.0: always through a "%s" format so that a '%' in it is
+    /// printed, never interpreted).
     pub fn log(&self, status: fmi2Status, category: Category, message: &str) {
-        // SAFETY: callback and environment came together from the importer's
-        // fmi2CallbackFunctions, which it keeps valid while the instance lives.
+        // SAFETY: callback and environment came together from the importer, which keeps
+        // them valid while the instance lives.
         unsafe {
-            send(
-                self.callback,
-                self.environment,
-                &self.instance_name,
-                status,
-                category,
-                message,
-            );
+            self.sink
+                .send(&self.instance_name, status, category, message)
+        }
+    }
+}
+
+impl Sink {
+    /// Calls the callback once with `message`.
+    ///
+    /// # Safety
+    /// The callback and environment must be the importer's, valid for the call.
+    pub unsafe fn send(
+        &self,
+        instance_name: &CStr,
+        status: fmi2Status,
+        category: Category,
+        message: &str,
+    ) {
+        match *self {
+            // SAFETY: the caller's contract.
+            Sink::Fmi2 {
+                callback,
+                environment,
+            } => unsafe {
+                send(
+                    callback,
+                    environment,
+                    instance_name,
+                    status,
+                    category,
+                    message,
+                )
+            },
+            Sink::Fmi3 { callback: None, .. } => {}
+            Sink::Fmi3 {
+                callback: Some(callback),
+                environment,
+            } => {
+                // FMI 3.0's logger has no instance name: the environment tells instances
+                // apart.
+                let text = CString::new(message.replace('\0', "\u{fffd}")).unwrap_or_default();
+                // SAFETY: the caller's contract; both strings outlive the call.
+                unsafe {
+                    callback(
+                        environment,
+                        fmi3Status::from(status),
+                        category.c_name().as_ptr(),
+                        text.as_ptr(),
+                    );
+                }
+            }
         }
     }
 }

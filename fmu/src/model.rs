@@ -3,7 +3,9 @@
 //! each model derives from its core variable table (lookup by value reference, GUID).
 
 use crate::error::FmuError;
+use crate::fmi3_variables::Layout3;
 use crate::guid;
+use crate::instance::Api;
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::{Causality, Variability, Variable};
 use flyloop_core::{ParamError, SnapshotError};
@@ -37,6 +39,11 @@ pub struct ModelInfo {
     pub direct_feedthrough: &'static [(&'static str, &'static [&'static str])],
     /// Outputs that do not depend on the continuous states (Model Exchange dependencies).
     pub state_free_outputs: &'static [&'static str],
+    /// FMI 3.0: runs of variables `P_0 .. P_n-1` shown as one array `P`, with the array's
+    /// description.
+    pub arrays: &'static [(&'static str, &'static str)],
+    /// FMI 3.0: a variable for each event indicator (name, unit, description), in order.
+    pub event_indicators: &'static [(&'static str, &'static str, &'static str)],
 }
 
 /// What a Model-Exchange capable model adds to its table: its continuous states and their
@@ -118,6 +125,11 @@ pub struct ModelTable {
     pub variables: Vec<Variable>,
     pub guid: String,
     pub guid_c: CString,
+    /// FMI 3.0's instantiationToken (its own interface: arrays, `time`, event indicators).
+    pub token3: String,
+    pub token3_c: CString,
+    /// The FMI 3.0 variables.
+    pub fmi3: Layout3,
     /// Value reference → position in `variables`, sorted for binary search.
     by_vr: Vec<(u32, usize)>,
     /// States and derivatives, for a model that offers Model Exchange.
@@ -138,6 +150,7 @@ impl ModelTable {
         model_exchange: Option<ModelExchangeTable>,
     ) -> Self {
         let guid = guid::of_interface(info.identifier, &variables);
+        let token3 = guid::of_fmi3_interface(info.identifier, &variables);
         let mut by_vr: Vec<(u32, usize)> = variables
             .iter()
             .enumerate()
@@ -146,13 +159,27 @@ impl ModelTable {
         by_vr.sort_unstable();
         // A GUID is hex digits, dashes and braces: it never holds a NUL.
         let guid_c = CString::new(guid.clone()).unwrap_or_default();
-        ModelTable {
+        let token3_c = CString::new(token3.clone()).unwrap_or_default();
+        let mut table = ModelTable {
             info,
             variables,
             guid,
             guid_c,
+            token3,
+            token3_c,
+            fmi3: Layout3::empty(),
             by_vr,
             model_exchange,
+        };
+        table.fmi3 = Layout3::new(&table);
+        table
+    }
+
+    /// The GUID (FMI 2.0) or instantiation token (FMI 3.0).
+    pub fn token(&self, api: Api) -> &str {
+        match api {
+            Api::Fmi2 => &self.guid,
+            Api::Fmi3 => &self.token3,
         }
     }
 

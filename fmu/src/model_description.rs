@@ -5,7 +5,7 @@
 //! date), so the checked-in copies under modelDescription/ can be compared byte for byte.
 
 use crate::log::CATEGORIES;
-use crate::model::{ModelTable, type_name};
+use crate::model::{ModelInfo, ModelTable, type_name};
 use crate::units::{self, BASE_UNITS};
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::{Causality, Variability, Variable};
@@ -21,7 +21,7 @@ pub struct UnknownUnit {
 }
 
 /// Escapes text for an XML attribute value.
-fn escape(text: &str) -> String {
+pub(crate) fn escape(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     for ch in text.chars() {
         match ch {
@@ -37,7 +37,7 @@ fn escape(text: &str) -> String {
 }
 
 /// An xs:double: the shortest text that reads back to the same f64.
-fn real(value: f64) -> String {
+pub(crate) fn real(value: f64) -> String {
     if value.is_nan() {
         "NaN".to_string()
     } else if value.is_infinite() {
@@ -48,7 +48,7 @@ fn real(value: f64) -> String {
 }
 
 /// A value of `kind` as its XML attribute text.
-fn value_text(kind: ValueKind, value: f64) -> String {
+pub(crate) fn value_text(kind: ValueKind, value: f64) -> String {
     match kind {
         ValueKind::Real => real(value),
         ValueKind::Integer => format!("{}", value as i64),
@@ -65,7 +65,7 @@ fn causality(c: Causality) -> &'static str {
     }
 }
 
-fn variability(v: Variability) -> &'static str {
+pub(crate) fn variability(v: Variability) -> &'static str {
     match v {
         Variability::Fixed => "fixed",
         Variability::Tunable => "tunable",
@@ -75,6 +75,7 @@ fn variability(v: Variability) -> &'static str {
 }
 
 /// The units of Real variables, sorted.
+#[cfg(test)]
 fn units_used(variables: &[Variable]) -> BTreeSet<&'static str> {
     variables
         .iter()
@@ -84,14 +85,25 @@ fn units_used(variables: &[Variable]) -> BTreeSet<&'static str> {
 }
 
 fn unit_definitions(out: &mut String, variables: &[Variable]) -> Result<(), UnknownUnit> {
+    let units: Vec<(&str, &str)> = variables
+        .iter()
+        .filter(|v| v.kind == ValueKind::Real && !v.unit.is_empty())
+        .map(|v| (v.unit, v.name))
+        .collect();
+    write_units(out, &units)
+}
+
+/// `<UnitDefinitions>` for the units of `used` ((unit, a variable that has it) pairs).
+pub(crate) fn write_units(out: &mut String, used: &[(&str, &str)]) -> Result<(), UnknownUnit> {
+    let units: BTreeSet<&str> = used.iter().map(|&(unit, _)| unit).collect();
     out.push_str("  <UnitDefinitions>\n");
-    for unit in units_used(variables) {
+    for unit in units {
         let exponents = units::exponents(unit).ok_or_else(|| UnknownUnit {
             unit: unit.to_string(),
-            variable: variables
+            variable: used
                 .iter()
-                .find(|v| v.unit == unit)
-                .map_or_else(String::new, |v| v.name.to_string()),
+                .find(|&&(u, _)| u == unit)
+                .map_or_else(String::new, |&(_, name)| name.to_string()),
         })?;
         match exponents {
             Some(exponents) => {
@@ -110,6 +122,28 @@ fn unit_definitions(out: &mut String, variables: &[Variable]) -> Result<(), Unkn
     }
     out.push_str("  </UnitDefinitions>\n");
     Ok(())
+}
+
+/// `<LogCategories>` and `<DefaultExperiment>` (the same in FMI 2.0 and 3.0).
+pub(crate) fn categories_and_experiment(out: &mut String, info: &ModelInfo) {
+    out.push_str("  <LogCategories>\n");
+    for (_, name, description) in CATEGORIES {
+        let _ = writeln!(
+            out,
+            "    <Category name=\"{}\" description=\"{}\"/>",
+            name.to_string_lossy(),
+            escape(description)
+        );
+    }
+    out.push_str("  </LogCategories>\n");
+    let (start, stop, step) = info.default_experiment;
+    let _ = writeln!(
+        out,
+        "  <DefaultExperiment startTime=\"{}\" stopTime=\"{}\" stepSize=\"{}\"/>",
+        real(start),
+        real(stop),
+        real(step)
+    );
 }
 
 /// `derivative` is the 1-based index of the state a derivative variable belongs to.
@@ -145,16 +179,6 @@ fn scalar_variable(out: &mut String, v: &Variable, derivative: Option<usize>) {
     out.push_str("/>\n    </ScalarVariable>\n");
 }
 
-/// 1-based positions (ModelVariables order) of `names`.
-fn indices(table: &ModelTable, names: &[&str]) -> String {
-    names
-        .iter()
-        .filter_map(|n| table.variables.iter().position(|v| v.name == *n))
-        .map(|i| (i + 1).to_string())
-        .collect::<Vec<_>>()
-        .join(" ")
-}
-
 /// 1-based position (ModelVariables order) of value reference `vr`.
 fn index_of(table: &ModelTable, vr: u32) -> Option<usize> {
     table
@@ -164,23 +188,19 @@ fn index_of(table: &ModelTable, vr: u32) -> Option<usize> {
         .map(|i| i + 1)
 }
 
-/// The dependencies of `output`: its direct-feedthrough inputs and, under Model Exchange,
-/// the continuous states (none for a state itself, which is its own known).
-fn output_dependencies(table: &ModelTable, output: &Variable) -> String {
-    let mut dependencies = indices(table, table.direct_feedthrough(output.name));
+/// The value references `output` depends on: its direct-feedthrough inputs and, under Model
+/// Exchange, the continuous states (none for a state itself, which is its own known).
+pub(crate) fn output_dependencies(table: &ModelTable, output: &Variable) -> Vec<u32> {
+    let mut dependencies: Vec<u32> = table
+        .direct_feedthrough(output.name)
+        .iter()
+        .filter_map(|name| table.by_name(name))
+        .map(|v| v.value_reference)
+        .collect();
     if let Some(me) = &table.model_exchange {
         let is_state = me.states.contains(&output.value_reference);
         if !is_state && !table.info.state_free_outputs.contains(&output.name) {
-            let states: Vec<String> = me
-                .states
-                .iter()
-                .filter_map(|&vr| index_of(table, vr))
-                .map(|i| i.to_string())
-                .collect();
-            if !dependencies.is_empty() {
-                dependencies.push(' ');
-            }
-            dependencies.push_str(&states.join(" "));
+            dependencies.extend(&me.states);
         }
     }
     dependencies
@@ -200,6 +220,11 @@ fn model_structure(out: &mut String, table: &ModelTable) {
             "      <Unknown index=\"{}\" dependencies=\"{}\"/>",
             i + 1,
             output_dependencies(table, v)
+                .iter()
+                .filter_map(|&vr| index_of(table, vr))
+                .map(|i| i.to_string())
+                .collect::<Vec<_>>()
+                .join(" ")
         );
     }
     out.push_str("    </Outputs>\n");
@@ -266,24 +291,7 @@ pub fn generate(table: &ModelTable) -> Result<String, UnknownUnit> {
         info.identifier
     );
     unit_definitions(&mut out, &table.variables)?;
-    out.push_str("  <LogCategories>\n");
-    for (_, name, description) in CATEGORIES {
-        let _ = writeln!(
-            out,
-            "    <Category name=\"{}\" description=\"{}\"/>",
-            name.to_string_lossy(),
-            escape(description)
-        );
-    }
-    out.push_str("  </LogCategories>\n");
-    let (start, stop, step) = info.default_experiment;
-    let _ = writeln!(
-        out,
-        "  <DefaultExperiment startTime=\"{}\" stopTime=\"{}\" stepSize=\"{}\"/>",
-        real(start),
-        real(stop),
-        real(step)
-    );
+    categories_and_experiment(&mut out, info);
     out.push_str("  <ModelVariables>\n");
     for (i, v) in table.variables.iter().enumerate() {
         let _ = writeln!(out, "    <!-- Index {} -->", i + 1);

@@ -4,7 +4,7 @@
 //! through the object-safe [`Simulation`] so one library serves every model.
 
 use crate::error::FmuError;
-use crate::model::{FmuModel, ModelTable, StepRequest, settable_after_initialisation, type_name};
+use crate::model::{FmuModel, ModelTable, StepRequest, settable_after_initialisation};
 use crate::state_record;
 use flyloop_core::SnapshotError;
 use flyloop_core::number::Compact;
@@ -24,13 +24,18 @@ pub const STEP_TOLERANCE: f64 = 1e-9;
 /// A single fmi2DoStep may run at most this many internal steps (≈ tens of seconds of CPU).
 pub const MAX_INTERNAL_STEPS: f64 = 1e8;
 
-/// The type an fmi2Get*/fmi2Set* function works with.
+/// The type an fmi2Get*/fmi2Set* or fmi3Get*/fmi3Set* function works with.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FmiType {
     Real,
     Integer,
     Boolean,
     String,
+    Float64,
+    Int32,
+    Boolean3,
+    /// An FMI 3.0 type no variable has (Float32, Int8, ..., String, Binary), by name.
+    Other3(&'static str),
 }
 
 impl FmiType {
@@ -38,18 +43,46 @@ impl FmiType {
         match self {
             FmiType::Real => "Real",
             FmiType::Integer => "Integer",
-            FmiType::Boolean => "Boolean",
+            FmiType::Boolean | FmiType::Boolean3 => "Boolean",
             FmiType::String => "String",
+            FmiType::Float64 => "Float64",
+            FmiType::Int32 => "Int32",
+            FmiType::Other3(name) => name,
         }
     }
 
-    fn matches(self, kind: ValueKind) -> bool {
+    fn is_fmi3(self) -> bool {
         matches!(
-            (self, kind),
-            (FmiType::Real, ValueKind::Real)
-                | (FmiType::Integer, ValueKind::Integer)
-                | (FmiType::Boolean, ValueKind::Boolean)
+            self,
+            FmiType::Float64 | FmiType::Int32 | FmiType::Boolean3 | FmiType::Other3(_)
         )
+    }
+
+    /// The type of this FMI version that reads a variable of `kind`.
+    fn for_kind(self, kind: ValueKind) -> FmiType {
+        match (self.is_fmi3(), kind) {
+            (false, ValueKind::Real) => FmiType::Real,
+            (false, ValueKind::Integer) => FmiType::Integer,
+            (false, ValueKind::Boolean) => FmiType::Boolean,
+            (true, ValueKind::Real) => FmiType::Float64,
+            (true, ValueKind::Integer) => FmiType::Int32,
+            (true, ValueKind::Boolean) => FmiType::Boolean3,
+        }
+    }
+
+    pub(crate) fn matches(self, kind: ValueKind) -> bool {
+        self.for_kind(kind) == self
+    }
+
+    /// The error for a variable of another type than this function's.
+    pub fn mismatch(self, name: &'static str, vr: u32, kind: ValueKind) -> FmuError {
+        FmuError::WrongType {
+            name,
+            vr,
+            actual: self.for_kind(kind).name(),
+            requested: self.name(),
+            api: if self.is_fmi3() { "fmi3" } else { "fmi2" },
+        }
     }
 }
 
@@ -289,12 +322,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
             .variable(vr)
             .ok_or(FmuError::UnknownValueReference(vr))?;
         if !ty.matches(variable.kind) {
-            return Err(FmuError::WrongType {
-                name: variable.name,
-                vr,
-                actual: type_name(variable.kind),
-                requested: ty.name(),
-            });
+            return Err(ty.mismatch(variable.name, vr, variable.kind));
         }
         Ok(self.model.get(&self.initial, vr)?)
     }
@@ -304,12 +332,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
             .variable(vr)
             .ok_or(FmuError::UnknownValueReference(vr))?;
         if !ty.matches(variable.kind) {
-            return Err(FmuError::WrongType {
-                name: variable.name,
-                vr,
-                actual: type_name(variable.kind),
-                requested: ty.name(),
-            });
+            return Err(ty.mismatch(variable.name, vr, variable.kind));
         }
         let name = variable.name;
         match variable.causality {
@@ -325,7 +348,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
             {
                 return Err(FmuError::NotSettable {
                     name,
-                    reason: "it is a fixed parameter; set it before fmi2ExitInitializationMode",
+                    reason: "it is a fixed parameter; set it before initialization mode ends",
                 });
             }
             _ => {}

@@ -12,8 +12,7 @@ mod support;
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::Causality;
 use flyloop_fmu::fmi2_types::fmi2Status::fmi2OK;
-use flyloop_fmu::model_description::generate;
-use flyloop_fmu::pack::{model_description_path, write_model_description};
+use flyloop_fmu::pack::{Version, model_description_path, write_model_description};
 use std::path::{Path, PathBuf};
 use support::{Fmu, Model};
 
@@ -25,14 +24,17 @@ fn checked_in_dir() -> PathBuf {
 fn checked_in_model_descriptions_match_the_generated_ones() {
     let dir = checked_in_dir();
     let update = std::env::var_os("UPDATE_MODEL_DESCRIPTION").is_some_and(|v| v == "1");
-    for model in [Model::Quadrotor, Model::Lander2D] {
+    for (model, version) in [Model::Quadrotor, Model::Lander2D]
+        .into_iter()
+        .flat_map(|m| Version::ALL.map(|v| (m, v)))
+    {
         let table = model.table();
         if update {
-            write_model_description(table, &dir).unwrap();
+            write_model_description(table, version, &dir).unwrap();
         }
-        let path = model_description_path(&dir, table);
+        let path = model_description_path(&dir, table, version);
         let checked_in = std::fs::read_to_string(&path).unwrap_or_default();
-        let generated = generate(table).unwrap();
+        let generated = version.model_description(table).unwrap();
         assert!(
             checked_in == generated,
             "{} is out of date with the variable tables; regenerate it with\n    \
@@ -40,7 +42,11 @@ fn checked_in_model_descriptions_match_the_generated_ones() {
              and review the diff",
             path.display()
         );
-        assert!(generated.contains(&format!("guid=\"{}\"", table.guid)));
+        let token = match version {
+            Version::Fmi2 => format!("guid=\"{}\"", table.guid),
+            Version::Fmi3 => format!("instantiationToken=\"{}\"", table.token3),
+        };
+        assert!(generated.contains(&token), "{token}");
     }
 }
 

@@ -19,7 +19,8 @@ ROOT = Path(__file__).resolve().parents[2]
 def fmus() -> dict[str, Path]:
     out = ROOT / "dist" / "fmu"
     subprocess.run(["bash", str(ROOT / "scripts" / "pack-fmus.sh"), str(out)], cwd=ROOT, check=True)
-    paths = {name: out / f"{name}.fmu" for name in ("Quadrotor", "Lander2D")}
+    names = ("Quadrotor", "Lander2D", "Quadrotor-fmi3", "Lander2D-fmi3")
+    paths = {name: out / f"{name}.fmu" for name in names}
     for path in paths.values():
         assert path.is_file(), path
     return paths

@@ -1,5 +1,5 @@
-//! flyloop-fmu-pack: writes Quadrotor.fmu and Lander2D.fmu, or the checked-in
-//! modelDescription copies.
+//! flyloop-fmu-pack: writes Quadrotor.fmu and Lander2D.fmu (FMI 2.0), Quadrotor-fmi3.fmu and
+//! Lander2D-fmi3.fmu (FMI 3.0), or the checked-in modelDescription copies of all four.
 //!
 //! ```text
 //! flyloop-fmu-pack fmus <libflyloop_fmu.so> <out-dir>
@@ -9,7 +9,7 @@
 //! scripts/pack-fmus.sh builds the library and runs the first form into dist/fmu.
 
 use flyloop_fmu::models::tables;
-use flyloop_fmu::pack::{write_fmu, write_model_description};
+use flyloop_fmu::pack::{Version, write_fmu, write_model_description};
 use std::path::Path;
 use std::process::ExitCode;
 
@@ -20,13 +20,15 @@ fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let result = match args.as_slice() {
-        ["fmus", library, out] => tables()
+        ["fmus", library, out] => Version::ALL
             .into_iter()
-            .map(|t| write_fmu(t, Path::new(library), Path::new(out)))
+            .flat_map(|v| tables().map(|t| (t, v)))
+            .map(|(t, v)| write_fmu(t, v, Path::new(library), Path::new(out)))
             .collect::<Result<Vec<_>, _>>(),
-        ["model-descriptions", dir] => tables()
+        ["model-descriptions", dir] => Version::ALL
             .into_iter()
-            .map(|t| write_model_description(t, Path::new(dir)))
+            .flat_map(|v| tables().map(|t| (t, v)))
+            .map(|(t, v)| write_model_description(t, v, Path::new(dir)))
             .collect::<Result<Vec<_>, _>>(),
         _ => {
             eprintln!("{USAGE}");

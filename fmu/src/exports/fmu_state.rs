@@ -10,18 +10,21 @@ use crate::error::FmuError;
 use crate::fmi2_types::*;
 use crate::instance::{SavedState, masks};
 use flyloop_core::number::Compact;
+use std::ffi::c_void;
+
+/// An FMU state pointer (fmi2FMUstate, fmi3FMUState).
+type StatePtr = *mut c_void;
 
 /// Copies the current state. `*FMUstate` NULL gets a new state; a state of this instance is
 /// overwritten in place.
 ///
 /// # Safety
 /// `FMUstate` must be NULL or valid for reads and writes of one pointer.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetFMUstate(
+pub(crate) unsafe fn get_state(
     c: fmi2Component,
-    FMUstate: *mut fmi2FMUstate,
+    function: &'static str,
+    FMUstate: *mut StatePtr,
 ) -> fmi2Status {
-    let function = "fmi2GetFMUstate";
     with_instance(c, function, masks::FMU_STATE, |instance| {
         if FMUstate.is_null() {
             return Err(FmuError::NullArgument("FMUstate"));
@@ -49,9 +52,11 @@ pub unsafe extern "C" fn fmi2GetFMUstate(
 /// # Safety
 /// `c` must be NULL or a live instance; `FMUstate` may be anything (it is looked up, not
 /// dereferenced).
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
-    let function = "fmi2SetFMUstate";
+pub(crate) unsafe fn set_state(
+    c: fmi2Component,
+    function: &'static str,
+    FMUstate: StatePtr,
+) -> fmi2Status {
     with_instance(c, function, masks::FMU_STATE, |instance| {
         if FMUstate.is_null() {
             return Err(FmuError::NullArgument("FMUstate"));
@@ -76,12 +81,12 @@ pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstat
 ///
 /// # Safety
 /// `FMUstate` must be NULL or valid for reads and writes of one pointer.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2FreeFMUstate(
+pub(crate) unsafe fn free_state(
     c: fmi2Component,
-    FMUstate: *mut fmi2FMUstate,
+    function: &'static str,
+    FMUstate: *mut StatePtr,
 ) -> fmi2Status {
-    with_instance(c, "fmi2FreeFMUstate", masks::FMU_STATE, |instance| {
+    with_instance(c, function, masks::FMU_STATE, |instance| {
         if FMUstate.is_null() {
             return Err(FmuError::NullArgument("FMUstate"));
         }
@@ -99,37 +104,32 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(
 
 /// # Safety
 /// `size` must be NULL or writable.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
+pub(crate) unsafe fn serialized_size(
     c: fmi2Component,
-    FMUstate: fmi2FMUstate,
+    function: &'static str,
+    FMUstate: StatePtr,
     size: *mut usize,
 ) -> fmi2Status {
-    with_instance(
-        c,
-        "fmi2SerializedFMUstateSize",
-        masks::FMU_STATE,
-        |instance| {
-            let length = instance.state(FMUstate as usize)?.bytes.len();
-            // SAFETY: per the contract.
-            unsafe { write_out(size, length, "size") }?;
-            Ok(fmi2Status::fmi2OK)
-        },
-    )
+    with_instance(c, function, masks::FMU_STATE, |instance| {
+        let length = instance.state(FMUstate as usize)?.bytes.len();
+        // SAFETY: per the contract.
+        unsafe { write_out(size, length, "size") }?;
+        Ok(fmi2Status::fmi2OK)
+    })
 }
 
 /// Copies a state's bytes; `size` must be what fmi2SerializedFMUstateSize said.
 ///
 /// # Safety
 /// `serializedState` must be NULL or writable for `size` bytes.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SerializeFMUstate(
+pub(crate) unsafe fn serialize(
     c: fmi2Component,
-    FMUstate: fmi2FMUstate,
-    serializedState: *mut fmi2Byte,
+    function: &'static str,
+    FMUstate: StatePtr,
+    serializedState: *mut u8,
     size: usize,
 ) -> fmi2Status {
-    with_instance(c, "fmi2SerializeFMUstate", masks::FMU_STATE, |instance| {
+    with_instance(c, function, masks::FMU_STATE, |instance| {
         let bytes = &instance.state(FMUstate as usize)?.bytes;
         if size != bytes.len() {
             return Err(FmuError::InvalidArgument(format!(
@@ -139,7 +139,7 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
             )));
         }
         // SAFETY: per the contract.
-        let out = unsafe { c_slice_mut(serializedState.cast::<u8>(), size, "serializedState") }?;
+        let out = unsafe { c_slice_mut(serializedState, size, "serializedState") }?;
         out.copy_from_slice(bytes);
         Ok(fmi2Status::fmi2OK)
     })
@@ -151,19 +151,19 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
 /// # Safety
 /// `serializedState` must be NULL or readable for `size` bytes; `FMUstate` must be NULL or
 /// valid for reads and writes of one pointer.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
+pub(crate) unsafe fn deserialize(
     c: fmi2Component,
-    serializedState: *const fmi2Byte,
+    function: &'static str,
+    serializedState: *const u8,
     size: usize,
-    FMUstate: *mut fmi2FMUstate,
+    FMUstate: *mut StatePtr,
 ) -> fmi2Status {
-    with_instance(c, "fmi2DeSerializeFMUstate", masks::FMU_STATE, |instance| {
+    with_instance(c, function, masks::FMU_STATE, |instance| {
         if FMUstate.is_null() {
             return Err(FmuError::NullArgument("FMUstate"));
         }
         // SAFETY: per the contract.
-        let bytes = unsafe { c_slice(serializedState.cast::<u8>(), size, "serializedState") }?;
+        let bytes = unsafe { c_slice(serializedState, size, "serializedState") }?;
         instance.stage_from_code(instance.sim.check_saved(bytes)?)?;
         // SAFETY: non-NULL and readable per the contract.
         let existing = unsafe { FMUstate.read() };
@@ -178,4 +178,85 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
         }
         Ok(fmi2Status::fmi2OK)
     })
+}
+
+/// See [`get_state`].
+///
+/// # Safety
+/// `FMUstate` must be NULL or valid for reads and writes of one pointer.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetFMUstate(
+    c: fmi2Component,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    // SAFETY: forwarded contract.
+    unsafe { get_state(c, "fmi2GetFMUstate", FMUstate) }
+}
+
+/// See [`set_state`].
+///
+/// # Safety
+/// `c` must be NULL or a live instance.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
+    // SAFETY: forwarded contract.
+    unsafe { set_state(c, "fmi2SetFMUstate", FMUstate) }
+}
+
+/// See [`free_state`].
+///
+/// # Safety
+/// `FMUstate` must be NULL or valid for reads and writes of one pointer.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2FreeFMUstate(
+    c: fmi2Component,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    // SAFETY: forwarded contract.
+    unsafe { free_state(c, "fmi2FreeFMUstate", FMUstate) }
+}
+
+/// # Safety
+/// `size` must be NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
+    c: fmi2Component,
+    FMUstate: fmi2FMUstate,
+    size: *mut usize,
+) -> fmi2Status {
+    // SAFETY: forwarded contract.
+    unsafe { serialized_size(c, "fmi2SerializedFMUstateSize", FMUstate, size) }
+}
+
+/// See [`serialize`].
+///
+/// # Safety
+/// `serializedState` must be NULL or writable for `size` bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SerializeFMUstate(
+    c: fmi2Component,
+    FMUstate: fmi2FMUstate,
+    serializedState: *mut fmi2Byte,
+    size: usize,
+) -> fmi2Status {
+    let out = serializedState.cast::<u8>();
+    // SAFETY: forwarded contract.
+    unsafe { serialize(c, "fmi2SerializeFMUstate", FMUstate, out, size) }
+}
+
+/// See [`deserialize`].
+///
+/// # Safety
+/// `serializedState` must be NULL or readable for `size` bytes; `FMUstate` must be NULL or
+/// valid for reads and writes of one pointer.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
+    c: fmi2Component,
+    serializedState: *const fmi2Byte,
+    size: usize,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    let bytes = serializedState.cast::<u8>();
+    // SAFETY: forwarded contract.
+    unsafe { deserialize(c, "fmi2DeSerializeFMUstate", bytes, size, FMUstate) }
 }

@@ -1,11 +1,11 @@
 //! Creating, configuring, initialising, terminating, resetting and freeing an instance.
 
 use super::guard::{c_slice, guarded, with_instance};
+use super::instantiate::{Request, create_instance};
 use crate::error::FmuError;
 use crate::fmi2_types::*;
-use crate::instance::{Instance, Interface, Stage, masks};
-use crate::log::{self, Category, Logger};
-use crate::models;
+use crate::instance::{Api, Instance, Interface, Stage, masks};
+use crate::log::{Category, Sink};
 use flyloop_core::number::Compact;
 use std::ffi::{CStr, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -42,76 +42,28 @@ pub unsafe extern "C" fn fmi2Instantiate(
     let outcome = catch_unwind(AssertUnwindSafe(|| {
         // SAFETY: NULL or a valid callback struct (the importer's contract).
         let functions = unsafe { functions.as_ref() }.copied()?;
-        let logger = functions.logger?;
-        let env = functions.componentEnvironment;
-        // SAFETY: NULL or a NUL-terminated string.
-        let name = unsafe { c_str(instanceName) };
-        let fail = |message: &str| {
-            let shown = name.map(CStr::to_owned).unwrap_or_default();
-            // SAFETY: logger and environment come together from the importer's callbacks.
-            unsafe {
-                log::send(
-                    logger,
-                    env,
-                    &shown,
-                    fmi2Status::fmi2Error,
-                    Category::Error,
-                    &format!("fmi2Instantiate: {message}"),
-                );
-            }
-            None
-        };
-        let Some(name) = name.filter(|n| !n.is_empty()) else {
-            return fail("instanceName is NULL or empty");
+        let sink = Sink::Fmi2 {
+            callback: functions.logger?,
+            environment: functions.componentEnvironment,
         };
         let interface = match fmuType {
-            fmi2CoSimulation => Interface::CoSimulation,
-            fmi2ModelExchange => Interface::ModelExchange,
-            other => {
-                return fail(&format!(
-                    "fmuType {other} is neither Model Exchange (0) nor Co-Simulation (1)"
-                ));
-            }
+            fmi2CoSimulation => Ok(Interface::CoSimulation),
+            fmi2ModelExchange => Ok(Interface::ModelExchange),
+            other => Err(format!(
+                "fmuType {other} is neither Model Exchange (0) nor Co-Simulation (1)"
+            )),
         };
-        // SAFETY: NULL or a NUL-terminated string.
-        let Some(guid) = (unsafe { c_str(fmuGUID) }) else {
-            return fail("fmuGUID is NULL");
-        };
-        let guid = guid.to_string_lossy();
-        let Some(sim) = models::simulation_for(&guid) else {
-            let known: Vec<String> = models::tables()
-                .iter()
-                .map(|t| format!("{} {}", t.info.identifier, t.guid))
-                .collect();
-            return fail(&format!(
-                "GUID {guid} is not one of this library's models ({}); the \
-                 modelDescription.xml and the binary do not belong together",
-                known.join(", ")
-            ));
-        };
-        let sim = match sim {
-            Ok(sim) => sim,
-            Err(e) => return fail(&format!("the model does not start: {e}")),
-        };
-        if interface == Interface::ModelExchange && sim.table().model_exchange.is_none() {
-            return fail(&format!(
-                "{} is Co-Simulation only (its physics engine steps internally); \
-                 instantiate it with fmuType fmi2CoSimulation",
-                sim.table().info.identifier
-            ));
-        }
-        let instance = Instance::new(
+        // SAFETY: NULL or NUL-terminated strings (the contract).
+        let (name, guid) = unsafe { (c_str(instanceName), c_str(fmuGUID)) };
+        create_instance(&Request {
+            function: "fmi2Instantiate",
+            api: Api::Fmi2,
+            name,
             interface,
-            Logger::new(logger, env, name.to_owned()),
-            loggingOn != fmi2False,
-            sim,
-        );
-        instance.event(&format!(
-            "fmi2Instantiate: {} {:?} instance ({guid}) created",
-            instance.sim.table().info.identifier,
-            instance.interface
-        ));
-        Some(Box::into_raw(Box::new(instance)))
+            token: guid,
+            sink,
+            logging_on: loggingOn != fmi2False,
+        })
     }));
     match outcome {
         Ok(Some(instance)) => instance.cast(),
@@ -123,19 +75,15 @@ pub unsafe extern "C" fn fmi2Instantiate(
 ///
 /// # Safety
 /// `s` must be NULL or NUL-terminated and valid for the call.
-unsafe fn c_str<'a>(s: fmi2String) -> Option<&'a CStr> {
+pub(crate) unsafe fn c_str<'a>(s: *const c_char) -> Option<&'a CStr> {
     // SAFETY: per the function's contract.
     (!s.is_null()).then(|| unsafe { CStr::from_ptr(s) })
 }
 
-/// Frees the instance and every FMU state it handed out. NULL is ignored.
-///
-/// # Safety
-/// `c` must be NULL or an instance not freed yet.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
-    let status = with_instance(c, "fmi2FreeInstance", masks::FREE_INSTANCE, |instance| {
-        instance.event("fmi2FreeInstance: freeing the instance");
+/// Frees the instance behind `c` (the body of fmi2FreeInstance and fmi3FreeInstance).
+pub(crate) fn free_instance(c: fmi2Component, function: &'static str) {
+    let status = with_instance(c, function, masks::FREE_INSTANCE, |instance| {
+        instance.event(&format!("{function}: freeing the instance"));
         Ok(fmi2Status::fmi2OK)
     });
     // Free only what passed the stage check (FREE_INSTANCE allows every stage an instance
@@ -146,6 +94,54 @@ pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
             drop(unsafe { Box::from_raw(c.cast::<Instance>()) });
         }));
     }
+}
+
+/// Frees the instance and every FMU state it handed out. NULL is ignored.
+///
+/// # Safety
+/// `c` must be NULL or an instance not freed yet.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
+    free_instance(c, "fmi2FreeInstance");
+}
+
+/// The body of fmi2SetDebugLogging and fmi3SetDebugLogging.
+///
+/// # Safety
+/// `categories` must be NULL or point to `n` C strings.
+pub(crate) unsafe fn set_debug_logging(
+    c: fmi2Component,
+    function: &'static str,
+    on: bool,
+    n: usize,
+    categories: *const fmi2String,
+) -> fmi2Status {
+    with_instance(c, function, masks::SET_DEBUG_LOGGING, |instance| {
+        // SAFETY: per the function's contract.
+        let names = unsafe { c_slice(categories, n, "categories[]") }?;
+        if names.is_empty() {
+            instance.filter.set_all(on);
+            return Ok(fmi2Status::fmi2OK);
+        }
+        let mut worst = fmi2Status::fmi2OK;
+        for &name in names {
+            // SAFETY: each entry is NULL or a C string (the contract).
+            let name = unsafe { c_str(name) }.map(CStr::to_string_lossy);
+            let error = match name.as_deref().map(|n| (n, Category::from_name(n))) {
+                Some((_, Some(category))) => {
+                    instance.filter.set(category, on);
+                    continue;
+                }
+                Some((n, None)) => FmuError::InvalidArgument(format!(
+                    "unknown log category `{n}` (known: logEvents, logStatusWarning, \
+                     logStatusError, logStatusFatal)"
+                )),
+                None => FmuError::NullArgument("categories[i]"),
+            };
+            worst = worst.max(instance.report(function, &error));
+        }
+        Ok(worst)
+    })
 }
 
 /// Switches log categories: those named in `categories`, or all of them when
@@ -160,38 +156,25 @@ pub unsafe extern "C" fn fmi2SetDebugLogging(
     nCategories: usize,
     categories: *const fmi2String,
 ) -> fmi2Status {
-    with_instance(
-        c,
-        "fmi2SetDebugLogging",
-        masks::SET_DEBUG_LOGGING,
-        |instance| {
-            let on = loggingOn != fmi2False;
-            // SAFETY: per the function's contract.
-            let names = unsafe { c_slice(categories, nCategories, "categories[]") }?;
-            if names.is_empty() {
-                instance.filter.set_all(on);
-                return Ok(fmi2Status::fmi2OK);
-            }
-            let mut worst = fmi2Status::fmi2OK;
-            for &name in names {
-                // SAFETY: each entry is NULL or a C string (the contract).
-                let name = unsafe { c_str(name) }.map(CStr::to_string_lossy);
-                let error = match name.as_deref().map(|n| (n, Category::from_name(n))) {
-                    Some((_, Some(category))) => {
-                        instance.filter.set(category, on);
-                        continue;
-                    }
-                    Some((n, None)) => FmuError::InvalidArgument(format!(
-                        "unknown log category `{n}` (known: logEvents, logStatusWarning, \
-                     logStatusError, logStatusFatal)"
-                    )),
-                    None => FmuError::NullArgument("categories[i]"),
-                };
-                worst = worst.max(instance.report("fmi2SetDebugLogging", &error));
-            }
-            Ok(worst)
-        },
-    )
+    let on = loggingOn != fmi2False;
+    // SAFETY: forwarded contract.
+    unsafe { set_debug_logging(c, "fmi2SetDebugLogging", on, nCategories, categories) }
+}
+
+/// The experiment (fmi2SetupExperiment; fmi3EnterInitializationMode's arguments).
+pub(crate) fn setup_experiment(
+    instance: &mut Instance,
+    function: &str,
+    start: f64,
+    stop: Option<f64>,
+) -> Result<(), FmuError> {
+    instance.sim.setup_experiment(start, stop)?;
+    instance.event(&format!(
+        "{function}: start {}, stop {}",
+        Compact(start),
+        stop.map_or("undefined".to_string(), |s| Compact(s).to_string())
+    ));
+    Ok(())
 }
 
 /// Sets the start time (and the stop time, if defined). The tolerance is not used: both
@@ -208,21 +191,12 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
     stopTimeDefined: fmi2Boolean,
     stopTime: fmi2Real,
 ) -> fmi2Status {
-    with_instance(
-        c,
-        "fmi2SetupExperiment",
-        masks::SETUP_EXPERIMENT,
-        |instance| {
-            let stop = (stopTimeDefined != fmi2False).then_some(stopTime);
-            instance.sim.setup_experiment(startTime, stop)?;
-            instance.event(&format!(
-                "fmi2SetupExperiment: start {}, stop {}",
-                Compact(startTime),
-                stop.map_or("undefined".to_string(), |s| Compact(s).to_string())
-            ));
-            Ok(fmi2Status::fmi2OK)
-        },
-    )
+    let function = "fmi2SetupExperiment";
+    with_instance(c, function, masks::SETUP_EXPERIMENT, |instance| {
+        let stop = (stopTimeDefined != fmi2False).then_some(stopTime);
+        setup_experiment(instance, function, startTime, stop)?;
+        Ok(fmi2Status::fmi2OK)
+    })
 }
 
 /// # Safety
@@ -237,11 +211,9 @@ pub unsafe extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2St
     })
 }
 
-/// # Safety
-/// `c` must be NULL or a live instance.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
-    let function = "fmi2ExitInitializationMode";
+/// The body of fmi2ExitInitializationMode and fmi3ExitInitializationMode: Co-Simulation
+/// goes to step mode, Model Exchange to event mode.
+pub(crate) fn exit_initialization_mode(c: fmi2Component, function: &'static str) -> fmi2Status {
     with_instance(c, function, masks::EXIT_INITIALIZATION_MODE, |instance| {
         instance.stage = match instance.interface {
             Interface::CoSimulation => Stage::StepComplete,
@@ -255,13 +227,32 @@ pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Sta
 /// # Safety
 /// `c` must be NULL or a live instance.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
-    with_instance(c, "fmi2Terminate", masks::TERMINATE, |instance| {
+pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
+    exit_initialization_mode(c, "fmi2ExitInitializationMode")
+}
+
+/// The body of fmi2Terminate and fmi3Terminate.
+pub(crate) fn terminate(c: fmi2Component, function: &'static str) -> fmi2Status {
+    with_instance(c, function, masks::TERMINATE, |instance| {
         instance.stage = Stage::Terminated;
-        instance.event(&format!(
-            "fmi2Terminate: t = {}",
-            Compact(instance.sim.time())
-        ));
+        instance.event(&format!("{function}: t = {}", Compact(instance.sim.time())));
+        Ok(fmi2Status::fmi2OK)
+    })
+}
+
+/// # Safety
+/// `c` must be NULL or a live instance.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
+    terminate(c, "fmi2Terminate")
+}
+
+/// The body of fmi2Reset and fmi3Reset: back to the state right after instantiation.
+pub(crate) fn reset(c: fmi2Component, function: &'static str) -> fmi2Status {
+    with_instance(c, function, masks::RESET, |instance| {
+        instance.sim.reset()?;
+        instance.stage = Stage::Instantiated;
+        instance.event(&format!("{function}: back to the start values"));
         Ok(fmi2Status::fmi2OK)
     })
 }
@@ -273,10 +264,5 @@ pub unsafe extern "C" fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
 /// `c` must be NULL or a live instance.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
-    with_instance(c, "fmi2Reset", masks::RESET, |instance| {
-        instance.sim.reset()?;
-        instance.stage = Stage::Instantiated;
-        instance.event("fmi2Reset: back to the start values");
-        Ok(fmi2Status::fmi2OK)
-    })
+    reset(c, "fmi2Reset")
 }

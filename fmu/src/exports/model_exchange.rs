@@ -8,10 +8,11 @@ use super::guard::{c_slice, c_slice_mut, with_instance, write_out};
 use crate::error::FmuError;
 use crate::fmi2_types::*;
 use crate::instance::{Instance, Mask, Stage, masks};
+use crate::simulation::Simulation;
 use flyloop_core::number::Compact;
 
 /// [`with_instance`] for a Model Exchange function: also refuses a Co-Simulation instance.
-fn with_me(
+pub(crate) fn with_me(
     c: fmi2Component,
     function: &'static str,
     mask: Mask,
@@ -89,8 +90,35 @@ pub unsafe extern "C" fn fmi2EnterContinuousTimeMode(c: fmi2Component) -> fmi2St
     )
 }
 
-/// No step event and no termination; an error (Error stage) once the state is not finite.
+/// The body of fmi2CompletedIntegratorStep and fmi3CompletedIntegratorStep: no step event
+/// and no termination (`no` is the version's false); an error (Error stage) once the state is
+/// not finite.
 ///
+/// # Safety
+/// The two flags must be NULL or writable.
+pub(crate) unsafe fn completed_integrator_step<B: Copy>(
+    c: fmi2Component,
+    function: &'static str,
+    enter_event_mode: *mut B,
+    terminate_simulation: *mut B,
+    no: B,
+) -> fmi2Status {
+    with_me(c, function, masks::COMPLETED_INTEGRATOR_STEP, |instance| {
+        if enter_event_mode.is_null() {
+            return Err(FmuError::NullArgument("enterEventMode"));
+        }
+        if terminate_simulation.is_null() {
+            return Err(FmuError::NullArgument("terminateSimulation"));
+        }
+        instance.sim.completed_integrator_step()?;
+        // SAFETY: both non-NULL (checked above) and writable per the contract.
+        unsafe {
+            write_out(enter_event_mode, no, "enterEventMode")?;
+            write_out(terminate_simulation, no, "terminateSimulation")
+        }
+    })
+}
+
 /// # Safety
 /// `c` must be NULL or a live instance; the two flags NULL or writable.
 #[unsafe(no_mangle)]
@@ -100,25 +128,9 @@ pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
     enterEventMode: *mut fmi2Boolean,
     terminateSimulation: *mut fmi2Boolean,
 ) -> fmi2Status {
-    with_me(
-        c,
-        "fmi2CompletedIntegratorStep",
-        masks::COMPLETED_INTEGRATOR_STEP,
-        |instance| {
-            if enterEventMode.is_null() {
-                return Err(FmuError::NullArgument("enterEventMode"));
-            }
-            if terminateSimulation.is_null() {
-                return Err(FmuError::NullArgument("terminateSimulation"));
-            }
-            instance.sim.completed_integrator_step()?;
-            // SAFETY: both non-NULL (checked above) and writable per the contract.
-            unsafe {
-                write_out(enterEventMode, fmi2False, "enterEventMode")?;
-                write_out(terminateSimulation, fmi2False, "terminateSimulation")
-            }
-        },
-    )
+    let function = "fmi2CompletedIntegratorStep";
+    // SAFETY: forwarded contract.
+    unsafe { completed_integrator_step(c, function, enterEventMode, terminateSimulation, 0) }
 }
 
 /// # Safety
@@ -130,6 +142,23 @@ pub unsafe extern "C" fn fmi2SetTime(c: fmi2Component, time: fmi2Real) -> fmi2St
     })
 }
 
+/// The body of fmi2SetContinuousStates and fmi3SetContinuousStates.
+///
+/// # Safety
+/// `x` must be NULL or hold `nx` readable values.
+pub(crate) unsafe fn set_continuous_states(
+    c: fmi2Component,
+    function: &'static str,
+    x: *const f64,
+    nx: usize,
+) -> fmi2Status {
+    with_me(c, function, masks::SET_CONTINUOUS_STATES, |instance| {
+        // SAFETY: per the function's contract.
+        let x = unsafe { c_slice(x, nx, "continuous states") }?;
+        instance.sim.set_continuous_states(x)
+    })
+}
+
 /// # Safety
 /// `c` must be NULL or a live instance; `x` NULL or `nx` readable values.
 #[unsafe(no_mangle)]
@@ -138,17 +167,48 @@ pub unsafe extern "C" fn fmi2SetContinuousStates(
     x: *const fmi2Real,
     nx: usize,
 ) -> fmi2Status {
-    with_me(
-        c,
-        "fmi2SetContinuousStates",
-        masks::SET_CONTINUOUS_STATES,
-        |instance| {
-            // SAFETY: per the function's contract.
-            let x = unsafe { c_slice(x, nx, "x") }?;
-            instance.sim.set_continuous_states(x)
-        },
-    )
+    // SAFETY: forwarded contract.
+    unsafe { set_continuous_states(c, "fmi2SetContinuousStates", x, nx) }
 }
+
+/// A Model Exchange array the importer reads: the call's name, allowed stages, the array
+/// argument's name, and what fills it.
+pub(crate) struct Reader {
+    pub function: &'static str,
+    pub mask: Mask,
+    pub argument: &'static str,
+    pub fill: fn(&dyn Simulation, &mut [f64]) -> Result<(), FmuError>,
+}
+
+/// Fills the importer's array `out` of `n` values with `reader.fill`.
+///
+/// # Safety
+/// `out` must be NULL or hold `n` writable values.
+pub(crate) unsafe fn read_array(
+    c: fmi2Component,
+    reader: &Reader,
+    out: *mut f64,
+    n: usize,
+) -> fmi2Status {
+    with_me(c, reader.function, reader.mask, |instance| {
+        // SAFETY: per the function's contract.
+        let out = unsafe { c_slice_mut(out, n, reader.argument) }?;
+        (reader.fill)(instance.sim.as_ref(), out)
+    })
+}
+
+/// The derivatives of the continuous states: the core's right-hand side, bit for bit.
+pub(crate) const DERIVATIVES: fn(&dyn Simulation, &mut [f64]) -> Result<(), FmuError> =
+    |sim, out| sim.derivatives(out);
+/// The foot heights (m): a sign change is a touch-down or a lift-off.
+pub(crate) const EVENT_INDICATORS: fn(&dyn Simulation, &mut [f64]) -> Result<(), FmuError> =
+    |sim, out| sim.event_indicators(out);
+/// The continuous states.
+pub(crate) const STATES: fn(&dyn Simulation, &mut [f64]) -> Result<(), FmuError> =
+    |sim, out| sim.continuous_states(out);
+/// 1 for every state (positions in m, speeds in m/s, quaternion and motors near 1).
+pub(crate) const NOMINALS: fn(&dyn Simulation, &mut [f64]) -> Result<(), FmuError> =
+    |sim, out| sim.nominals(out);
 
 /// The derivatives of the continuous states: the core's right-hand side, bit for bit.
 ///
@@ -160,16 +220,14 @@ pub unsafe extern "C" fn fmi2GetDerivatives(
     derivatives: *mut fmi2Real,
     nx: usize,
 ) -> fmi2Status {
-    with_me(
-        c,
-        "fmi2GetDerivatives",
-        masks::GET_DERIVATIVES,
-        |instance| {
-            // SAFETY: per the function's contract.
-            let dx = unsafe { c_slice_mut(derivatives, nx, "derivatives") }?;
-            instance.sim.derivatives(dx)
-        },
-    )
+    let reader = Reader {
+        function: "fmi2GetDerivatives",
+        mask: masks::GET_DERIVATIVES,
+        argument: "derivatives",
+        fill: DERIVATIVES,
+    };
+    // SAFETY: forwarded contract.
+    unsafe { read_array(c, &reader, derivatives, nx) }
 }
 
 /// The foot heights (m): a sign change is a touch-down or a lift-off.
@@ -182,16 +240,14 @@ pub unsafe extern "C" fn fmi2GetEventIndicators(
     eventIndicators: *mut fmi2Real,
     ni: usize,
 ) -> fmi2Status {
-    with_me(
-        c,
-        "fmi2GetEventIndicators",
-        masks::GET_EVENT_INDICATORS,
-        |instance| {
-            // SAFETY: per the function's contract.
-            let z = unsafe { c_slice_mut(eventIndicators, ni, "eventIndicators") }?;
-            instance.sim.event_indicators(z)
-        },
-    )
+    let reader = Reader {
+        function: "fmi2GetEventIndicators",
+        mask: masks::GET_EVENT_INDICATORS,
+        argument: "eventIndicators",
+        fill: EVENT_INDICATORS,
+    };
+    // SAFETY: forwarded contract.
+    unsafe { read_array(c, &reader, eventIndicators, ni) }
 }
 
 /// # Safety
@@ -202,16 +258,14 @@ pub unsafe extern "C" fn fmi2GetContinuousStates(
     x: *mut fmi2Real,
     nx: usize,
 ) -> fmi2Status {
-    with_me(
-        c,
-        "fmi2GetContinuousStates",
-        masks::GET_CONTINUOUS_STATES,
-        |instance| {
-            // SAFETY: per the function's contract.
-            let x = unsafe { c_slice_mut(x, nx, "x") }?;
-            instance.sim.continuous_states(x)
-        },
-    )
+    let reader = Reader {
+        function: "fmi2GetContinuousStates",
+        mask: masks::GET_CONTINUOUS_STATES,
+        argument: "x",
+        fill: STATES,
+    };
+    // SAFETY: forwarded contract.
+    unsafe { read_array(c, &reader, x, nx) }
 }
 
 /// 1 for every state (positions in m, speeds in m/s, quaternion and motors near 1).
@@ -224,14 +278,12 @@ pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(
     x_nominal: *mut fmi2Real,
     nx: usize,
 ) -> fmi2Status {
-    with_me(
-        c,
-        "fmi2GetNominalsOfContinuousStates",
-        masks::GET_NOMINALS,
-        |instance| {
-            // SAFETY: per the function's contract.
-            let nominals = unsafe { c_slice_mut(x_nominal, nx, "x_nominal") }?;
-            instance.sim.nominals(nominals)
-        },
-    )
+    let reader = Reader {
+        function: "fmi2GetNominalsOfContinuousStates",
+        mask: masks::GET_NOMINALS,
+        argument: "x_nominal",
+        fill: NOMINALS,
+    };
+    // SAFETY: forwarded contract.
+    unsafe { read_array(c, &reader, x_nominal, nx) }
 }

@@ -7,7 +7,7 @@ use crate::fmi2_types::*;
 use crate::instance::{Instance, Mask, Stage, masks};
 use crate::simulation::FmiType;
 
-fn initialised(instance: &Instance) -> bool {
+pub(crate) fn initialised(instance: &Instance) -> bool {
     !matches!(
         instance.stage,
         Stage::Instantiated | Stage::InitializationMode

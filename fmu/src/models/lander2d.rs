@@ -21,6 +21,9 @@ static INFO: ModelInfo = ModelInfo {
         ("wind_force_y", &["wind_force_input_y"]),
     ],
     state_free_outputs: &[],
+    // Two commands read better by name (left, right) than as an array.
+    arrays: &[],
+    event_indicators: &[],
 };
 
 impl FmuModel for Lander2d {

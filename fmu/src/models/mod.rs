@@ -4,6 +4,7 @@ mod lander2d;
 mod quadrotor;
 
 use crate::error::FmuError;
+use crate::instance::Api;
 use crate::model::{FmuModel, ModelTable};
 use crate::simulation::{Engine, Simulation};
 use flyloop_core::lander2d::Lander2d;
@@ -14,11 +15,12 @@ pub fn tables() -> [&'static ModelTable; 2] {
     [Quadrotor::table(), Lander2d::table()]
 }
 
-/// A fresh simulation of the model whose GUID is `guid`, or `None` for an unknown GUID.
-pub fn simulation_for(guid: &str) -> Option<Result<Box<dyn Simulation>, FmuError>> {
-    if guid == Quadrotor::table().guid {
+/// A fresh simulation of the model whose GUID (FMI 2.0) or instantiation token (FMI 3.0) is
+/// `token`, or `None` for an unknown one.
+pub fn simulation_for(api: Api, token: &str) -> Option<Result<Box<dyn Simulation>, FmuError>> {
+    if token == Quadrotor::table().token(api) {
         Some(Engine::<Quadrotor>::new().map(|e| Box::new(e) as Box<dyn Simulation>))
-    } else if guid == Lander2d::table().guid {
+    } else if token == Lander2d::table().token(api) {
         Some(Engine::<Lander2d>::new().map(|e| Box::new(e) as Box<dyn Simulation>))
     } else {
         None

@@ -38,6 +38,39 @@ static INFO: ModelInfo = ModelInfo {
     ],
     // The wind is the episode wind plus the input: turbulence is a discrete state.
     state_free_outputs: &["wind_x", "wind_y", "wind_z"],
+    arrays: &[
+        (
+            "motor_command",
+            "Commands of the four motors, 0 .. 1 each: front-right (CCW), rear-left (CCW), \
+             front-left (CW), rear-right (CW)",
+        ),
+        (
+            "motor_state",
+            "Lagged states of the four motors (order of motor_command)",
+        ),
+    ],
+    event_indicators: &[
+        (
+            "foot_height_0",
+            "m",
+            "Height of foot 0 (front-right) above the ground; 1 with the ground off (event indicator)",
+        ),
+        (
+            "foot_height_1",
+            "m",
+            "Height of foot 1 (rear-left) above the ground (event indicator)",
+        ),
+        (
+            "foot_height_2",
+            "m",
+            "Height of foot 2 (front-left) above the ground (event indicator)",
+        ),
+        (
+            "foot_height_3",
+            "m",
+            "Height of foot 3 (rear-right) above the ground (event indicator)",
+        ),
+    ],
 };
 
 /// Value references of the bristle states (locals) and of the 25 derivatives.

@@ -1,0 +1,222 @@
+//! The FMI 3.0 functions for what these FMUs do not have: variables of the other ten types,
+//! clocks, structural parameters (configuration mode), per-element dependencies, directional
+//! and adjoint derivatives, evaluateDiscreteStates and Scheduled Execution. Each is exported
+//! (importers bind every function) and answers fmi3Error with the reason in the log.
+
+use super::values::{Setter, accessors, get_values, set_values};
+use super::with_instance3;
+use crate::error::FmuError;
+use crate::fmi3_types::*;
+use crate::instance::{Mask, masks3};
+use crate::simulation::FmiType;
+
+// Types no variable has: every value reference is refused, naming the variable's real type
+// when it exists; no value is ever converted.
+accessors!(
+    fmi3GetFloat32,
+    fmi3SetFloat32,
+    fmi3Float32,
+    FmiType::Other3("Float32"),
+    masks3::SET_OTHER,
+    |_| 0.0,
+    |_| f64::NAN
+);
+accessors!(
+    fmi3GetInt8,
+    fmi3SetInt8,
+    fmi3Int8,
+    FmiType::Other3("Int8"),
+    masks3::SET_OTHER,
+    |_| 0,
+    |_| f64::NAN
+);
+accessors!(
+    fmi3GetUInt8,
+    fmi3SetUInt8,
+    fmi3UInt8,
+    FmiType::Other3("UInt8"),
+    masks3::SET_OTHER,
+    |_| 0,
+    |_| f64::NAN
+);
+accessors!(
+    fmi3GetInt16,
+    fmi3SetInt16,
+    fmi3Int16,
+    FmiType::Other3("Int16"),
+    masks3::SET_OTHER,
+    |_| 0,
+    |_| f64::NAN
+);
+accessors!(
+    fmi3GetUInt16,
+    fmi3SetUInt16,
+    fmi3UInt16,
+    FmiType::Other3("UInt16"),
+    masks3::SET_OTHER,
+    |_| 0,
+    |_| f64::NAN
+);
+accessors!(
+    fmi3GetUInt32,
+    fmi3SetUInt32,
+    fmi3UInt32,
+    FmiType::Other3("UInt32"),
+    masks3::SET_OTHER,
+    |_| 0,
+    |_| f64::NAN
+);
+accessors!(
+    fmi3GetInt64,
+    fmi3SetInt64,
+    fmi3Int64,
+    FmiType::Other3("Int64"),
+    masks3::SET_OTHER,
+    |_| 0,
+    |_| f64::NAN
+);
+accessors!(
+    fmi3GetUInt64,
+    fmi3SetUInt64,
+    fmi3UInt64,
+    FmiType::Other3("UInt64"),
+    masks3::SET_OTHER,
+    |_| 0,
+    |_| f64::NAN
+);
+accessors!(
+    fmi3GetString,
+    fmi3SetString,
+    fmi3String,
+    FmiType::Other3("String"),
+    masks3::SET_OTHER,
+    |_| std::ptr::null(),
+    |_| f64::NAN
+);
+
+/// No Binary variables: every value reference is refused.
+///
+/// # Safety
+/// `valueReferences` NULL or `nValueReferences` elements; `values` NULL or `nValues`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3GetBinary(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    _valueSizes: *mut usize,
+    values: *mut fmi3Binary,
+    nValues: usize,
+) -> fmi3Status {
+    let vrs = (valueReferences, nValueReferences);
+    // SAFETY: forwarded contract; no value is ever converted.
+    unsafe {
+        get_values(
+            instance,
+            "fmi3GetBinary",
+            FmiType::Other3("Binary"),
+            vrs,
+            (values, nValues),
+            |_| std::ptr::null(),
+        )
+    }
+}
+
+/// No Binary variables: every value reference is refused.
+///
+/// # Safety
+/// `valueReferences` NULL or `nValueReferences` elements; `values` NULL or `nValues`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3SetBinary(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    _valueSizes: *const usize,
+    values: *const fmi3Binary,
+    nValues: usize,
+) -> fmi3Status {
+    let setter = Setter {
+        function: "fmi3SetBinary",
+        mask: masks3::SET_OTHER,
+        ty: FmiType::Other3("Binary"),
+    };
+    let vrs = (valueReferences, nValueReferences);
+    // SAFETY: forwarded contract; the values are never read.
+    unsafe { set_values(instance, setter, vrs, (values, nValues), |_| f64::NAN) }
+}
+
+/// Refuses with `why` (after the NULL and stage checks).
+fn refuse(
+    instance: fmi3Instance,
+    function: &'static str,
+    mask: Mask,
+    why: &'static str,
+) -> fmi3Status {
+    with_instance3(instance, function, mask, |_| {
+        Err(FmuError::NotSupported(why))
+    })
+}
+
+const NO_CLOCKS: &str = "this FMU has no clocks";
+
+/// Defines exported functions that only refuse, each with its C signature.
+macro_rules! refused {
+    ($($name:ident ( $($arg:ident : $t:ty),* ) => $why:expr;)*) => {
+        $(
+            /// Not offered: answers fmi3Error with the reason in the log.
+            ///
+            /// # Safety
+            /// `instance` must be NULL or live; nothing else is read.
+            #[unsafe(no_mangle)]
+            pub unsafe extern "C" fn $name(instance: fmi3Instance, $(_: $t),*) -> fmi3Status {
+                refuse(instance, stringify!($name), masks3::ANY, $why)
+            }
+        )*
+    };
+}
+
+refused! {
+    fmi3GetClock(vrs: *const fmi3ValueReference, n: usize, values: *mut fmi3Clock)
+        => NO_CLOCKS;
+    fmi3SetClock(vrs: *const fmi3ValueReference, n: usize, values: *const fmi3Clock)
+        => NO_CLOCKS;
+    fmi3GetIntervalDecimal(vrs: *const fmi3ValueReference, n: usize, intervals: *mut f64,
+        qualifiers: *mut fmi3IntervalQualifier) => NO_CLOCKS;
+    fmi3GetIntervalFraction(vrs: *const fmi3ValueReference, n: usize, counters: *mut u64,
+        resolutions: *mut u64, qualifiers: *mut fmi3IntervalQualifier) => NO_CLOCKS;
+    fmi3GetShiftDecimal(vrs: *const fmi3ValueReference, n: usize, shifts: *mut f64)
+        => NO_CLOCKS;
+    fmi3GetShiftFraction(vrs: *const fmi3ValueReference, n: usize, counters: *mut u64,
+        resolutions: *mut u64) => NO_CLOCKS;
+    fmi3SetIntervalDecimal(vrs: *const fmi3ValueReference, n: usize, intervals: *const f64)
+        => NO_CLOCKS;
+    fmi3SetIntervalFraction(vrs: *const fmi3ValueReference, n: usize, counters: *const u64,
+        resolutions: *const u64) => NO_CLOCKS;
+    fmi3SetShiftDecimal(vrs: *const fmi3ValueReference, n: usize, shifts: *const f64)
+        => NO_CLOCKS;
+    fmi3SetShiftFraction(vrs: *const fmi3ValueReference, n: usize, counters: *const u64,
+        resolutions: *const u64) => NO_CLOCKS;
+    fmi3ActivateModelPartition(clock: fmi3ValueReference, time: f64)
+        => "Scheduled Execution is not offered";
+    fmi3EnterConfigurationMode()
+        => "configuration mode: this FMU has no structural parameters";
+    fmi3ExitConfigurationMode()
+        => "configuration mode: this FMU has no structural parameters";
+    fmi3EvaluateDiscreteStates()
+        => "evaluateDiscreteStates (providesEvaluateDiscreteStates=\"false\")";
+    fmi3GetNumberOfVariableDependencies(vr: fmi3ValueReference, n: *mut usize)
+        => "per-element dependencies (providesPerElementDependencies=\"false\"); the \
+            modelDescription's ModelStructure lists the dependencies";
+    fmi3GetVariableDependencies(dependent: fmi3ValueReference, element: *mut usize,
+        independents: *mut fmi3ValueReference, elements: *mut usize,
+        kinds: *mut fmi3DependencyKind, n: usize)
+        => "per-element dependencies (providesPerElementDependencies=\"false\"); the \
+            modelDescription's ModelStructure lists the dependencies";
+    fmi3GetDirectionalDerivative(unknowns: *const fmi3ValueReference, nu: usize,
+        knowns: *const fmi3ValueReference, nk: usize, seed: *const f64, ns: usize,
+        sensitivity: *mut f64, nsens: usize)
+        => "directional derivatives (providesDirectionalDerivative=\"false\")";
+    fmi3GetAdjointDerivative(unknowns: *const fmi3ValueReference, nu: usize,
+        knowns: *const fmi3ValueReference, nk: usize, seed: *const f64, ns: usize,
+        sensitivity: *mut f64, nsens: usize)
+        => "adjoint derivatives (providesAdjointDerivatives=\"false\")";
+}

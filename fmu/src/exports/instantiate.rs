@@ -1,0 +1,88 @@
+//! What fmi2Instantiate and FMI 3.0's fmi3Instantiate* share: checking the name, the
+//! interface and the GUID / instantiation token, creating the model, and saying why when any
+//! of it fails.
+
+use crate::fmi2_types::fmi2Status;
+use crate::instance::{Api, Instance, Interface};
+use crate::log::{Category, Logger, Sink};
+use crate::models;
+use std::ffi::CStr;
+
+/// An instantiation request, its C arguments already read.
+pub(crate) struct Request<'a> {
+    /// The C function's name, for messages.
+    pub function: &'static str,
+    pub api: Api,
+    pub name: Option<&'a CStr>,
+    /// The interface asked for, or why the argument does not name one.
+    pub interface: Result<Interface, String>,
+    /// FMI 2.0's GUID or FMI 3.0's instantiation token.
+    pub token: Option<&'a CStr>,
+    pub sink: Sink,
+    pub logging_on: bool,
+}
+
+/// The new instance, or `None` after logging the reason.
+pub(crate) fn create_instance(request: &Request<'_>) -> Option<*mut Instance> {
+    let fail = |message: &str| {
+        let shown = request.name.map(CStr::to_owned).unwrap_or_default();
+        // SAFETY: the sink's callback and environment come together from the importer.
+        unsafe {
+            request.sink.send(
+                &shown,
+                fmi2Status::fmi2Error,
+                Category::Error,
+                &format!("{}: {message}", request.function),
+            );
+        }
+        None
+    };
+    let Some(name) = request.name.filter(|n| !n.is_empty()) else {
+        return fail("instanceName is NULL or empty");
+    };
+    let interface = match &request.interface {
+        Ok(interface) => *interface,
+        Err(why) => return fail(why),
+    };
+    let token_name = request.api.token_name();
+    let Some(token) = request.token else {
+        return fail(&format!("{token_name} is NULL"));
+    };
+    let token = token.to_string_lossy();
+    let Some(sim) = models::simulation_for(request.api, &token) else {
+        let known: Vec<String> = models::tables()
+            .iter()
+            .map(|t| format!("{} {}", t.info.identifier, t.token(request.api)))
+            .collect();
+        return fail(&format!(
+            "{token_name} {token} is not one of this library's models ({}); the \
+             modelDescription.xml and the binary do not belong together",
+            known.join(", ")
+        ));
+    };
+    let sim = match sim {
+        Ok(sim) => sim,
+        Err(e) => return fail(&format!("the model does not start: {e}")),
+    };
+    if interface == Interface::ModelExchange && sim.table().model_exchange.is_none() {
+        return fail(&format!(
+            "{} is Co-Simulation only (its physics engine steps internally); \
+             instantiate it for Co-Simulation",
+            sim.table().info.identifier
+        ));
+    }
+    let instance = Instance::new(
+        request.api,
+        interface,
+        Logger::new(request.sink, name.to_owned()),
+        request.logging_on,
+        sim,
+    );
+    instance.event(&format!(
+        "{}: {} {:?} instance ({token}) created",
+        request.function,
+        instance.sim.table().info.identifier,
+        instance.interface
+    ));
+    Some(Box::into_raw(Box::new(instance)))
+}
