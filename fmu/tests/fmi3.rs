@@ -310,6 +310,21 @@ fn fmi3_model_exchange_gives_the_fmi2_states_derivatives_and_indicators() {
     let indicator_vrs: Vec<u32> = (EVENT_INDICATOR_VR..).take(n_z).collect();
     assert_eq!(me3.get(&indicator_vrs, n_z).1, z3);
     assert_eq!(me3.get(&[TIME_VR], 1).1, [0.25]);
+    // An FMU state of the Model Exchange instance brings back states, time and stage exactly.
+    let mut saved: fmi3FMUState = std::ptr::null_mut();
+    let mut after = vec![0.0; n_x];
+    // SAFETY: live instance, arrays of the declared lengths.
+    unsafe {
+        assert_eq!(fmi3GetFMUState(me3.c, &mut saved), fmi3OK);
+        let moved: Vec<f64> = x.iter().map(|v| v + 0.125).collect();
+        assert_eq!(fmi3SetTime(me3.c, 0.5), fmi3OK);
+        assert_eq!(fmi3SetContinuousStates(me3.c, moved.as_ptr(), n_x), fmi3OK);
+        assert_eq!(fmi3SetFMUState(me3.c, saved), fmi3OK);
+        assert_eq!(fmi3GetContinuousStates(me3.c, after.as_mut_ptr(), n_x), fmi3OK);
+        assert_eq!(fmi3FreeFMUState(me3.c, &mut saved), fmi3OK);
+    }
+    assert_eq!(after, x);
+    assert_eq!(me3.get(&[TIME_VR], 1).1, [0.25]);
     let mut enter = 9u8;
     let mut terminate = 9u8;
     // SAFETY: live instance, writable outputs.

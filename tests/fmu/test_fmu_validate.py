@@ -11,7 +11,6 @@ import pytest
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
-
 ALL_FMUS = ["Quadrotor", "Lander2D", "Quadrotor-fmi3", "Lander2D-fmi3"]
 
 
