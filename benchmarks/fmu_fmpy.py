@@ -5,11 +5,13 @@ real importer, ctypes), in one run, to put next to the Rust-side cost of the sam
     bash scripts/pack-fmus.sh && .venv/bin/python benchmarks/fmu_fmpy.py [--steps N]
 
 Prints microseconds per call for: doStep alone; set 4 commands + doStep + get 13 outputs;
-an empty ctypes call into the same library (fmi2GetVersion) as the floor of any call; and the
-FMI 3.0 / FMI 2.0 ratio of each.
+doStep called through ctypes directly (without fmpy's wrapper), and on a NULL instance (what
+is left is ctypes passing the arguments); an empty ctypes call into the same library
+(fmi2GetVersion) as the floor of any call; and the FMI 3.0 / FMI 2.0 ratio of each.
 """
 
 import argparse
+import ctypes
 import shutil
 import time
 from pathlib import Path
@@ -77,6 +79,33 @@ def measure(fmu: str, steps: int) -> dict[str, float]:
             get_real(outputs)
             n += 1
 
+    # The same call without fmpy's Python wrapper (pre-made output arguments): what the FMU and
+    # ctypes cost, apart from the wrapper (FMI 3.0's builds four ctypes objects and a tuple).
+    if fmi3:
+        flags = [ctypes.c_bool() for _ in range(3)]
+        last = ctypes.c_double()
+        outs = [ctypes.byref(f) for f in flags] + [ctypes.byref(last)]
+        raw = slave.dll.fmi3DoStep
+
+        def raw_step(t: float, instance=slave.component) -> None:
+            raw(instance, t, h, True, *outs)
+    else:
+        raw = slave.dll.fmi2DoStep
+
+        def raw_step(t: float, instance=slave.component) -> None:
+            raw(instance, t, h, 1)
+
+    def null_steps(count: int) -> None:
+        # A NULL instance is refused at once: what is left is ctypes passing the arguments.
+        for _ in range(count):
+            raw_step(0.0, None)
+
+    def steps_raw(count: int) -> None:
+        nonlocal n
+        for _ in range(count):
+            raw_step(n * h)
+            n += 1
+
     version = slave.dll.fmi2GetVersion
 
     def empty_call(count: int) -> None:
@@ -86,6 +115,8 @@ def measure(fmu: str, steps: int) -> dict[str, float]:
     results = {
         "doStep (10 ms)": per_call(steps_only, steps),
         "set 4 + doStep + get 13": per_call(set_step_get, steps // 4),
+        "doStep through ctypes, without fmpy's wrapper": per_call(steps_raw, steps),
+        "the same on a NULL instance (argument passing)": per_call(null_steps, steps),
         "ctypes empty call (fmi2GetVersion)": per_call(empty_call, steps),
     }
     slave.terminate()
@@ -102,10 +133,10 @@ def main() -> None:
     args = parser.parse_args()
     fmi2 = measure(args.fmu, args.steps)
     fmi3 = measure(args.fmu3, args.steps)
-    print(f"{'fmpy, microseconds per call':42s} {'FMI 2.0':>8s} {'FMI 3.0':>8s} {'3.0/2.0':>8s}")
+    print(f"{'fmpy, microseconds per call':46s} {'FMI 2.0':>8s} {'FMI 3.0':>8s} {'3.0/2.0':>8s}")
     for name in fmi2:
         ratio = fmi3[name] / fmi2[name]
-        print(f"{name:42s} {fmi2[name]:8.3f} {fmi3[name]:8.3f} {ratio:8.3f}")
+        print(f"{name:46s} {fmi2[name]:8.3f} {fmi3[name]:8.3f} {ratio:8.3f}")
 
 
 if __name__ == "__main__":

@@ -4,7 +4,7 @@
 //! variable `time`, and — FMI 3.0 wants every event indicator to be a variable — one local
 //! per event indicator. An array takes the value reference of its first element.
 
-use crate::model::{ModelInfo, ModelTable};
+use crate::model::{ModelInfo, ModelTable, VrIndex};
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::{Causality, Variability, Variable};
 
@@ -98,8 +98,8 @@ pub struct Layout3 {
     /// In modelDescription order: `time` first, then the model's variables, then the event
     /// indicators.
     pub variables: Vec<Variable3>,
-    /// Value reference → position in `variables`, sorted.
-    by_vr: Vec<(u32, usize)>,
+    /// Value reference → position in `variables`.
+    by_vr: VrIndex,
     /// FMI 3.0 value references of the continuous states and of their derivatives, in
     /// state-vector order (an array once, where its first element comes).
     pub states: Vec<u32>,
@@ -133,7 +133,7 @@ impl Layout3 {
     pub(crate) fn empty() -> Self {
         Layout3 {
             variables: Vec::new(),
-            by_vr: Vec::new(),
+            by_vr: VrIndex::default(),
             states: Vec::new(),
             derivatives: Vec::new(),
             event_indicators: Vec::new(),
@@ -226,12 +226,7 @@ impl Layout3 {
             }
         }
         element_of.sort_unstable_by_key(|&(vr, _)| vr);
-        let mut by_vr: Vec<(u32, usize)> = variables
-            .iter()
-            .enumerate()
-            .map(|(i, v)| (v.value_reference, i))
-            .collect();
-        by_vr.sort_unstable();
+        let by_vr = VrIndex::new(variables.iter().map(|v| v.value_reference));
         let mut layout = Layout3 {
             variables,
             by_vr,
@@ -271,8 +266,7 @@ impl Layout3 {
 
     /// The variable with FMI 3.0 value reference `vr`.
     pub fn variable(&self, vr: u32) -> Option<&Variable3> {
-        let at = self.by_vr.binary_search_by_key(&vr, |&(v, _)| v).ok()?;
-        self.variables.get(self.by_vr[at].1)
+        self.variables.get(self.by_vr.get(vr)?)
     }
 
     /// The variable named `name`.

@@ -117,6 +117,31 @@ pub trait Hybrid {
     fn event_update(&mut self, elapsed: f64);
 }
 
+/// Value reference → position in a variable list, in O(1): a dense table up to the largest
+/// value reference (about a thousand entries here). Every get and set looks up through it.
+#[derive(Debug, Default)]
+pub struct VrIndex(Vec<u32>);
+
+impl VrIndex {
+    const NONE: u32 = u32::MAX;
+
+    /// The index of `vrs`, the i-th value reference at position i.
+    pub fn new(vrs: impl Iterator<Item = u32> + Clone) -> Self {
+        let len = vrs.clone().max().map_or(0, |m| m as usize + 1);
+        let mut table = vec![Self::NONE; len];
+        for (i, vr) in vrs.enumerate() {
+            table[vr as usize] = i as u32;
+        }
+        VrIndex(table)
+    }
+
+    /// The position of `vr`, if it is there.
+    pub fn get(&self, vr: u32) -> Option<usize> {
+        let at = *self.0.get(vr as usize)?;
+        (at != Self::NONE).then_some(at as usize)
+    }
+}
+
 /// The variable table of a model with what the FMI layer looks up on every call.
 #[derive(Debug)]
 pub struct ModelTable {
@@ -130,8 +155,8 @@ pub struct ModelTable {
     pub token3_c: CString,
     /// The FMI 3.0 variables.
     pub fmi3: Layout3,
-    /// Value reference → position in `variables`, sorted for binary search.
-    by_vr: Vec<(u32, usize)>,
+    /// Value reference → position in `variables`.
+    by_vr: VrIndex,
     /// States and derivatives, for a model that offers Model Exchange.
     pub model_exchange: Option<ModelExchangeTable>,
 }
@@ -151,12 +176,7 @@ impl ModelTable {
     ) -> Self {
         let guid = guid::of_interface(info.identifier, &variables);
         let token3 = guid::of_fmi3_interface(info.identifier, &variables);
-        let mut by_vr: Vec<(u32, usize)> = variables
-            .iter()
-            .enumerate()
-            .map(|(i, v)| (v.value_reference, i))
-            .collect();
-        by_vr.sort_unstable();
+        let by_vr = VrIndex::new(variables.iter().map(|v| v.value_reference));
         // A GUID is hex digits, dashes and braces: it never holds a NUL.
         let guid_c = CString::new(guid.clone()).unwrap_or_default();
         let token3_c = CString::new(token3.clone()).unwrap_or_default();
@@ -185,8 +205,7 @@ impl ModelTable {
 
     /// The variable with value reference `vr`.
     pub fn variable(&self, vr: u32) -> Option<&Variable> {
-        let at = self.by_vr.binary_search_by_key(&vr, |&(v, _)| v).ok()?;
-        self.variables.get(self.by_vr[at].1)
+        self.variables.get(self.by_vr.get(vr)?)
     }
 
     /// The variable named `name`.

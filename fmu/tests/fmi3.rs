@@ -320,7 +320,10 @@ fn fmi3_model_exchange_gives_the_fmi2_states_derivatives_and_indicators() {
         assert_eq!(fmi3SetTime(me3.c, 0.5), fmi3OK);
         assert_eq!(fmi3SetContinuousStates(me3.c, moved.as_ptr(), n_x), fmi3OK);
         assert_eq!(fmi3SetFMUState(me3.c, saved), fmi3OK);
-        assert_eq!(fmi3GetContinuousStates(me3.c, after.as_mut_ptr(), n_x), fmi3OK);
+        assert_eq!(
+            fmi3GetContinuousStates(me3.c, after.as_mut_ptr(), n_x),
+            fmi3OK
+        );
         assert_eq!(fmi3FreeFMUState(me3.c, &mut saved), fmi3OK);
     }
     assert_eq!(after, x);

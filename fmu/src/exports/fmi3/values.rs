@@ -9,26 +9,24 @@ use crate::exports::guard::{c_slice, c_slice_mut, with_instance};
 use crate::exports::values::initialised;
 use crate::fmi2_types::fmi2Status;
 use crate::fmi3_types::*;
-use crate::fmi3_variables::{Source, Variable3};
+use crate::fmi3_variables::{Layout3, Source, Variable3};
 use crate::instance::{Instance, Mask, masks3};
 use crate::simulation::FmiType;
 
-/// The variables behind `vrs`, checked against `n_values`.
-fn resolve(
-    instance: &Instance,
-    vrs: &[fmi3ValueReference],
+/// The variables behind `vrs`, after checking that every one exists and that together they
+/// hold `n_values` values (no allocation: this runs on every get and set).
+fn resolve<'a>(
+    layout: &'static Layout3,
+    vrs: &'a [fmi3ValueReference],
     n_values: usize,
-) -> Result<Vec<&'static Variable3>, FmuError> {
-    let layout = &instance.sim.table().fmi3;
-    let variables = vrs
-        .iter()
-        .map(|&vr| {
-            layout
-                .variable(vr)
-                .ok_or(FmuError::UnknownValueReference(vr))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let total: usize = variables.iter().map(|v| v.len()).sum();
+) -> Result<impl Iterator<Item = &'static Variable3> + use<'a>, FmuError> {
+    let mut total = 0;
+    for &vr in vrs {
+        total += layout
+            .variable(vr)
+            .ok_or(FmuError::UnknownValueReference(vr))?
+            .len();
+    }
     if total != n_values {
         return Err(FmuError::InvalidArgument(format!(
             "nValues is {n_values}, but the {} value references hold {total} values \
@@ -36,7 +34,7 @@ fn resolve(
             vrs.len()
         )));
     }
-    Ok(variables)
+    Ok(vrs.iter().filter_map(|&vr| layout.variable(vr)))
 }
 
 fn check_type(v: &'static Variable3, ty: FmiType) -> Result<(), FmuError> {
@@ -76,7 +74,7 @@ pub(crate) unsafe fn get_values<T>(
     with_instance(instance, function, masks3::GET_VALUE, |instance| {
         // SAFETY: per the function's contract.
         let vrs = unsafe { c_slice(vr, nvr, "valueReferences[]") }?;
-        let variables = resolve(instance, vrs, n_values)?;
+        let variables = resolve(&instance.sim.table().fmi3, vrs, n_values)?;
         // SAFETY: per the function's contract.
         let out = unsafe { c_slice_mut(values, n_values, "values[]") }?;
         let mut worst = fmi2Status::fmi2OK;
@@ -121,7 +119,7 @@ pub(crate) unsafe fn set_values<T: Copy>(
     with_instance(instance, function, mask, |instance| {
         // SAFETY: per the function's contract.
         let vrs = unsafe { c_slice(vr, nvr, "valueReferences[]") }?;
-        let variables = resolve(instance, vrs, n_values)?;
+        let variables = resolve(&instance.sim.table().fmi3, vrs, n_values)?;
         // SAFETY: per the function's contract.
         let values = unsafe { c_slice(values, n_values, "values[]") }?;
         let initialised = initialised(instance);
