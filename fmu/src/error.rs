@@ -2,7 +2,6 @@
 //! message that says what to do about it.
 
 use crate::fmi2_types::fmi2Status;
-use crate::instance::Stage;
 use flyloop_core::number::Compact;
 use flyloop_core::{ParamError, SnapshotError};
 
@@ -10,10 +9,10 @@ use flyloop_core::{ParamError, SnapshotError};
 pub enum FmuError {
     /// The function is not allowed in the instance's current stage.
     #[error(
-        "Illegal call sequence: the instance is in stage {stage:?}; \
+        "Illegal call sequence: the instance is in stage {stage}; \
          this function is allowed only in {allowed}"
     )]
-    IllegalCall { stage: Stage, allowed: &'static str },
+    IllegalCall { stage: String, allowed: String },
     /// A required pointer argument is NULL.
     #[error("argument `{0}` is NULL")]
     NullArgument(&'static str),

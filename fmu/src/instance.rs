@@ -73,6 +73,14 @@ pub enum Api {
 }
 
 impl Api {
+    /// Stage names as this version's standard calls them (FMI 3.0: Step Mode).
+    pub fn stage_name(self, names: &str) -> String {
+        match self {
+            Api::Fmi2 => names.to_string(),
+            Api::Fmi3 => names.replace("StepComplete", "StepMode"),
+        }
+    }
+
     /// What the modelDescription calls the string that ties it to the binary.
     pub fn token_name(self) -> &'static str {
         match self {
@@ -316,8 +324,8 @@ impl Instance {
             Ok(())
         } else {
             Err(FmuError::IllegalCall {
-                stage: self.stage,
-                allowed: mask.names,
+                stage: self.api.stage_name(&format!("{:?}", self.stage)),
+                allowed: self.api.stage_name(mask.names),
             })
         }
     }
