@@ -219,27 +219,17 @@ pub mod masks3 {
             | Terminated
             | Error
     );
-    pub const SET_FLOAT64: Mask =
-        mask!(Instantiated | InitializationMode | EventMode | ContinuousTimeMode | StepComplete);
-    pub const SET_OTHER: Mask = mask!(Instantiated | InitializationMode | EventMode | StepComplete);
+    /// The same stages as FMI 2.0's fmi2SetReal and the other setters.
+    pub const SET_FLOAT64: Mask = super::masks::SET_REAL;
+    pub const SET_OTHER: Mask = super::masks::SET_OTHER;
     pub const ENTER_STEP_MODE: Mask = mask!(InitializationMode | EventMode);
     pub const GET_OUTPUT_DERIVATIVES: Mask = mask!(StepComplete | StepFailed | Terminated);
     pub const UPDATE_DISCRETE_STATES: Mask = mask!(EventMode);
-    pub const GET_DERIVATIVES: Mask =
-        mask!(InitializationMode | EventMode | ContinuousTimeMode | Terminated | Error);
-    /// Functions that ask nothing of the stage (counts, unsupported capabilities).
-    pub const ANY: Mask = mask!(
-        Instantiated
-            | InitializationMode
-            | StepComplete
-            | StepInProgress
-            | StepFailed
-            | StepCanceled
-            | Terminated
-            | Error
-            | EventMode
-            | ContinuousTimeMode
-    );
+    /// FMI 3.0 allows derivatives in initialization mode too: the event indicators' stages.
+    pub const GET_DERIVATIVES: Mask = super::masks::GET_EVENT_INDICATORS;
+    /// Functions that ask nothing of the stage (counts, unsupported capabilities): every
+    /// stage but Fatal, as for fmi2SetDebugLogging.
+    pub const ANY: Mask = super::masks::SET_DEBUG_LOGGING;
 }
 
 /// A saved FMU state: the bytes of [`Simulation::save`]. Boxed; the box's address is the

@@ -25,19 +25,35 @@ pub(crate) fn with_me(
     })
 }
 
+/// The body of fmi2EnterEventMode and fmi3EnterEventMode.
+pub(crate) fn enter_event_mode(c: fmi2Component, function: &'static str) -> fmi2Status {
+    with_me(c, function, masks::ENTER_EVENT_MODE, |instance| {
+        instance.stage = Stage::EventMode;
+        Ok(())
+    })
+}
+
 /// # Safety
 /// `c` must be NULL or a live instance.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2EnterEventMode(c: fmi2Component) -> fmi2Status {
-    with_me(
-        c,
-        "fmi2EnterEventMode",
-        masks::ENTER_EVENT_MODE,
-        |instance| {
-            instance.stage = Stage::EventMode;
-            Ok(())
-        },
-    )
+    enter_event_mode(c, "fmi2EnterEventMode")
+}
+
+/// The discrete changes of the event at the current time, logged as `function`'s event:
+/// whether the continuous states changed, and the next time event (the part of
+/// fmi2NewDiscreteStates and fmi3UpdateDiscreteStates that is not C arguments).
+pub(crate) fn discrete_update(
+    instance: &mut Instance,
+    function: &str,
+) -> Result<(bool, Option<f64>), FmuError> {
+    let (changed, next) = instance.sim.new_discrete_states()?;
+    instance.event(&format!(
+        "{function}: t = {}, next time event {}",
+        Compact(instance.sim.time()),
+        next.map_or("none".to_string(), |t| Compact(t).to_string())
+    ));
+    Ok((changed, next))
 }
 
 /// The discrete changes of the event at the current time (turbulence sample, released
@@ -55,7 +71,7 @@ pub unsafe extern "C" fn fmi2NewDiscreteStates(
         if eventInfo.is_null() {
             return Err(FmuError::NullArgument("eventInfo"));
         }
-        let (changed, next) = instance.sim.new_discrete_states()?;
+        let (changed, next) = discrete_update(instance, function)?;
         let info = fmi2EventInfo {
             newDiscreteStatesNeeded: fmi2False,
             terminateSimulation: fmi2False,
@@ -65,12 +81,14 @@ pub unsafe extern "C" fn fmi2NewDiscreteStates(
             nextEventTime: next.unwrap_or(0.0),
         };
         // SAFETY: non-NULL (checked above) and writable per the contract.
-        unsafe { write_out(eventInfo, info, "eventInfo") }?;
-        instance.event(&format!(
-            "{function}: t = {}, next time event {}",
-            Compact(instance.sim.time()),
-            next.map_or("none".to_string(), |t| Compact(t).to_string())
-        ));
+        unsafe { write_out(eventInfo, info, "eventInfo") }
+    })
+}
+
+/// The body of fmi2EnterContinuousTimeMode and fmi3EnterContinuousTimeMode.
+pub(crate) fn enter_continuous_time_mode(c: fmi2Component, function: &'static str) -> fmi2Status {
+    with_me(c, function, masks::ENTER_CONTINUOUS_TIME_MODE, |instance| {
+        instance.stage = Stage::ContinuousTimeMode;
         Ok(())
     })
 }
@@ -79,15 +97,7 @@ pub unsafe extern "C" fn fmi2NewDiscreteStates(
 /// `c` must be NULL or a live instance.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2EnterContinuousTimeMode(c: fmi2Component) -> fmi2Status {
-    with_me(
-        c,
-        "fmi2EnterContinuousTimeMode",
-        masks::ENTER_CONTINUOUS_TIME_MODE,
-        |instance| {
-            instance.stage = Stage::ContinuousTimeMode;
-            Ok(())
-        },
-    )
+    enter_continuous_time_mode(c, "fmi2EnterContinuousTimeMode")
 }
 
 /// The body of fmi2CompletedIntegratorStep and fmi3CompletedIntegratorStep: no step event
@@ -133,13 +143,18 @@ pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
     unsafe { completed_integrator_step(c, function, enterEventMode, terminateSimulation, 0) }
 }
 
+/// The body of fmi2SetTime and fmi3SetTime.
+pub(crate) fn set_time(c: fmi2Component, function: &'static str, time: f64) -> fmi2Status {
+    with_me(c, function, masks::SET_TIME, |instance| {
+        instance.sim.set_time(time)
+    })
+}
+
 /// # Safety
 /// `c` must be NULL or a live instance.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2SetTime(c: fmi2Component, time: fmi2Real) -> fmi2Status {
-    with_me(c, "fmi2SetTime", masks::SET_TIME, |instance| {
-        instance.sim.set_time(time)
-    })
+    set_time(c, "fmi2SetTime", time)
 }
 
 /// The body of fmi2SetContinuousStates and fmi3SetContinuousStates.

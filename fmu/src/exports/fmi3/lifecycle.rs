@@ -7,10 +7,11 @@ use crate::exports::lifecycle::{
     c_str, exit_initialization_mode, free_instance, reset, set_debug_logging, setup_experiment,
     terminate,
 };
+use crate::exports::model_exchange::enter_event_mode;
 use crate::fmi3_types::*;
-use crate::instance::{Api, Interface, Stage, masks, masks3};
-use crate::log::{Category, Sink};
-use std::ffi::{CStr, c_char};
+use crate::instance::{Api, Interface, Stage, masks3};
+use crate::log::Sink;
+use std::ffi::c_char;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// Returns "3.0".
@@ -34,7 +35,7 @@ pub unsafe extern "C" fn fmi3SetDebugLogging(
         .into()
 }
 
-/// Instantiates for `interface` unless `refusal` says why not; NULL on any failure.
+/// Instantiates for `interface`, or refuses with the reason it holds; NULL on any failure.
 ///
 /// # Safety
 /// The strings must be NULL or NUL-terminated.
@@ -149,34 +150,30 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3InstantiateScheduledExecution(
     instanceName: fmi3String,
-    _instantiationToken: fmi3String,
+    instantiationToken: fmi3String,
     _resourcePath: fmi3String,
     _visible: fmi3Boolean,
-    _loggingOn: fmi3Boolean,
+    loggingOn: fmi3Boolean,
     instanceEnvironment: fmi3InstanceEnvironment,
     logMessage: Option<fmi3LogMessageCallback>,
     _clockUpdate: Option<fmi3ClockUpdateCallback>,
     _lockPreemption: Option<fmi3LockPreemptionCallback>,
     _unlockPreemption: Option<fmi3UnlockPreemptionCallback>,
 ) -> fmi3Instance {
-    guarded(std::ptr::null_mut(), || {
-        let sink = Sink::Fmi3 {
-            callback: logMessage,
-            environment: instanceEnvironment,
-        };
-        // SAFETY: NULL or a NUL-terminated string; the sink is the importer's.
-        unsafe {
-            let name = c_str(instanceName).map(CStr::to_owned).unwrap_or_default();
-            sink.send(
-                &name,
-                crate::fmi2_types::fmi2Status::fmi2Error,
-                Category::Error,
-                "fmi3InstantiateScheduledExecution: Scheduled Execution is not offered \
-                 (the modelDescription has no ScheduledExecution element)",
-            );
-        }
-        std::ptr::null_mut()
-    })
+    let refusal = "Scheduled Execution is not offered (the modelDescription has no \
+                   ScheduledExecution element)";
+    // SAFETY: forwarded contract.
+    unsafe {
+        instantiate(
+            "fmi3InstantiateScheduledExecution",
+            Err(refusal.to_string()),
+            instanceName,
+            instantiationToken,
+            loggingOn,
+            instanceEnvironment,
+            logMessage,
+        )
+    }
 }
 
 /// Frees the instance and every FMU state it handed out. NULL is ignored.
@@ -231,16 +228,7 @@ pub unsafe extern "C" fn fmi3ExitInitializationMode(instance: fmi3Instance) -> f
 /// `instance` must be NULL or live.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3EnterEventMode(instance: fmi3Instance) -> fmi3Status {
-    with_instance3(
-        instance,
-        "fmi3EnterEventMode",
-        masks::ENTER_EVENT_MODE,
-        |instance| {
-            instance.check_model_exchange()?;
-            instance.stage = Stage::EventMode;
-            Ok(())
-        },
-    )
+    enter_event_mode(instance, "fmi3EnterEventMode").into()
 }
 
 /// # Safety

@@ -5,39 +5,18 @@ use super::with_instance3;
 use crate::error::FmuError;
 use crate::exports::guard::write_out;
 use crate::exports::model_exchange::{
-    DERIVATIVES, EVENT_INDICATORS, NOMINALS, Reader, STATES, completed_integrator_step, read_array,
-    set_continuous_states,
+    DERIVATIVES, EVENT_INDICATORS, NOMINALS, Reader, STATES, completed_integrator_step,
+    discrete_update, enter_continuous_time_mode, read_array, set_continuous_states, set_time,
+    with_me,
 };
 use crate::fmi3_types::*;
-use crate::instance::{Instance, Mask, Stage, masks, masks3};
-use flyloop_core::number::Compact;
-
-/// [`with_instance3`] for a Model Exchange function: also refuses a Co-Simulation instance.
-fn with_me3(
-    instance: fmi3Instance,
-    function: &'static str,
-    mask: Mask,
-    body: impl FnOnce(&mut Instance) -> Result<(), FmuError>,
-) -> fmi3Status {
-    with_instance3(instance, function, mask, |instance| {
-        instance.check_model_exchange()?;
-        body(instance)
-    })
-}
+use crate::instance::{masks, masks3};
 
 /// # Safety
 /// `instance` must be NULL or live.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3EnterContinuousTimeMode(instance: fmi3Instance) -> fmi3Status {
-    with_me3(
-        instance,
-        "fmi3EnterContinuousTimeMode",
-        masks::ENTER_CONTINUOUS_TIME_MODE,
-        |instance| {
-            instance.stage = Stage::ContinuousTimeMode;
-            Ok(())
-        },
-    )
+    enter_continuous_time_mode(instance, "fmi3EnterContinuousTimeMode").into()
 }
 
 /// The discrete changes of the event at the current time (turbulence sample, released
@@ -56,7 +35,7 @@ pub unsafe extern "C" fn fmi3UpdateDiscreteStates(
     nextEventTime: *mut fmi3Float64,
 ) -> fmi3Status {
     let function = "fmi3UpdateDiscreteStates";
-    with_me3(
+    with_me(
         instance,
         function,
         masks3::UPDATE_DISCRETE_STATES,
@@ -80,23 +59,18 @@ pub unsafe extern "C" fn fmi3UpdateDiscreteStates(
             if nextEventTime.is_null() {
                 return Err(FmuError::NullArgument("nextEventTime"));
             }
-            let (changed, next) = instance.sim.new_discrete_states()?;
+            let (changed, next) = discrete_update(instance, function)?;
             let values = [false, false, false, changed, next.is_some()];
             // SAFETY: every pointer checked non-NULL above, writable per the contract.
             unsafe {
                 for ((pointer, name), value) in flags.into_iter().zip(values) {
                     write_out(pointer, u8::from(value), name)?;
                 }
-                write_out(nextEventTime, next.unwrap_or(0.0), "nextEventTime")?;
+                write_out(nextEventTime, next.unwrap_or(0.0), "nextEventTime")
             }
-            instance.event(&format!(
-                "{function}: t = {}, next time event {}",
-                Compact(instance.sim.time()),
-                next.map_or("none".to_string(), |t| Compact(t).to_string())
-            ));
-            Ok(())
         },
     )
+    .into()
 }
 
 /// No step event and no termination; an error once the state is not finite.
@@ -122,9 +96,7 @@ pub unsafe extern "C" fn fmi3CompletedIntegratorStep(
 /// `instance` must be NULL or live.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3SetTime(instance: fmi3Instance, time: fmi3Float64) -> fmi3Status {
-    with_me3(instance, "fmi3SetTime", masks::SET_TIME, |instance| {
-        instance.sim.set_time(time)
-    })
+    set_time(instance, "fmi3SetTime", time).into()
 }
 
 /// # Safety
