@@ -26,6 +26,7 @@ pub mod lander2d;
 pub mod number;
 pub mod params;
 pub mod quadrotor;
+pub mod rate_loop;
 pub mod reference;
 pub mod rng;
 pub mod sensors;

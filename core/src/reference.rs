@@ -6,6 +6,7 @@
 use crate::lander2d::{Lander2dInitial, Lander2dParams};
 use crate::params::Parameters;
 use crate::quadrotor::{QuadrotorInitial, QuadrotorParams};
+use crate::rate_loop::RateLoopParams;
 use crate::sensors::SensorParams;
 use crate::tasks::flight::FlightParams;
 use crate::tasks::landing::LandingParams;
@@ -28,6 +29,11 @@ pub fn parameter_reference() -> String {
             "Quadrotor sensors (`SensorParams`, PX4 mode)",
             "Home point, Earth field and noise of the IMU (body FRD), magnetometer, barometer (ISA) and GPS that PX4 reads; the field defaults are the World Magnetic Model at the default home.",
             SensorParams::markdown_table(),
+        ),
+        (
+            "PX4's rate loop (`RateLoopParams`, the flight tasks' rates interface)",
+            "PX4 v1.16.0's multicopter rate controller, gyro filters and control allocation as the core models them; defaults are airframe 10016 none_iris's (body FRD, normalised torque). Any real parameter here, of the quadrotor, and the flight tasks' `action_latency` and `obs_noise_*` can be randomised per episode by name (`randomize` / the config file's `[randomize]` table).",
+            RateLoopParams::markdown_table(),
         ),
         (
             "Hover and Waypoints tasks (`FlightParams`)",

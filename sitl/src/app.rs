@@ -127,10 +127,11 @@ fn start_px4(args: Args) -> Result<(), StartError> {
         seed: args.seed,
     })?;
     if let Some(path) = &args.track {
-        let track = Track::create(path).map_err(|source| StartError::Track {
-            path: path.clone(),
-            source,
-        })?;
+        let track =
+            Track::create(path, args.track_interval_us).map_err(|source| StartError::Track {
+                path: path.clone(),
+                source,
+            })?;
         session.set_track(track);
     }
     let listener =

@@ -101,9 +101,14 @@ pub struct Args {
     #[arg(long, default_value_t = 1.0, value_parser = parse_speed)]
     pub speed_factor: f64,
 
-    /// PX4 mode: write the ground-truth track (CSV, 50 Hz of simulation time) to this file.
+    /// PX4 mode: write the ground-truth track (CSV, by default 50 Hz of simulation time) to
+    /// this file.
     #[arg(long)]
     pub track: Option<PathBuf>,
+
+    /// PX4 mode: simulation time between two rows of the track, µs (4000 = every step).
+    #[arg(long, default_value_t = crate::px4::track::TRACK_INTERVAL_US, value_parser = clap::value_parser!(u64).range(1..))]
+    pub track_interval_us: u64,
 
     /// Print the task's parameters and exit: `table` (MAVLink ids, names, ranges, defaults;
     /// the default) or `toml` (a starter file for --config, with --config's values if given).

@@ -2,10 +2,11 @@
 //! core's names or their MAVLink short ids. Missing keys keep the core's defaults; every error
 //! names the parameter and its bound (the core's [`ParamError`]).
 
-use crate::model::{TaskConfig, TaskInstance, TaskKind};
+use crate::model::{ModelKind, TaskConfig, TaskInstance, TaskKind};
 use crate::param_table::{self, Group, ParamEntry};
 use flyloop_core::ParamError;
 use flyloop_core::params::Parameters;
+use flyloop_core::tasks::randomization::{ParamRange, Randomization};
 use std::path::{Path, PathBuf};
 
 /// Why a config file was refused.
@@ -25,7 +26,12 @@ pub enum ConfigError {
 pub fn parse(task: TaskKind, text: &str) -> Result<TaskConfig, ParamError> {
     let table: toml::Table = toml::from_str(text)?;
     let mut values: Vec<(&str, f64)> = Vec::with_capacity(table.len());
+    let mut ranges = Vec::new();
     for (key, value) in &table {
+        if key == RANDOMIZE_TABLE {
+            ranges = parse_ranges(value)?;
+            continue;
+        }
         let Some(number) = toml_number(value) else {
             let entry = find_entry(&param_table::entries(task), task, key)?;
             return Err(ParamError::Parse(format!(
@@ -35,7 +41,37 @@ pub fn parse(task: TaskKind, text: &str) -> Result<TaskConfig, ParamError> {
         };
         values.push((key.as_str(), number));
     }
-    from_values(task, values)
+    from_values_and_ranges(task, values, ranges)
+}
+
+/// The config file's table of randomisation ranges: `[randomize]` with `name = [low, high]`.
+pub const RANDOMIZE_TABLE: &str = "randomize";
+
+/// `[randomize]`'s entries as ranges; each must be a pair of numbers.
+fn parse_ranges(value: &toml::Value) -> Result<Vec<ParamRange>, ParamError> {
+    let Some(table) = value.as_table() else {
+        return Err(ParamError::Parse(format!(
+            "`{RANDOMIZE_TABLE}` must be a table of `name = [low, high]` ranges"
+        )));
+    };
+    let mut ranges = Vec::with_capacity(table.len());
+    for (name, range) in table {
+        let pair = range.as_array().filter(|a| a.len() == 2);
+        let bounds: Option<Vec<f64>> = pair.map(|a| a.iter().filter_map(toml_number).collect());
+        match bounds.as_deref() {
+            Some(&[low, high]) => ranges.push(ParamRange {
+                name: name.clone(),
+                low,
+                high,
+            }),
+            _ => {
+                return Err(ParamError::Parse(format!(
+                    "randomisation range `{name}` must be a pair of numbers [low, high]"
+                )));
+            }
+        }
+    }
+    Ok(ranges)
 }
 
 /// A parameter file's value as a number: integers, floats, and booleans as 0/1; `None` for
@@ -65,6 +101,16 @@ pub fn from_values<'a>(
     task: TaskKind,
     pairs: impl IntoIterator<Item = (&'a str, f64)>,
 ) -> Result<TaskConfig, ParamError> {
+    from_values_and_ranges(task, pairs, Vec::new())
+}
+
+/// [`from_values`] with randomisation ranges (flight tasks only; checked against the
+/// parameter sets by the core).
+pub fn from_values_and_ranges<'a>(
+    task: TaskKind,
+    pairs: impl IntoIterator<Item = (&'a str, f64)>,
+    ranges: Vec<ParamRange>,
+) -> Result<TaskConfig, ParamError> {
     let entries = param_table::entries(task);
     let mut values: Vec<(ParamEntry, f64)> = Vec::new();
     for (key, value) in pairs {
@@ -80,11 +126,21 @@ pub fn from_values<'a>(
     for &group in Group::for_task(task) {
         match group {
             Group::Quadrotor => config.quadrotor = Parameters::from_values(pick(group))?,
+            Group::RateLoop => config.rate_loop = Parameters::from_values(pick(group))?,
             Group::Flight => config.flight = Parameters::from_values(pick(group))?,
             Group::Waypoints => config.waypoints = Parameters::from_values(pick(group))?,
             Group::Lander => config.lander = Parameters::from_values(pick(group))?,
             Group::Landing => config.landing = Parameters::from_values(pick(group))?,
         }
+    }
+    if !ranges.is_empty() {
+        if task.model() != ModelKind::Quadrotor {
+            return Err(ParamError::Parse(format!(
+                "task `{}` has no randomisation; the flight tasks (hover, waypoints) do",
+                task.frame_name()
+            )));
+        }
+        config.randomize = Randomization::new(ranges)?;
     }
     TaskInstance::build(task, &config)?;
     Ok(config)
@@ -146,6 +202,37 @@ mod tests {
         assert!(err.contains("`mass` must be a number"), "{err}");
         let err = parse(TaskKind::Hover, "mass = ").unwrap_err().to_string();
         assert!(err.contains("invalid parameter file"), "{err}");
+    }
+
+    #[test]
+    fn randomisation_ranges_come_from_their_table() {
+        let c = parse(
+            TaskKind::Hover,
+            "mass = 1.5\n[randomize]\nmass = [1.2, 1.8]\nroll_rate_p = [0.1, 0.2]\n",
+        )
+        .unwrap();
+        let r = c.randomize.ranges();
+        assert_eq!(r.len(), 2);
+        assert_eq!(
+            (r[0].name.as_str(), r[0].low, r[0].high),
+            ("mass", 1.2, 1.8)
+        );
+        let err = parse(TaskKind::Hover, "[randomize]\nmass = [2.0, 1.0]")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("`mass` = [2, 1] kg must be ordered"), "{err}");
+        let err = parse(TaskKind::Hover, "[randomize]\nmass = 1.0")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("range `mass` must be a pair"), "{err}");
+        let err = parse(TaskKind::Hover, "[randomize]\nmasss = [1, 2]")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("`masss`"), "{err}");
+        let err = parse(TaskKind::Landing, "[randomize]\nmass = [1, 2]")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("no randomisation"), "{err}");
     }
 
     #[test]

@@ -4,7 +4,7 @@
 
 use flyloop_core::lander2d::Lander2d;
 use flyloop_core::quadrotor::Quadrotor;
-use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{UnitQuaternion, Vector3};
 
 /// Standard gravity for milli-g units (mG), m/s².
 pub const STANDARD_GRAVITY: f64 = 9.80665;
@@ -30,28 +30,7 @@ pub struct Kinematics {
     pub air_velocity: Vector3<f64>,
 }
 
-/// ENU → NED as a rotation: 180° about the axis (1, 1, 0)/√2.
-fn ned_from_enu() -> UnitQuaternion<f64> {
-    let h = std::f64::consts::FRAC_1_SQRT_2;
-    UnitQuaternion::new_unchecked(Quaternion::new(0.0, h, h, 0.0))
-}
-
-/// FRD → FLU as a rotation: 180° about x.
-fn flu_from_frd() -> UnitQuaternion<f64> {
-    UnitQuaternion::new_unchecked(Quaternion::new(0.0, 1.0, 0.0, 0.0))
-}
-
-pub use flyloop_core::sensors::frames::{enu_to_ned, flu_to_frd};
-
-/// The attitude body FRD → world NED, in the hemisphere w ≥ 0.
-pub fn attitude_ned(attitude_enu: &UnitQuaternion<f64>) -> UnitQuaternion<f64> {
-    let q = ned_from_enu() * attitude_enu * flu_from_frd();
-    if q.w < 0.0 {
-        UnitQuaternion::new_unchecked(-q.into_inner())
-    } else {
-        q
-    }
-}
+pub use flyloop_core::sensors::frames::{attitude_ned, enu_to_ned, flu_to_frd};
 
 /// Roll, pitch, yaw (ZYX) of the NED/FRD attitude, rad; yaw in (−π, π], 0 = north.
 pub fn euler_ned(attitude_enu: &UnitQuaternion<f64>) -> (f64, f64, f64) {

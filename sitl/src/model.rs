@@ -6,9 +6,11 @@ use crate::kinematics::Kinematics;
 use flyloop_core::ParamError;
 use flyloop_core::lander2d::Lander2dParams;
 use flyloop_core::quadrotor::QuadrotorParams;
+use flyloop_core::rate_loop::RateLoopParams;
 use flyloop_core::tasks::flight::FlightParams;
 use flyloop_core::tasks::hover::Hover;
 use flyloop_core::tasks::landing::{Landing, LandingParams};
+use flyloop_core::tasks::randomization::{Randomization, VehicleParams};
 use flyloop_core::tasks::waypoints::{WaypointParams, Waypoints};
 use flyloop_core::tasks::{ActionError, Info, StepOutcome, Task};
 
@@ -69,10 +71,25 @@ impl TaskKind {
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct TaskConfig {
     pub quadrotor: QuadrotorParams,
+    /// PX4's rate loop, flown by the flight tasks' rates interface.
+    pub rate_loop: RateLoopParams,
     pub flight: FlightParams,
     pub waypoints: WaypointParams,
     pub lander: Lander2dParams,
     pub landing: LandingParams,
+    /// Per-episode ranges of the flight tasks' vehicle parameters (empty: off).
+    pub randomize: Randomization,
+}
+
+impl TaskConfig {
+    /// The flight tasks' vehicle: quadrotor, rate loop and flight parameters.
+    pub fn vehicle(&self) -> VehicleParams {
+        VehicleParams {
+            quadrotor: self.quadrotor.clone(),
+            rate_loop: self.rate_loop.clone(),
+            flight: self.flight.clone(),
+        }
+    }
 }
 
 /// A task instance of one of the three kinds.
@@ -87,14 +104,14 @@ impl TaskInstance {
     /// Builds `kind` from `config`; every parameter set it uses is validated by the core.
     pub fn build(kind: TaskKind, config: &TaskConfig) -> Result<Self, ParamError> {
         Ok(match kind {
-            TaskKind::Hover => TaskInstance::Hover(Box::new(Hover::new(
-                config.quadrotor.clone(),
-                config.flight.clone(),
+            TaskKind::Hover => TaskInstance::Hover(Box::new(Hover::with_vehicle(
+                config.vehicle(),
+                config.randomize.clone(),
             )?)),
-            TaskKind::Waypoints => TaskInstance::Waypoints(Box::new(Waypoints::new(
-                config.quadrotor.clone(),
-                config.flight.clone(),
+            TaskKind::Waypoints => TaskInstance::Waypoints(Box::new(Waypoints::with_vehicle(
+                config.vehicle(),
                 config.waypoints.clone(),
+                config.randomize.clone(),
             )?)),
             TaskKind::Landing => TaskInstance::Landing(Box::new(Landing::new(
                 config.lander.clone(),

@@ -16,6 +16,7 @@ pub const PARAM_ID_LEN: usize = 16;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Group {
     Quadrotor,
+    RateLoop,
     Flight,
     Waypoints,
     Lander,
@@ -26,8 +27,13 @@ impl Group {
     /// The sets a task is built from, in the order the parameter protocol lists them.
     pub fn for_task(task: TaskKind) -> &'static [Group] {
         match task {
-            TaskKind::Hover => &[Group::Quadrotor, Group::Flight],
-            TaskKind::Waypoints => &[Group::Quadrotor, Group::Flight, Group::Waypoints],
+            TaskKind::Hover => &[Group::Quadrotor, Group::Flight, Group::RateLoop],
+            TaskKind::Waypoints => &[
+                Group::Quadrotor,
+                Group::Flight,
+                Group::Waypoints,
+                Group::RateLoop,
+            ],
             TaskKind::Landing => &[Group::Lander, Group::Landing],
         }
     }
@@ -36,6 +42,7 @@ impl Group {
     pub fn label(self) -> &'static str {
         match self {
             Group::Quadrotor => "model (quadrotor)",
+            Group::RateLoop => "model (PX4 rate loop)",
             Group::Flight => "task (flight)",
             Group::Waypoints => "task (waypoints)",
             Group::Lander => "model (lander2d)",
@@ -78,6 +85,7 @@ pub fn entries(task: TaskKind) -> Vec<ParamEntry> {
     for &group in Group::for_task(task) {
         match group {
             Group::Quadrotor => out.extend(rows::<flyloop_core::quadrotor::QuadrotorParams>(group)),
+            Group::RateLoop => out.extend(rows::<flyloop_core::rate_loop::RateLoopParams>(group)),
             Group::Flight => out.extend(rows::<flyloop_core::tasks::flight::FlightParams>(group)),
             Group::Waypoints => out.extend(rows::<flyloop_core::tasks::waypoints::WaypointParams>(
                 group,
@@ -95,6 +103,7 @@ pub fn entries(task: TaskKind) -> Vec<ParamEntry> {
 pub fn get(config: &TaskConfig, group: Group, name: &str) -> Result<f64, ParamError> {
     match group {
         Group::Quadrotor => config.quadrotor.get(name),
+        Group::RateLoop => config.rate_loop.get(name),
         Group::Flight => config.flight.get(name),
         Group::Waypoints => config.waypoints.get(name),
         Group::Lander => config.lander.get(name),
@@ -112,6 +121,7 @@ pub fn set(
 ) -> Result<(), ParamError> {
     match group {
         Group::Quadrotor => config.quadrotor.set(name, value),
+        Group::RateLoop => config.rate_loop.set(name, value),
         Group::Flight => config.flight.set(name, value),
         Group::Waypoints => config.waypoints.set(name, value),
         Group::Lander => config.lander.set(name, value),

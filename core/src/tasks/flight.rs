@@ -40,6 +40,21 @@ pub struct FlightParams {
     pub crash_z_vel_threshold: f64,
     /// Crash when |roll| or |pitch| exceeds this, degrees. Default 80.
     pub crash_tilt_threshold: f64,
+    /// Actions are collective thrust + body rates flown through PX4's rate loop
+    /// ([`crate::rate_loop`]) instead of motor commands; the observation is then the
+    /// estimator's view (see [`crate::tasks::flight_vehicle`]). Default false.
+    pub rates_action: bool,
+    /// Rates interface: time from an action to the rate loop using it, s. Default 0.
+    pub action_latency: f64,
+    /// Rates interface: standard deviation of the observed position's noise, m. Default 0.
+    pub obs_noise_position: f64,
+    /// Rates interface: standard deviation of the observed velocity's noise, m/s. Default 0.
+    pub obs_noise_velocity: f64,
+    /// Rates interface: standard deviation of the observed roll, pitch and yaw noise, rad.
+    /// Default 0.
+    pub obs_noise_attitude: f64,
+    /// Rates interface: standard deviation of the observed body rates' noise, rad/s. Default 0.
+    pub obs_noise_rates: f64,
 }
 
 impl Default for FlightParams {
@@ -57,11 +72,17 @@ impl Default for FlightParams {
             enable_out_of_bounds_detection: true,
             crash_z_vel_threshold: -20.0,
             crash_tilt_threshold: 80.0,
+            rates_action: false,
+            action_latency: 0.0,
+            obs_noise_position: 0.0,
+            obs_noise_velocity: 0.0,
+            obs_noise_attitude: 0.0,
+            obs_noise_rates: 0.0,
         }
     }
 }
 
-static FLIGHT_SPECS: [ParamSpec<FlightParams>; 12] = [
+static FLIGHT_SPECS: [ParamSpec<FlightParams>; 18] = [
     param!(real dt, "s", 1e-4, 1.0, "Control period"),
     param!(integer max_steps, "", 1, 100_000_000, "Steps after which the episode is truncated"),
     param!(integer target_change_interval, "", 0, 100_000_000, "Steps between new targets (0 = never)"),
@@ -74,6 +95,12 @@ static FLIGHT_SPECS: [ParamSpec<FlightParams>; 12] = [
     param!(boolean enable_out_of_bounds_detection, "End the episode when too far from the target"),
     param!(real crash_z_vel_threshold, "m/s", -1e3, 0.0, "Crash below this vertical velocity"),
     param!(real crash_tilt_threshold, "deg", 0.0, 180.0, "Crash beyond this |roll| or |pitch|"),
+    param!(boolean rates_action, "Actions are thrust + body rates through PX4's rate loop (else motor commands)"),
+    param!(real action_latency, "s", 0.0, 1.0, "Rates interface: delay from an action to the rate loop"),
+    param!(real obs_noise_position, "m", 0.0, 100.0, "Rates interface: observed position noise (std)"),
+    param!(real obs_noise_velocity, "m/s", 0.0, 100.0, "Rates interface: observed velocity noise (std)"),
+    param!(real obs_noise_attitude, "rad", 0.0, 1.0, "Rates interface: observed roll/pitch/yaw noise (std)"),
+    param!(real obs_noise_rates, "rad/s", 0.0, 100.0, "Rates interface: observed body rate noise (std)"),
 ];
 
 impl Parameters for FlightParams {

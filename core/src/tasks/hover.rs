@@ -6,19 +6,22 @@
 //! axis in the world, [22:25] wind (m/s), [25:29] motor states, [29:33] motor commands. Each
 //! value is clipped to its declared bound (position ±√3·side, i.e. the out-of-bounds radius).
 //!
+//! On the rates interface (`rates_action`) the action is thrust + body rates through PX4's
+//! rate loop and the observation is the estimator's 16 values ([`super::flight_vehicle`]).
+//!
 //! Reward: d = ‖target − p‖, r_pos = e^(−d), r_vel = tanh(v·d̂ / velocity_scale),
 //! r = r_pos + ½ (1 − r_pos) r_vel. Terminated on a crash or out of bounds (d > √3·side);
 //! truncated when step_count ≥ max_steps. A new target every `target_change_interval` steps
 //! appears after the step's reward, in the observation that step returns.
 
 use super::flight::{
-    BASE_OBSERVATION_SIZE, FlightParams, FlightStatus, apply_action, base_bounds,
-    distance_and_direction, flight_info, is_crashed, sample_start, sample_target, velocity_reward,
-    write_base_observation,
+    FlightParams, FlightStatus, distance_and_direction, flight_info, is_crashed, sample_start,
+    sample_target, velocity_reward,
 };
+use super::flight_vehicle::FlightVehicle;
+use super::randomization::{Randomization, VehicleParams};
 use super::{Info, StepOutcome, Task};
 use crate::error::ParamError;
-use crate::params::Parameters;
 use crate::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
 use crate::rng::SimRng;
 use crate::tasks::ActionError;
@@ -29,7 +32,7 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Hover {
     params: FlightParams,
-    quad: Quadrotor,
+    vehicle: FlightVehicle,
     target: Vector3<f64>,
     status: FlightStatus,
     obs_low: Vec<f32>,
@@ -37,20 +40,34 @@ pub struct Hover {
 }
 
 impl Hover {
-    /// A Hover task, reset with seed 0. Both parameter sets are validated.
+    /// A Hover task on the motor or rates interface (as `params.rates_action` says) with
+    /// PX4's default rate loop and no randomisation, reset with seed 0.
     pub fn new(model: QuadrotorParams, params: FlightParams) -> Result<Self, ParamError> {
-        params.validate()?;
-        model.validate()?;
-        let (lo, hi) = base_bounds(&model, out_of_bounds_distance(&params));
-        let body = BodyState::at_rest(Vector3::zeros(), 0.0, 0.0, 0.0, 0.0);
-        let quad = Quadrotor::new(model, body, SimRng::new(0))?;
+        let nominal = VehicleParams {
+            quadrotor: model,
+            flight: params,
+            ..VehicleParams::default()
+        };
+        Hover::with_vehicle(nominal, Randomization::none())
+    }
+
+    /// A Hover task on the vehicle `nominal` describes (its `flight` set is the task's),
+    /// randomised per episode by `randomization`, reset with seed 0. Every set is validated.
+    pub fn with_vehicle(
+        nominal: VehicleParams,
+        randomization: Randomization,
+    ) -> Result<Self, ParamError> {
+        let params = nominal.flight.clone();
+        let bound = out_of_bounds_distance(&params);
+        let vehicle = FlightVehicle::new(nominal, randomization)?;
+        let (obs_low, obs_high) = vehicle.observation_bounds(bound);
         let mut hover = Hover {
             params,
-            quad,
+            vehicle,
             target: Vector3::zeros(),
             status: FlightStatus::default(),
-            obs_low: lo.to_vec(),
-            obs_high: hi.to_vec(),
+            obs_low,
+            obs_high,
         };
         hover.reset(0);
         Ok(hover)
@@ -61,12 +78,16 @@ impl Hover {
     }
 
     pub fn quadrotor(&self) -> &Quadrotor {
-        &self.quad
+        self.vehicle.quadrotor()
     }
 
     /// Mutable access for tests and front ends that place the vehicle by hand.
     pub fn quadrotor_mut(&mut self) -> &mut Quadrotor {
-        &mut self.quad
+        self.vehicle.quadrotor_mut()
+    }
+
+    pub fn vehicle(&self) -> &FlightVehicle {
+        &self.vehicle
     }
 
     pub fn target(&self) -> Vector3<f64> {
@@ -76,7 +97,7 @@ impl Hover {
     /// Moves the target (e.g. a user-chosen hover point); distance progress restarts from here.
     pub fn set_target(&mut self, target: Vector3<f64>) {
         self.target = target;
-        self.status.initial_distance = (target - self.quad.body.position).norm();
+        self.status.initial_distance = (target - self.quadrotor().body.position).norm();
     }
 
     pub fn step_count(&self) -> u32 {
@@ -102,11 +123,11 @@ impl Task for Hover {
     }
 
     fn action_bounds(&self) -> (Vec<f64>, Vec<f64>) {
-        (vec![0.0; 4], vec![1.0; 4])
+        self.vehicle.action_bounds()
     }
 
     fn observation_size(&self) -> usize {
-        BASE_OBSERVATION_SIZE
+        self.obs_low.len()
     }
 
     fn observation_bounds(&self) -> (Vec<f32>, Vec<f32>) {
@@ -115,22 +136,24 @@ impl Task for Hover {
 
     fn reset(&mut self, seed: u64) {
         let mut rng = SimRng::new(seed);
-        let body = sample_start(&self.params, &self.quad.params, &mut rng);
+        let model = self.vehicle.draw(seed);
+        let body = sample_start(&self.params, model, &mut rng);
         let target = sample_target(&self.params, &body.position, &mut rng);
-        self.quad.restart(body, rng);
+        self.vehicle.restart(body, rng, seed);
         self.status = FlightStatus::default();
         self.set_target(target);
     }
 
     fn step(&mut self, action: &[f64]) -> Result<StepOutcome, ActionError> {
-        apply_action(&mut self.quad, action, self.params.dt)?;
+        self.vehicle.apply(action, self.params.dt)?;
         self.status.step_count += 1;
 
-        let body = &self.quad.body;
+        let quad = self.vehicle.quadrotor();
+        let body = &quad.body;
         let reward = hover_reward(&self.params, body, &self.target);
         let status = &mut self.status;
         status.crashed =
-            self.params.enable_crash_detection && is_crashed(&self.params, &self.quad.params, body);
+            self.params.enable_crash_detection && is_crashed(&self.params, &quad.params, body);
         status.out_of_bounds = self.params.enable_out_of_bounds_detection
             && (self.target - body.position).norm() > out_of_bounds_distance(&self.params);
         let terminated = status.crashed || status.out_of_bounds;
@@ -138,8 +161,9 @@ impl Task for Hover {
 
         let interval = self.params.target_change_interval;
         if interval > 0 && status.step_count % interval == 0 {
-            let from = self.quad.body.position;
-            let target = sample_target(&self.params, &from, self.quad.rng_mut());
+            let from = self.quadrotor().body.position;
+            let rng = self.vehicle.quadrotor_mut().rng_mut();
+            let target = sample_target(&self.params, &from, rng);
             self.set_target(target);
         }
         Ok(StepOutcome {
@@ -150,11 +174,14 @@ impl Task for Hover {
     }
 
     fn write_observation(&self, out: &mut [f32]) {
-        write_base_observation(&self.quad, &self.target, &self.obs_low, &self.obs_high, out);
+        self.vehicle
+            .write_observation(&self.target, &self.obs_low, &self.obs_high, out);
     }
 
     fn info(&self) -> Info {
-        flight_info(&self.quad, &self.target, &self.status, self.params.dt)
+        let mut info = flight_info(self.quadrotor(), &self.target, &self.status, self.params.dt);
+        info.extend(self.vehicle.info());
+        info
     }
 
     fn dt(&self) -> f64 {

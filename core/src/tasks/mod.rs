@@ -91,7 +91,9 @@ pub fn clip_f32(value: f64, lo: f32, hi: f32) -> f32 {
 }
 
 pub mod flight;
+pub mod flight_vehicle;
 pub mod hover;
 pub mod landing;
 pub mod landing_reward;
+pub mod randomization;
 pub mod waypoints;

@@ -1,8 +1,9 @@
 //! Waypoints: fly through a sequence of waypoints as fast as possible (seed 001's
 //! SequentialWaypointEnv), paying the checkpoint bonus the reference never paid.
 //!
-//! Observation (37 × f32): the 33 Hover values with the current waypoint as target, then
-//! [33:36] next waypoint − position (m) and [36] seconds since the last checkpoint.
+//! Observation (37 × f32 on the motor interface, 20 on the rates interface): the vehicle's
+//! observation with the current waypoint as target ([`super::flight_vehicle`]), then
+//! next waypoint − position (m, in the same frame) and seconds since the last checkpoint.
 //!
 //! Reward on the step that comes within `waypoint_reach_threshold` of the current waypoint:
 //! max(checkpoint_bonus − bonus_decay_rate · t_since_checkpoint, 1); otherwise
@@ -11,15 +12,16 @@
 //! max_steps or when every waypoint is reached.
 
 use super::flight::{
-    BASE_OBSERVATION_SIZE, FlightParams, FlightStatus, apply_action, base_bounds,
-    distance_and_direction, flight_info, is_crashed, sample_start, sample_target, velocity_reward,
-    write_base_observation,
+    FlightParams, FlightStatus, distance_and_direction, flight_info, is_crashed, sample_start,
+    sample_target, velocity_reward,
 };
+use super::flight_vehicle::FlightVehicle;
+use super::randomization::{Randomization, VehicleParams};
 use super::{ActionError, Info, InfoValue, StepOutcome, Task, clip_f32};
 use crate::error::ParamError;
 use crate::param;
 use crate::params::{ParamSpec, Parameters};
-use crate::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
+use crate::quadrotor::{Quadrotor, QuadrotorParams};
 use crate::rng::SimRng;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -62,15 +64,15 @@ impl Parameters for WaypointParams {
     }
 }
 
-/// Number of observation values.
-pub const WAYPOINT_OBSERVATION_SIZE: usize = BASE_OBSERVATION_SIZE + 4;
+/// Number of observation values the task adds to its vehicle's.
+pub const WAYPOINT_EXTRA_SIZE: usize = 4;
 
 /// The Waypoints task. Plain data: clone it to snapshot an episode.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Waypoints {
     flight: FlightParams,
     params: WaypointParams,
-    quad: Quadrotor,
+    vehicle: FlightVehicle,
     waypoints: Vec<Vector3<f64>>,
     current: usize,
     reached: u32,
@@ -87,30 +89,43 @@ pub fn waypoint_out_of_bounds_distance(flight: &FlightParams) -> f64 {
 }
 
 impl Waypoints {
-    /// A Waypoints task, reset with seed 0. All parameter sets are validated.
+    /// A Waypoints task on the motor or rates interface (as `flight.rates_action` says) with
+    /// PX4's default rate loop and no randomisation, reset with seed 0.
     pub fn new(
         model: QuadrotorParams,
         flight: FlightParams,
         params: WaypointParams,
     ) -> Result<Self, ParamError> {
-        flight.validate()?;
+        let nominal = VehicleParams {
+            quadrotor: model,
+            flight,
+            ..VehicleParams::default()
+        };
+        Waypoints::with_vehicle(nominal, params, Randomization::none())
+    }
+
+    /// A Waypoints task on the vehicle `nominal` describes (its `flight` set is the
+    /// task's), randomised per episode by `randomization`, reset with seed 0. Every set is
+    /// validated.
+    pub fn with_vehicle(
+        nominal: VehicleParams,
+        params: WaypointParams,
+        randomization: Randomization,
+    ) -> Result<Self, ParamError> {
         params.validate()?;
-        model.validate()?;
+        let flight = nominal.flight.clone();
+        let vehicle = FlightVehicle::new(nominal, randomization)?;
         let bound = waypoint_out_of_bounds_distance(&flight);
-        let (base_lo, base_hi) = base_bounds(&model, bound);
+        let (mut obs_low, mut obs_high) = vehicle.observation_bounds(bound);
         let max_time = f64::from(flight.max_steps) * flight.dt;
-        let mut obs_low = base_lo.to_vec();
-        let mut obs_high = base_hi.to_vec();
         obs_low.extend([-bound as f32; 3]);
         obs_high.extend([bound as f32; 3]);
         obs_low.push(0.0);
         obs_high.push(max_time as f32);
-        let body = BodyState::at_rest(Vector3::zeros(), 0.0, 0.0, 0.0, 0.0);
-        let quad = Quadrotor::new(model, body, SimRng::new(0))?;
         let mut task = Waypoints {
             flight,
             params,
-            quad,
+            vehicle,
             waypoints: Vec::new(),
             current: 0,
             reached: 0,
@@ -124,11 +139,15 @@ impl Waypoints {
     }
 
     pub fn quadrotor(&self) -> &Quadrotor {
-        &self.quad
+        self.vehicle.quadrotor()
     }
 
     pub fn quadrotor_mut(&mut self) -> &mut Quadrotor {
-        &mut self.quad
+        self.vehicle.quadrotor_mut()
+    }
+
+    pub fn vehicle(&self) -> &FlightVehicle {
+        &self.vehicle
     }
 
     /// The episode's waypoints, in order.
@@ -162,11 +181,11 @@ impl Task for Waypoints {
     }
 
     fn action_bounds(&self) -> (Vec<f64>, Vec<f64>) {
-        (vec![0.0; 4], vec![1.0; 4])
+        self.vehicle.action_bounds()
     }
 
     fn observation_size(&self) -> usize {
-        WAYPOINT_OBSERVATION_SIZE
+        self.obs_low.len()
     }
 
     fn observation_bounds(&self) -> (Vec<f32>, Vec<f32>) {
@@ -175,30 +194,31 @@ impl Task for Waypoints {
 
     fn reset(&mut self, seed: u64) {
         let mut rng = SimRng::new(seed);
-        let body = sample_start(&self.flight, &self.quad.params, &mut rng);
+        let model = self.vehicle.draw(seed);
+        let body = sample_start(&self.flight, model, &mut rng);
         let mut from = body.position;
         self.waypoints.clear();
         for _ in 0..self.params.max_num_waypoints {
             from = sample_target(&self.flight, &from, &mut rng);
             self.waypoints.push(from);
         }
-        self.quad.restart(body, rng);
+        self.vehicle.restart(body, rng, seed);
         self.current = 0;
         self.reached = 0;
         self.steps_since_checkpoint = 0;
         self.status = FlightStatus {
-            initial_distance: (self.current_waypoint() - self.quad.body.position).norm(),
+            initial_distance: (self.current_waypoint() - self.quadrotor().body.position).norm(),
             ..FlightStatus::default()
         };
     }
 
     fn step(&mut self, action: &[f64]) -> Result<StepOutcome, ActionError> {
-        apply_action(&mut self.quad, action, self.flight.dt)?;
+        self.vehicle.apply(action, self.flight.dt)?;
         self.status.step_count += 1;
         self.steps_since_checkpoint += 1;
 
         let waypoint = self.current_waypoint();
-        let (d, _) = distance_and_direction(&self.quad.body, &waypoint);
+        let (d, _) = distance_and_direction(&self.quadrotor().body, &waypoint);
         let all_reached = self.reached >= self.params.max_num_waypoints;
         let mut reward = if d < self.params.waypoint_reach_threshold_m && !all_reached {
             let bonus = self.params.checkpoint_bonus
@@ -207,20 +227,21 @@ impl Task for Waypoints {
             self.current += 1;
             self.steps_since_checkpoint = 0;
             self.status.initial_distance =
-                (self.current_waypoint() - self.quad.body.position).norm();
+                (self.current_waypoint() - self.quadrotor().body.position).norm();
             bonus.max(1.0)
         } else {
-            velocity_reward(&self.flight, &self.quad.body, &waypoint)
+            velocity_reward(&self.flight, &self.quadrotor().body, &waypoint)
         };
         if reward > 0.0 {
-            let mean_motor = self.quad.body.motors.iter().sum::<f64>() / 4.0;
+            let mean_motor = self.quadrotor().body.motors.iter().sum::<f64>() / 4.0;
             reward += 0.5 * mean_motor;
         }
 
-        let d_now = (self.current_waypoint() - self.quad.body.position).norm();
+        let d_now = (self.current_waypoint() - self.quadrotor().body.position).norm();
+        let quad = self.vehicle.quadrotor();
         let status = &mut self.status;
         status.crashed = self.flight.enable_crash_detection
-            && is_crashed(&self.flight, &self.quad.params, &self.quad.body);
+            && is_crashed(&self.flight, &quad.params, &quad.body);
         status.out_of_bounds = self.flight.enable_out_of_bounds_detection
             && d_now > waypoint_out_of_bounds_distance(&self.flight);
         let truncated = status.step_count >= self.flight.max_steps
@@ -234,13 +255,15 @@ impl Task for Waypoints {
 
     fn write_observation(&self, out: &mut [f32]) {
         let current = self.current_waypoint();
-        write_base_observation(&self.quad, &current, &self.obs_low, &self.obs_high, out);
-        let next = self.next_waypoint() - self.quad.body.position;
+        self.vehicle
+            .write_observation(&current, &self.obs_low, &self.obs_high, out);
+        let base = self.vehicle.observation_size();
+        let next = self.vehicle.observed_offset(&self.next_waypoint());
         for i in 0..3 {
-            let k = BASE_OBSERVATION_SIZE + i;
+            let k = base + i;
             out[k] = clip_f32(next[i], self.obs_low[k], self.obs_high[k]);
         }
-        let k = BASE_OBSERVATION_SIZE + 3;
+        let k = base + 3;
         out[k] = clip_f32(
             self.time_since_checkpoint(),
             self.obs_low[k],
@@ -250,7 +273,7 @@ impl Task for Waypoints {
 
     fn info(&self) -> Info {
         let current = self.current_waypoint();
-        let mut info = flight_info(&self.quad, &current, &self.status, self.flight.dt);
+        let mut info = flight_info(self.quadrotor(), &current, &self.status, self.flight.dt);
         info.extend([
             (
                 "waypoints_reached",
@@ -269,6 +292,7 @@ impl Task for Waypoints {
                 InfoValue::Real(self.time_since_checkpoint()),
             ),
         ]);
+        info.extend(self.vehicle.info());
         info
     }
 

@@ -1,39 +1,42 @@
 //! The flight track of PX4 mode (`--track FILE`): ground truth as CSV, one row every
-//! [`TRACK_INTERVAL_US`] of simulation time, for plots and for checking PX4's estimate.
+//! `--track-interval-us` of simulation time ([`TRACK_INTERVAL_US`] by default), for plots and for checking PX4's estimate.
 //!
 //! Columns: `connection` (1 for the first PX4, 2 after a reconnect, …), `time_us` (simulation
 //! time = PX4's clock), `north,east,down` (m from home), `vn,ve,vd` (m/s),
-//! `roll,pitch,yaw` (rad, FRD → NED), `m0..m3` (motor states in [0, 1]), `grounded` (0/1).
+//! `roll,pitch,yaw` (rad, FRD → NED), `m0..m3` (motor states in [0, 1]), `grounded` (0/1),
+//! `p,q,r` (body rates, rad/s, FRD).
 
-use crate::kinematics::{attitude_ned, enu_to_ned};
+use crate::kinematics::{attitude_ned, enu_to_ned, flu_to_frd};
 use flyloop_core::quadrotor::Quadrotor;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
-/// Simulation time between two rows, µs (50 Hz).
+/// Simulation time between two rows by default, µs (50 Hz).
 pub const TRACK_INTERVAL_US: u64 = 20_000;
 
 /// The CSV header line.
 pub const HEADER: &str =
-    "connection,time_us,north,east,down,vn,ve,vd,roll,pitch,yaw,m0,m1,m2,m3,grounded";
+    "connection,time_us,north,east,down,vn,ve,vd,roll,pitch,yaw,m0,m1,m2,m3,grounded,p,q,r";
 
 /// A track file being written.
 #[derive(Debug)]
 pub struct Track {
     out: BufWriter<File>,
     next_us: u64,
+    interval_us: u64,
     connection: u32,
 }
 
 impl Track {
-    /// Creates (truncates) `path` and writes the header.
-    pub fn create(path: &Path) -> io::Result<Self> {
+    /// Creates (truncates) `path` and writes the header; a row every `interval_us`.
+    pub fn create(path: &Path, interval_us: u64) -> io::Result<Self> {
         let mut out = BufWriter::new(File::create(path)?);
         writeln!(out, "{HEADER}")?;
         Ok(Track {
             out,
             next_us: 0,
+            interval_us,
             connection: 0,
         })
     }
@@ -50,15 +53,16 @@ impl Track {
         if time_us < self.next_us {
             return Ok(());
         }
-        self.next_us = time_us + TRACK_INTERVAL_US;
+        self.next_us = time_us + self.interval_us;
         let b = &quad.body;
         let p = enu_to_ned(&b.position);
         let v = enu_to_ned(&b.velocity);
         let (roll, pitch, yaw) = attitude_ned(&quad.attitude()).euler_angles();
         let m = b.motors;
+        let w = flu_to_frd(&b.body_rates);
         writeln!(
             self.out,
-            "{},{time_us},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.5},{:.5},{:.5},{:.4},{:.4},{:.4},{:.4},{}",
+            "{},{time_us},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.5},{:.5},{:.5},{:.4},{:.4},{:.4},{:.4},{},{:.5},{:.5},{:.5}",
             self.connection,
             p.x,
             p.y,
@@ -73,7 +77,10 @@ impl Track {
             m[1],
             m[2],
             m[3],
-            u8::from(quad.is_grounded())
+            u8::from(quad.is_grounded()),
+            w.x,
+            w.y,
+            w.z
         )
     }
 
