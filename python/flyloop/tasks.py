@@ -87,6 +87,46 @@ def _wind_direction(arg: str, v: Any) -> tuple[bool, float]:
     return (True, 0.0) if v is None else (False, as_float(arg, v))
 
 
+def _action_interface(arg: str, v: Any) -> tuple[bool]:
+    if v not in ("motors", "rates"):
+        raise ValueError(f"{arg} must be 'motors' or 'rates', got {v!r}")
+    return (v == "rates",)
+
+
+NOISE_KEYS = ("position", "velocity", "attitude", "rates")
+
+
+def _observation_noise(arg: str, v: Any) -> tuple[float, ...]:
+    # None: no noise; a mapping: standard deviations by quantity (missing ones 0).
+    if v is None:
+        return (0.0,) * len(NOISE_KEYS)
+    if not isinstance(v, Mapping):
+        raise TypeError(f"{arg} must be None or a dict over {NOISE_KEYS}, got {v!r}")
+    unknown = set(v) - set(NOISE_KEYS)
+    if unknown:
+        raise ValueError(f"{arg}: unknown keys {sorted(unknown)}; known: {list(NOISE_KEYS)}")
+    return tuple(as_float(f"{arg}[{k!r}]", v.get(k, 0.0)) for k in NOISE_KEYS)
+
+
+# A config key "randomize.<name>" holds the range (low, high) of core parameter <name>: the
+# native extension reads it so, and to_toml writes it into the SITL's [randomize] table.
+RANGE_PREFIX = "randomize."
+
+
+def randomize_entries(arg: str, v: Any) -> dict[str, tuple[float, float]]:
+    """`randomize={name: (low, high)}` as config entries; None or {} = off."""
+    if v is None:
+        return {}
+    if not isinstance(v, Mapping):
+        raise TypeError(f"{arg} must be None or a dict {{parameter: (low, high)}}, got {v!r}")
+    out = {}
+    for name, pair in v.items():
+        if not isinstance(name, str):
+            raise TypeError(f"{arg}: parameter names are strings, got {name!r}")
+        out[RANGE_PREFIX + name] = as_interval(f"{arg}[{name!r}]", pair)
+    return out
+
+
 def _arg(name: str, core: str | tuple[str, ...], convert, doc: str) -> Argument:
     core = (core,) if isinstance(core, str) else core
     return Argument(name, core, convert, doc)
@@ -156,6 +196,31 @@ FLIGHT_ARGUMENTS: list[Argument] = [
         "velocity_scale",
         _one(as_float),
         "speed scale of the velocity reward, m/s",
+    ),
+    _arg(
+        "action_interface",
+        "rates_action",
+        _action_interface,
+        "'motors' (4 motor commands) or 'rates' (thrust + body rates through PX4's rate loop)",
+    ),
+    _arg(
+        "action_latency",
+        "action_latency",
+        _one(as_float),
+        "rates interface: delay from an action to the rate loop, s",
+    ),
+    _arg(
+        "observation_noise",
+        tuple("obs_noise_" + k for k in NOISE_KEYS),
+        _observation_noise,
+        "rates interface: observation noise std by quantity (position m, velocity m/s, "
+        "attitude rad, rates rad/s)",
+    ),
+    _arg(
+        "randomize",
+        (),
+        randomize_entries,
+        "domain randomisation: {core parameter: (low, high)} drawn per episode from its seed",
     ),
 ]
 WAYPOINT_ARGUMENTS: list[Argument] = [
@@ -281,8 +346,12 @@ class TaskSpec:
         """The core's description of the task built from `config` (core name -> value):
         observation and action bounds, dt, info layout, parameters with their `value`.
         A value the core refuses raises SitlParameterError naming the env argument."""
+        values = {
+            k: (tuple(map(float, v)) if k.startswith(RANGE_PREFIX) else float(v))
+            for k, v in config.items()
+        }
         try:
-            return _native.describe(self.name, {k: float(v) for k, v in config.items()})
+            return _native.describe(self.name, values)
         except ValueError as exc:
             raise parameter_error(self, str(exc)) from None
 
@@ -316,6 +385,9 @@ def resolve_config(
     by_name = {a.name: a for a in spec.arguments}
     for name, value in arguments.items():
         arg = by_name[name]
+        if name == "randomize":
+            config.update(randomize_entries(name, value))
+            continue
         for core, v in zip(arg.core, arg.convert(name, value), strict=True):
             config[core] = v
     extra = dict(model_params or {})
@@ -359,13 +431,22 @@ def parameter_error(spec: TaskSpec, message: str) -> SitlParameterError:
     if ": parameter" in lead and lead.startswith("config file"):
         lead = lead.split(": ", 1)[1]
     where = ", ".join(argument_for(spec, n) for n in names) or "an argument"
+    if "randomisation" in lead:
+        where = "randomize"
     return SitlParameterError(f"{spec.env_id}: {where} refused by the core: {lead}")
 
 
-def to_toml(config: Mapping[str, bool | int | float]) -> str:
-    """A flat TOML table (the SITL's --config file)."""
+def to_toml(config: Mapping[str, Any]) -> str:
+    """The SITL's --config file: a flat TOML table, and the randomisation ranges in its
+    [randomize] table."""
     lines = []
+    ranges = [
+        f"{k[len(RANGE_PREFIX) :]} = [{float(lo)!r}, {float(hi)!r}]"
+        for k, (lo, hi) in ((k, v) for k, v in config.items() if k.startswith(RANGE_PREFIX))
+    ]
     for name, v in config.items():
+        if name.startswith(RANGE_PREFIX):
+            continue
         if isinstance(v, bool):
             text = "true" if v else "false"
         elif isinstance(v, int):
@@ -373,4 +454,6 @@ def to_toml(config: Mapping[str, bool | int | float]) -> str:
         else:
             text = repr(float(v))
         lines.append(f"{name} = {text}")
+    if ranges:
+        lines += ["", "[randomize]", *ranges]
     return "\n".join(lines) + "\n"

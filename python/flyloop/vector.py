@@ -102,9 +102,10 @@ class FlyloopVectorEnv(VectorEnv):
         self.metadata = {**type(self).metadata, "render_fps": max(1, round(1.0 / self.dt))}
 
         self._n_obs = self.single_observation_space.shape[0]
-        self._n_values = FRAME_HEADER_LEN + self._n_obs + spec.info_size()
+        layout = self.core["info"]
+        self._n_values = FRAME_HEADER_LEN + self._n_obs + sum(n for _, _, n in layout)
         self._n_arrays = frame_array_count(self._n_values)
-        self._columns = InfoColumns(spec.info, FRAME_HEADER_LEN + self._n_obs, self.num_envs)
+        self._columns = InfoColumns(layout, FRAME_HEADER_LEN + self._n_obs, self.num_envs)
         self._encoder = Encoder()
         self._generators: list[np.random.Generator] = [
             seeding.np_random()[0] for _ in range(self.num_envs)

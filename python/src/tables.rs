@@ -3,6 +3,7 @@
 
 use flyloop_core::params::ValueKind;
 use flyloop_core::tasks::InfoValue;
+use flyloop_core::tasks::randomization::ParamRange;
 use flyloop_sitl::config;
 use flyloop_sitl::model::{TaskConfig, TaskInstance, TaskKind};
 use flyloop_sitl::param_table;
@@ -23,16 +24,35 @@ pub fn task_kind(name: &str) -> PyResult<TaskKind> {
     }
 }
 
-/// The parameter sets of `task` from `{core name or param_id: number}`, checked by the core
-/// exactly as the SITL checks its config file; errors are ValueErrors carrying the core's
-/// message (it names the parameter and its bound).
+/// Prefix of a config key that holds a randomisation range: `"randomize.mass": (1.2, 1.8)`
+/// (the SITL's config file has them in its `[randomize]` table).
+const RANGE_PREFIX: &str = "randomize.";
+
+/// The parameter sets of `task` from `{core name or param_id: number}` and
+/// `{"randomize.<name>": (low, high)}`, checked by the core exactly as the SITL checks its
+/// config file; errors are ValueErrors carrying the core's message (it names the parameter
+/// and its bound).
 pub fn task_config(task: TaskKind, params: Option<&Bound<'_, PyDict>>) -> PyResult<TaskConfig> {
     let mut pairs: Vec<(String, f64)> = Vec::new();
+    let mut ranges = Vec::new();
     if let Some(params) = params {
         for (key, value) in params.iter() {
             let name: String = key.extract().map_err(|_| {
                 PyTypeError::new_err(format!("parameter names are strings, got {key}"))
             })?;
+            if let Some(param) = name.strip_prefix(RANGE_PREFIX) {
+                let (low, high): (f64, f64) = value.extract().map_err(|_| {
+                    PyTypeError::new_err(format!(
+                        "randomisation range `{param}` must be a pair of numbers (low, high), got {value}"
+                    ))
+                })?;
+                ranges.push(ParamRange {
+                    name: param.to_string(),
+                    low,
+                    high,
+                });
+                continue;
+            }
             let number: f64 = value.extract().map_err(|_| {
                 PyTypeError::new_err(format!(
                     "parameter `{name}` must be a number or a boolean, got {value}"
@@ -41,7 +61,7 @@ pub fn task_config(task: TaskKind, params: Option<&Bound<'_, PyDict>>) -> PyResu
             pairs.push((name, number));
         }
     }
-    config::from_values(task, pairs.iter().map(|(k, v)| (k.as_str(), *v)))
+    config::from_values_and_ranges(task, pairs.iter().map(|(k, v)| (k.as_str(), *v)), ranges)
         .map_err(|e| PyValueError::new_err(e.to_string()))
 }
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 import os
 import tempfile
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import gymnasium as gym
@@ -31,6 +31,7 @@ from ..spaces import FastBox
 from ..tasks import (
     FLAG,
     INTEGER,
+    RANGE_PREFIX,
     REAL,
     TaskSpec,
     parameter_error,
@@ -94,11 +95,12 @@ def spaces_of(description: Mapping[str, Any]) -> tuple[gym.spaces.Box, FastBox]:
     return observation, action
 
 
-def info_reader(spec: TaskSpec, n_obs: int):
-    """A function: frame values -> the info dict (names and types of the core's info)."""
+def info_reader(layout: Sequence[Sequence[Any]], n_obs: int):
+    """A function: frame values -> the info dict (the core's info `layout`: name, kind,
+    count)."""
     fields = []
     at = FRAME_HEADER_LEN + n_obs
-    for name, kind, count in spec.info:
+    for name, kind, count in layout:
         fields.append((name, kind, at, at + count))
         at += count
 
@@ -185,6 +187,11 @@ def configure_attached(link: SitlLink, encoder: Encoder, spec: TaskSpec, config,
         "COMMAND_ACK to SET_MESSAGE_INTERVAL",
     )
     ids = spec.param_ids
+    if any(name.startswith(RANGE_PREFIX) for name in config):
+        raise ValueError(
+            "randomize needs a SITL the env starts itself (or backend='native'): a running "
+            "SITL takes its randomisation ranges from its --config file's [randomize] table"
+        )
     for name, value in config.items():
         param_id = ids[name]
         sent = float(value)
@@ -259,9 +266,10 @@ class FlyloopEnv(gym.Env):
     def _start_sitl(self, sitl_path: Any, sitl_address: Any, vehicle: int, timeout: float) -> None:
         spec = self.SPEC
         self._n_obs = self.observation_space.shape[0]
-        self._n_values = FRAME_HEADER_LEN + self._n_obs + spec.info_size()
+        layout = self.core["info"]
+        self._n_values = FRAME_HEADER_LEN + self._n_obs + sum(n for _, _, n in layout)
         self._n_arrays = frame_array_count(self._n_values)
-        self._read_info = info_reader(spec, self._n_obs)
+        self._read_info = info_reader(layout, self._n_obs)
         self._encoder = Encoder()
 
         self.vehicle = 1 if sitl_address is None else int(vehicle)

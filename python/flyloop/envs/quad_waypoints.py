@@ -91,6 +91,7 @@ class QuadWaypointsEnv(QuadHoverEnv):
         vehicle: int = 1,
         timeout: float = 5.0,
         backend: str = "sitl",
+        **flight_arguments: Any,
     ) -> None:
         super().__init__(
             max_steps=max_steps,
@@ -118,4 +119,5 @@ class QuadWaypointsEnv(QuadHoverEnv):
             waypoint_reach_threshold_m=waypoint_reach_threshold_m,
             checkpoint_bonus=checkpoint_bonus,
             bonus_decay_rate_per_sec=bonus_decay_rate_per_sec,
+            **flight_arguments,
         )

@@ -1,0 +1,135 @@
+"""A policy trained in flyloop flies through the real PX4: examples/px4_offboard.py arms and
+takes off with PX4, switches to OFFBOARD and runs the shipped rates policy on PX4's estimate
+(SET_ATTITUDE_TARGET: body rates + thrust), on the stock Iris and on a vehicle the policy never
+saw (mass +20 %, thrust coefficient −10 %); and it fails safe when PX4 is missing or the
+telemetry stops."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+SCRIPT = ROOT / "examples" / "px4_offboard.py"
+POLICY = ROOT / "policies" / "px4_offboard_hover"
+WAYPOINTS = "0,0,3;2,0,3;2,2,4"
+
+
+def offboard(pair, *flyloop_args: str, waypoints=WAYPOINTS, hold=4.0, timeout=240):
+    """flyloop (with `flyloop_args`) and PX4, then the deployment script against PX4's
+    offboard port; returns the script's result and the flyloop process."""
+    flyloop = pair.flyloop(*flyloop_args)
+    px4 = pair.px4()
+    result = subprocess.run(
+        [
+            sys.executable,
+            str(SCRIPT),
+            str(POLICY),
+            "--connect",
+            f"udpout:127.0.0.1:{14580 + px4.instance}",
+            "--waypoints",
+            waypoints,
+            "--hold",
+            str(hold),
+            "--timeout",
+            "90",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+    return result, flyloop, px4
+
+
+def hold_errors(stdout: str) -> list[tuple[float, float]]:
+    found = re.findall(r"waypoint \d+: hold error mean ([\d.]+) m, max ([\d.]+) m", stdout)
+    return [(float(a), float(b)) for a, b in found]
+
+
+def check_flight(result, bound: float) -> list[tuple[float, float]]:
+    assert result.returncode == 0, result.stdout + result.stderr
+    errors = hold_errors(result.stdout)
+    assert len(errors) == 3, result.stdout
+    for mean, worst in errors:
+        assert mean < bound, result.stdout
+        assert worst < 2 * bound + 0.3, result.stdout
+    lines = result.stdout.strip().splitlines()
+    assert lines[-1].startswith("max hold error"), lines[-1]
+    assert "PX4 holds position" in result.stderr and "PX4 lands" in result.stderr
+    return errors
+
+
+def test_the_shipped_policy_holds_waypoints_through_px4_on_the_iris(pair):
+    result, flyloop, _ = offboard(pair)
+    check_flight(result, 0.3)
+    assert flyloop.proc.poll() is None
+
+
+def test_the_shipped_policy_flies_a_vehicle_it_never_saw(pair):
+    config = ROOT / "sitl" / "presets" / "px4_iris_unseen.toml"
+    assert (
+        "mass = 1.8\n" in config.read_text() and "thrust_coefficient = 9.0\n" in config.read_text()
+    )
+    result, _, _ = offboard(pair, "--config", str(config))
+    check_flight(result, 0.5)
+
+
+def test_no_px4_is_said_in_one_line_without_a_traceback(tmp_path):
+    start = time.monotonic()
+    result = subprocess.run(
+        [
+            sys.executable,
+            str(SCRIPT),
+            str(POLICY),
+            "--connect",
+            "udpout:127.0.0.1:9",
+            "--timeout",
+            "3",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert result.returncode == 2, result.stderr
+    assert "PX4 not reachable at udpout:127.0.0.1:9" in result.stderr
+    assert "Traceback" not in result.stderr
+    assert time.monotonic() - start < 30
+
+
+def test_telemetry_stopping_mid_flight_hands_back_to_px4(pair):
+    flyloop = pair.flyloop()
+    px4 = pair.px4()
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            str(SCRIPT),
+            str(POLICY),
+            "--connect",
+            f"udpout:127.0.0.1:{14580 + px4.instance}",
+            "--waypoints",
+            "0,0,3;10,0,3",
+            "--hold",
+            "30",
+            "--stale",
+            "2",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        # Once the first hold is reported the vehicle is flying in OFFBOARD: stop the
+        # simulator, and with it PX4's clock and telemetry.
+        line = proc.stdout.readline()
+        assert line.startswith("waypoint 0:"), line + proc.stderr.read()
+        flyloop.proc.kill()
+        out, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 4, err
+    assert "telemetry stopped" in err
+    assert "Traceback" not in err
