@@ -88,7 +88,8 @@ impl Owner {
     }
 }
 
-/// Every parameter name a range may use, in table order.
+/// Every parameter name a range may use, in the parameter tables' order (quadrotor, flight
+/// task, rate loop: the order `flyloop-sitl --list-params` lists them).
 pub fn randomizable_names() -> Vec<&'static str> {
     let real = |kind: ValueKind, name: &'static str| {
         (kind == ValueKind::Real && !NOT_RANDOMIZABLE.contains(&name)).then_some(name)
@@ -96,12 +97,12 @@ pub fn randomizable_names() -> Vec<&'static str> {
     QuadrotorParams::specs()
         .iter()
         .filter_map(|s| real(s.kind, s.name))
+        .chain(FLIGHT_RANDOMIZABLE)
         .chain(
             RateLoopParams::specs()
                 .iter()
                 .filter_map(|s| real(s.kind, s.name)),
         )
-        .chain(FLIGHT_RANDOMIZABLE)
         .collect()
 }
 
@@ -111,9 +112,11 @@ impl Randomization {
         Randomization::default()
     }
 
-    /// Ranges by name. Each name must be a randomisable parameter (see
-    /// [`randomizable_names`]), named once; each range finite, low ≤ high, inside the
-    /// parameter's bounds. Relations are checked by [`Randomization::check`].
+    /// Ranges by name, in any order: they are kept, drawn and reported in the order of
+    /// [`randomizable_names`] (the parameter tables' order), so the same ranges give the same
+    /// vehicles however they were listed. Each name must be a randomisable parameter, named
+    /// once; each range finite, low ≤ high, inside the parameter's bounds. Relations are
+    /// checked by [`Randomization::check`].
     pub fn new(ranges: Vec<ParamRange>) -> Result<Self, ParamError> {
         for (i, r) in ranges.iter().enumerate() {
             let known = owner(&r.name).filter(|_| !NOT_RANDOMIZABLE.contains(&r.name.as_str()));
@@ -128,7 +131,9 @@ impl Randomization {
             if kind != ValueKind::Real {
                 return Err(ParamError::Relation {
                     name,
-                    requirement: format!("`{name}` is not a real number and cannot be randomised"),
+                    requirement: format!(
+                        "randomisation range of `{name}`: only real parameters can be randomised"
+                    ),
                 });
             }
             if ranges[..i].iter().any(|o| o.name == r.name) {
@@ -151,6 +156,9 @@ impl Randomization {
                 });
             }
         }
+        let order = randomizable_names();
+        let mut ranges = ranges;
+        ranges.sort_by_key(|r| order.iter().position(|n| *n == r.name));
         Ok(Randomization { ranges })
     }
 
@@ -243,13 +251,25 @@ mod tests {
             vb.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
         );
         assert_eq!(a.quadrotor.mass, va[0]);
-        assert_eq!(a.rate_loop.roll_rate_p, va[2]);
-        assert_eq!(a.flight.action_latency, va[3]);
-        assert!((1.2..=1.8).contains(&va[0]) && (0.0..=0.03).contains(&va[3]));
+        // Drawn in the tables' order: quadrotor, flight task, rate loop.
+        assert_eq!(a.flight.action_latency, va[2]);
+        assert_eq!(a.rate_loop.roll_rate_p, va[3]);
+        assert!((1.2..=1.8).contains(&va[0]) && (0.0..=0.03).contains(&va[2]));
         let (c, _) = r.draw(&nominal, 8);
         assert_ne!(a.quadrotor.mass, c.quadrotor.mass);
         // Untouched parameters keep their nominal values.
         assert_eq!(a.quadrotor.arm_length, nominal.quadrotor.arm_length);
+    }
+
+    #[test]
+    fn the_order_ranges_are_given_in_does_not_matter() {
+        let a = Randomization::new(vec![range("roll_rate_p", 0.1, 0.2), range("mass", 1.0, 2.0)]);
+        let b = Randomization::new(vec![range("mass", 1.0, 2.0), range("roll_rate_p", 0.1, 0.2)]);
+        let (a, b) = (a.unwrap(), b.unwrap());
+        assert_eq!(a, b);
+        let nominal = VehicleParams::default();
+        assert_eq!(a.draw(&nominal, 3), b.draw(&nominal, 3));
+        assert_eq!(a.ranges()[0].name, "mass");
     }
 
     #[test]
@@ -273,7 +293,7 @@ mod tests {
         let err = Randomization::new(vec![range("ground_enabled", 0.0, 1.0)])
             .unwrap_err()
             .to_string();
-        assert!(err.contains("cannot be randomised"), "{err}");
+        assert!(err.contains("only real parameters can be randomised"), "{err}");
         let err = Randomization::new(vec![range("wind_speed_min", 0.0, 1.0)])
             .unwrap_err()
             .to_string();
