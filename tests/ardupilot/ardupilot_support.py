@@ -440,24 +440,32 @@ def settle(source, north: float, east: float, alt: float, tolerance: float, time
     raise AssertionError(f"no arrival at {(north, east, alt)} within {timeout} s: last {e}")
 
 
-def truth_vs_estimate(rows: list[dict[str, float]], hold: Hold, connection: int) -> float:
-    """Largest distance between ArduPilot's estimate and flyloop's ground truth at the same
-    time (ArduPilot's clock is flyloop's physics time; the truth interpolated between rows)."""
+def truth_vs_estimate_parts(
+    rows: list[dict[str, float]], hold: Hold, connection: int
+) -> tuple[float, float, float]:
+    """Largest distance (3-D, horizontal, vertical) between ArduPilot's estimate and flyloop's
+    ground truth at the same time (ArduPilot's clock is flyloop's physics time; the truth
+    interpolated between rows)."""
     rows = [r for r in rows if r["connection"] == connection]
     times = [r["time_us"] / 1000 for r in rows]
     compared = [s for s in hold.samples if times[0] <= s.time_ms <= times[-1]]
     assert len(compared) > len(hold.samples) / 2, f"the track ends at {times[-1]} ms"
-    worst = 0.0
+    worst = [0.0, 0.0, 0.0]
     for s in compared:
         i = next(k for k in range(1, len(times)) if times[k] >= s.time_ms)
         a, b = rows[i - 1], rows[i]
         w = (s.time_ms - times[i - 1]) / (times[i] - times[i - 1])
         truth = tuple(a[k] + w * (b[k] - a[k]) for k in ("north", "east", "down"))
-        if math.dist(truth, s.position) > worst:
-            worst = math.dist(truth, s.position)
-            worst_at = (s, truth)
-    print(f"truth vs estimate: worst {worst:.3f} m at {worst_at}")
-    return worst
+        d = [truth[k] - s.position[k] for k in range(3)]
+        parts = (math.hypot(*d), math.hypot(d[0], d[1]), abs(d[2]))
+        worst = [max(x, y) for x, y in zip(worst, parts, strict=True)]
+    return worst[0], worst[1], worst[2]
+
+
+def truth_vs_estimate(rows: list[dict[str, float]], hold: Hold, connection: int) -> float:
+    """Largest 3-D distance between ArduPilot's estimate and flyloop's truth (see
+    truth_vs_estimate_parts)."""
+    return truth_vs_estimate_parts(rows, hold, connection)[0]
 
 
 def check_landed(rows: list[dict[str, float]], north: float, east: float) -> None:
