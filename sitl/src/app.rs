@@ -187,10 +187,11 @@ fn start_ardupilot(args: Args) -> Result<(), StartError> {
         seed: args.seed,
     })?;
     if let Some(path) = &args.track {
-        let track = Track::create(path, args.track_interval_us).map_err(|source| StartError::Track {
-            path: path.clone(),
-            source,
-        })?;
+        let track =
+            Track::create(path, args.track_interval_us).map_err(|source| StartError::Track {
+                path: path.clone(),
+                source,
+            })?;
         session.set_track(track);
     }
     let socket =

@@ -27,11 +27,10 @@ fn field(reply: &[u8], key: &str) -> Vec<f64> {
     let text = std::str::from_utf8(reply).unwrap();
     let at = text.find(&format!("\"{key}\":")).unwrap() + key.len() + 3;
     let rest = &text[at..];
-    let end = rest.find(|c| c == ']' || c == ',' || c == '}').unwrap();
     let end = if rest.starts_with('[') {
         rest.find(']').unwrap()
     } else {
-        end
+        rest.find([',', '}']).unwrap()
     };
     rest[..end]
         .trim_start_matches('[')
