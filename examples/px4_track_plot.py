@@ -1,6 +1,8 @@
-"""Plots a PX4 flight on flyloop from the ground-truth track of `flyloop-sitl --px4 --track`.
+"""Plots a PX4 (or ArduPilot) flight on flyloop from the ground-truth track of
+`flyloop-sitl --px4 --track` (or `--ardupilot --track`: the same columns).
 
     .venv/bin/python examples/px4_track_plot.py track.csv docs/img/px4_mission.png
+    .venv/bin/python examples/px4_track_plot.py track.csv mission.png ArduPilot
 
 Left: the path seen from above (north up). Right: height above home and motor states over
 simulation time. One line per PX4 connection.
@@ -23,11 +25,11 @@ def read(path: Path) -> list[dict[str, float]]:
         return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
 
 
-def plot(rows: list[dict[str, float]], out: Path) -> None:
+def plot(rows: list[dict[str, float]], out: Path, autopilot: str = "PX4") -> None:
     fig, (top, side) = plt.subplots(1, 2, figsize=(10, 4), dpi=100)
     for connection in sorted({r["connection"] for r in rows}):
         flight = [r for r in rows if r["connection"] == connection]
-        label = f"PX4 connection {int(connection)}"
+        label = f"{autopilot} connection {int(connection)}"
         top.plot([r["east"] for r in flight], [r["north"] for r in flight], label=label)
         t = [r["time_us"] * 1e-6 for r in flight]
         side.plot(t, [-r["down"] for r in flight], label=f"height ({label})")
@@ -44,9 +46,9 @@ def plot(rows: list[dict[str, float]], out: Path) -> None:
 
 
 def main() -> None:
-    if len(sys.argv) != 3:
-        sys.exit("usage: px4_track_plot.py TRACK.csv OUT.png")
-    plot(read(Path(sys.argv[1])), Path(sys.argv[2]))
+    if len(sys.argv) not in (3, 4):
+        sys.exit("usage: px4_track_plot.py TRACK.csv OUT.png [AUTOPILOT (default PX4)]")
+    plot(read(Path(sys.argv[1])), Path(sys.argv[2]), *sys.argv[3:])
 
 
 if __name__ == "__main__":

@@ -4,13 +4,13 @@
 use crate::cli::{Args, GcsTarget, ListFormat};
 use crate::config::{self, ConfigError};
 use crate::model::{ModelKind, TaskConfig, TaskInstance, TaskKind};
-use crate::px4;
 use crate::px4::config::Px4Config;
 use crate::px4::server::Pacing;
 use crate::px4::session::{Session, SessionOptions};
 use crate::px4::track::Track;
 use crate::server::{self, GcsLink};
 use crate::sim::{Sim, SimOptions};
+use crate::{ardupilot, px4};
 use crate::{param_table, starter_config, task_frame};
 use clap::Parser;
 use flyloop_core::ParamError;
@@ -104,19 +104,7 @@ fn start_px4(args: Args) -> Result<(), StartError> {
             "--px4 flies the quadrotor only".to_string(),
         ));
     }
-    let mut config = match &args.config {
-        Some(path) => {
-            let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
-                path: path.clone(),
-                source,
-            })?;
-            Px4Config::parse(&text).map_err(|source| ConfigError::Invalid {
-                path: path.clone(),
-                source,
-            })?
-        }
-        None => Px4Config::iris(),
-    };
+    let mut config = vehicle_config(&args)?;
     config.sensors.home_latitude = args.home.latitude_deg;
     config.sensors.home_longitude = args.home.longitude_deg;
     config.sensors.home_altitude = args.home.altitude_m;
@@ -169,9 +157,82 @@ fn start_px4(args: Args) -> Result<(), StartError> {
     Ok(())
 }
 
+/// The vehicle of the autopilot modes: `--config`, else the Iris preset.
+fn vehicle_config(args: &Args) -> Result<Px4Config, StartError> {
+    Ok(match &args.config {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+                path: path.clone(),
+                source,
+            })?;
+            Px4Config::parse(&text).map_err(|source| ConfigError::Invalid {
+                path: path.clone(),
+                source,
+            })?
+        }
+        None => Px4Config::iris(),
+    })
+}
+
+/// ArduPilot mode: the vehicle, the UDP socket, then ArduPilot's frames until a signal.
+fn start_ardupilot(args: Args) -> Result<(), StartError> {
+    if args.model() != ModelKind::Quadrotor {
+        return Err(StartError::Options(
+            "--ardupilot flies the quadrotor only".to_string(),
+        ));
+    }
+    let config = vehicle_config(&args)?;
+    let mut session = ardupilot::session::Session::new(&ardupilot::session::SessionOptions {
+        config,
+        seed: args.seed,
+    })?;
+    if let Some(path) = &args.track {
+        let track =
+            Track::create(path, args.track_interval_us).map_err(|source| StartError::Track {
+                path: path.clone(),
+                source,
+            })?;
+        session.set_track(track);
+    }
+    let socket =
+        std::net::UdpSocket::bind(args.ardupilot_listen).map_err(|source| StartError::Bind {
+            link: "ArduPilot",
+            addr: args.ardupilot_listen,
+            source,
+        })?;
+    let listen = socket.local_addr()?;
+    let speed = args.speed_factor;
+    let ready = format!(
+        "flyloop-sitl ready ardupilot={listen} mode=ardupilot model=quadrotor speed_factor={speed} seed={}",
+        args.seed
+    );
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()?;
+    let session = runtime.block_on(async move {
+        let shutdown = server::Shutdown::install()?;
+        println!("{ready}");
+        tracing::info!(%listen, speed_factor = speed, "flyloop-sitl waiting for ArduPilot");
+        ardupilot::server::run(
+            session,
+            socket,
+            Pacing {
+                speed_factor: speed,
+            },
+            shutdown,
+        )
+        .await
+    })?;
+    tracing::info!("stopped: {}", session.stats);
+    Ok(())
+}
+
 fn start(args: Args) -> Result<(), StartError> {
     if args.px4 {
         return start_px4(args);
+    }
+    if args.ardupilot {
+        return start_ardupilot(args);
     }
     let task = args.task().map_err(StartError::Options)?;
     let config = match &args.config {

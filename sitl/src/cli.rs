@@ -96,17 +96,30 @@ pub struct Args {
     #[arg(long, default_value_t = 0.004, value_parser = parse_step)]
     pub px4_step: f64,
 
-    /// PX4 mode: simulation seconds per wall-clock second (0 = as fast as possible). Start PX4
-    /// with the same PX4_SIM_SPEED_FACTOR.
+    /// ArduPilot mode: be ArduPilot's JSON physics backend (UDP: servo packets in, one JSON
+    /// state line out per frame, lockstep); quadrotor only, the Iris preset unless `--config`
+    /// names another file. ArduPilot runs with `--model JSON`.
+    #[arg(long, conflicts_with = "px4")]
+    pub ardupilot: bool,
+
+    /// ArduPilot mode: UDP address ArduPilot sends its servo packets to (ArduPilot instance k
+    /// sends to port 9002 + 10k; port 0 picks a free port, see the first stdout line).
+    #[arg(long, default_value = "127.0.0.1:9002")]
+    pub ardupilot_listen: SocketAddr,
+
+    /// PX4 and ArduPilot modes: simulation seconds per wall-clock second (0 = as fast as the
+    /// autopilot answers). Start PX4 with the same PX4_SIM_SPEED_FACTOR, ArduPilot with a
+    /// `--speedup` at least as high.
     #[arg(long, default_value_t = 1.0, value_parser = parse_speed)]
     pub speed_factor: f64,
 
-    /// PX4 mode: write the ground-truth track (CSV, by default 50 Hz of simulation time) to
-    /// this file.
+    /// PX4 and ArduPilot modes: write the ground-truth track (CSV, by default 50 Hz of
+    /// simulation time) to this file.
     #[arg(long)]
     pub track: Option<PathBuf>,
 
-    /// PX4 mode: simulation time between two rows of the track, µs (4000 = every step).
+    /// PX4 and ArduPilot modes: simulation time between two rows of the track, µs (4000 =
+    /// every PX4 step).
     #[arg(long, default_value_t = crate::px4::track::TRACK_INTERVAL_US, value_parser = clap::value_parser!(u64).range(1..))]
     pub track_interval_us: u64,
 
@@ -294,6 +307,10 @@ mod tests {
             (a.px4, a.px4_listen.port(), a.speed_factor, a.px4_step),
             (true, 4561, 0.0, 0.004)
         );
+        let a = parse(&["--ardupilot", "--ardupilot-listen", "127.0.0.1:0"]).unwrap();
+        assert!(a.ardupilot && !a.px4 && a.ardupilot_listen.port() == 0);
+        assert_eq!(parse(&[]).unwrap().ardupilot_listen.port(), 9002);
+        assert!(parse(&["--ardupilot", "--px4"]).is_err());
         let h = parse(&["--home", "10.5, -20.25, 3"]).unwrap().home;
         assert_eq!(
             (h.latitude_deg, h.longitude_deg, h.altitude_m),

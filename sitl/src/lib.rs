@@ -8,9 +8,12 @@
 //! - [`kinematics`]: the one place where ENU/FLU becomes NED/FRD,
 //! - [`task_frame`]: the task frame layout (DEBUG_FLOAT_ARRAY),
 //! - [`param_table`], [`param_protocol`], [`config`]: parameters over MAVLink and from TOML,
-//! - [`px4`]: PX4 mode, flyloop as PX4's simulator over TCP.
+//! - [`px4`]: PX4 mode, flyloop as PX4's simulator over TCP,
+//! - [`ardupilot`]: ArduPilot mode, flyloop as ArduPilot's JSON physics backend over UDP,
+//! - [`pacer`]: the wall-clock pacer of both autopilot modes.
 
 pub mod app;
+pub mod ardupilot;
 pub mod cli;
 pub mod commands;
 pub mod config;
@@ -18,6 +21,7 @@ pub mod fuzz;
 pub mod gcs_streams;
 pub mod kinematics;
 pub mod model;
+pub mod pacer;
 pub mod param_protocol;
 pub mod param_table;
 pub mod px4;

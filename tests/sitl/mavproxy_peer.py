@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import queue
+import signal
 import subprocess
 import sys
 import threading
@@ -27,6 +28,9 @@ class MavProxy:
             text=True,
             cwd=cwd,  # its logs (mav.tlog, mav.parm) go there
             env={**os.environ, "MAVLINK20": "1"},
+            # Its own process group: MAVProxy forks helper processes that outlive a killed
+            # parent; kill() stops the whole group.
+            start_new_session=True,
         )
         threading.Thread(target=self._read, daemon=True).start()
 
@@ -59,6 +63,10 @@ class MavProxy:
         return "".join(self.seen[-200:])
 
     def kill(self) -> None:
-        # MAVProxy's own shutdown can take long; what a test needed is already read.
-        self.proc.kill()
+        # MAVProxy's own shutdown can take long; what a test needed is already read. The
+        # group (this process's id) holds MAVProxy and the helpers it forked.
+        try:
+            os.killpg(self.proc.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
         self.proc.wait()

@@ -101,6 +101,25 @@ impl Sensors {
     /// Reads IMU, magnetometer and barometer for `quad` as it is now; `dt` (s) is the time
     /// since the previous sample: it sets the white noise per sample and moves the biases.
     pub fn sample(&mut self, quad: &Quadrotor, dt: f64) -> SensorReading {
+        let imu = self.sample_imu(quad, dt);
+        let p = &self.params;
+        let rng = &mut self.rng;
+        let mag = imu::with_noise(
+            mag::body_field_frd(&quad.attitude(), &self.field_ned),
+            p.mag_noise,
+            rng,
+        );
+        let baro = baro::reading(
+            p.home_altitude + quad.body.position.z,
+            p.baro_noise * rng.normal(),
+        );
+        SensorReading { imu, mag, baro }
+    }
+
+    /// Reads the IMU alone (for an autopilot that models its other sensors itself, as
+    /// ArduPilot does): the same biases, noise and random stream as the IMU part of
+    /// [`Sensors::sample`].
+    pub fn sample_imu(&mut self, quad: &Quadrotor, dt: f64) -> ImuReading {
         let p = &self.params;
         let rng = &mut self.rng;
         imu::step_bias(
@@ -117,11 +136,10 @@ impl Sensors {
             dt,
             rng,
         );
-        let attitude = quad.attitude();
         let (acceleration, _) = quad.accelerations();
-        let accel = imu::specific_force_frd(&attitude, &acceleration, quad.params.gravity);
+        let accel = imu::specific_force_frd(&quad.attitude(), &acceleration, quad.params.gravity);
         let gyro = frames::flu_to_frd(&quad.body.body_rates);
-        let imu = ImuReading {
+        ImuReading {
             accel: imu::with_noise(
                 accel + self.accel_bias,
                 imu::white_noise_std(p.accel_noise_density, dt),
@@ -132,17 +150,7 @@ impl Sensors {
                 imu::white_noise_std(p.gyro_noise_density, dt),
                 rng,
             ),
-        };
-        let mag = imu::with_noise(
-            mag::body_field_frd(&attitude, &self.field_ned),
-            p.mag_noise,
-            rng,
-        );
-        let baro = baro::reading(
-            p.home_altitude + quad.body.position.z,
-            p.baro_noise * rng.normal(),
-        );
-        SensorReading { imu, mag, baro }
+        }
     }
 
     /// The GPS at simulation time `time` (s): takes a fix of `quad` when one is due (at

@@ -40,7 +40,7 @@ impl Px4Config {
                 sensors.push((key.as_str(), number));
             } else {
                 return Err(ParamError::UnknownName(format!(
-                    "{key}` for PX4 mode (quadrotor or sensor parameter expected"
+                    "{key}` for PX4 or ArduPilot mode (quadrotor or sensor parameter expected"
                 )));
             }
         }

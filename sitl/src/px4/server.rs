@@ -8,52 +8,10 @@ use std::net::TcpStream;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+pub use crate::pacer::Pacing;
+use crate::pacer::{self, Anchor, MAX_LAG};
 use tokio::net::TcpListener;
-
-/// Wall-clock pacing of simulation time.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Pacing {
-    /// Simulation seconds per wall second; 0 = as fast as PX4 answers.
-    pub speed_factor: f64,
-}
-
-/// Simulation time a paced run may fall behind the wall clock before it stops trying to
-/// catch up (a stall does not turn into a burst).
-const MAX_LAG: Duration = Duration::from_millis(100);
-/// Before lockstep at `--speed-factor 0`: free steps this many times faster than real time.
-const FREE_RUN_SPEED: f64 = 10.0;
-
-impl Pacing {
-    /// Wall time of one step before lockstep.
-    fn free_step(&self, step_us: u64) -> Duration {
-        let speed = if self.speed_factor > 0.0 {
-            self.speed_factor
-        } else {
-            FREE_RUN_SPEED
-        };
-        Duration::from_secs_f64(step_us as f64 * 1e-6 / speed)
-    }
-}
-
-/// Where the wall clock and simulation time were lined up last.
-#[derive(Debug, Clone, Copy)]
-struct Anchor {
-    wall: Instant,
-    sim_us: u64,
-}
-
-impl Anchor {
-    /// When simulation time `sim_us` is due on the wall clock; re-anchors when far behind.
-    fn due(&mut self, sim_us: u64, speed: f64, now: Instant) -> Instant {
-        let ahead = sim_us.saturating_sub(self.sim_us) as f64 * 1e-6 / speed;
-        let due = self.wall + Duration::from_secs_f64(ahead);
-        if now > due + MAX_LAG {
-            *self = Anchor { wall: now, sim_us };
-            return now;
-        }
-        due
-    }
-}
 
 fn unix_now_us() -> u64 {
     SystemTime::now()
@@ -202,16 +160,8 @@ fn serve(session: &mut Session, mut stream: TcpStream, pacing: Pacing, stop: &At
                 let start = Instant::now();
                 let steps = session.receive(&buf[..n], &mut out);
                 session.stats.handling += start.elapsed();
-                if steps > 0 && pacing.speed_factor > 0.0 {
-                    let a = anchor.get_or_insert(Anchor {
-                        wall: start,
-                        sim_us: session.time_us(),
-                    });
-                    let now = Instant::now();
-                    let due = a.due(session.time_us(), pacing.speed_factor, now);
-                    if due > now {
-                        std::thread::sleep(due - now);
-                    }
+                if steps > 0 {
+                    pacer::wait_for(pacing, &mut anchor, session.time_us(), start);
                 }
             }
             // Timed out (the next free step, or a look at the stop flag) or interrupted.

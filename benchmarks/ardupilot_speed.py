@@ -1,0 +1,117 @@
+"""How fast ArduCopter + flyloop run in lockstep through ArduPilot's JSON interface, and what
+share of the CPU flyloop takes; with --px4, the same for PX4 right after (benchmarks/px4_speed.py)
+so both stand side by side from one run.
+
+Starts flyloop-sitl --ardupilot with `--speed-factor 0` (no pacing: each frame answered as
+soon as it comes) and an ArduCopter SITL build from $FLYLOOP_ARDUPILOT with `--speedup`
+(ArduPilot paces itself to that many times real time; a high value means as fast as it can),
+arms it in GUIDED, takes off to 5 m and, while it hovers, measures over a wall-clock window:
+
+- the real-time factor: ArduPilot's clock (= flyloop's physics time) advanced per wall second,
+- CPU seconds of flyloop and of ArduPilot (utime + stime from /proc) and their ratio,
+- flyloop's CPU per frame (1/1200 s of physics by default), and its own work per frame
+  (decode, physics, IMU, JSON; from its counters: no socket calls).
+
+    FLYLOOP_ARDUPILOT=... .venv/bin/python benchmarks/ardupilot_speed.py [--seconds 10]
+        [--speedup 100] [--px4 --px4-speed 20]   (--px4 needs FLYLOOP_PX4 too)
+
+Run it on a quiet machine (nothing compiling).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "tests" / "ardupilot"))
+sys.path.insert(0, str(REPO / "tests" / "sitl"))
+
+import ardupilot_support as aps  # noqa: E402
+from flyloop import find_sitl_binary  # noqa: E402
+
+TICK = os.sysconf("SC_CLK_TCK")
+
+
+def cpu_seconds(pid: int) -> float:
+    """utime + stime of a process and its threads, s."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / TICK
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--seconds", type=float, default=10.0)
+    parser.add_argument("--speedup", type=int, default=100)
+    parser.add_argument("--px4", action="store_true", help="then run benchmarks/px4_speed.py")
+    parser.add_argument("--px4-speed", type=int, default=20)
+    args = parser.parse_args()
+    aps.SPEEDUP = args.speedup
+    build = aps.ardupilot_build(aps.fresh_dir("ardupilot-build-"))
+    work = aps.fresh_dir("ardupilot-bench-")
+    flyloop = aps.Flyloop(find_sitl_binary(), work, speed=0)
+    ap = None
+    try:
+        ap = aps.ArduPilot(build, aps.free_instance(), flyloop.port, aps.fresh_dir("apw-"))
+        ap.connect()
+        ap.wait_for_gps(120)
+        ap.mode(aps.GUIDED)
+        ap.arm()
+        ap.takeoff()
+        aps.settle(ap, 0.0, 0.0, aps.TAKEOFF_ALT, 0.5, 120)
+        wall0, sim0 = time.monotonic(), ap.estimate().time_ms
+        cpu0 = (cpu_seconds(flyloop.proc.pid), cpu_seconds(ap.proc.pid))
+        # Read ArduPilot's messages all along (a full socket buffer would stall it).
+        while time.monotonic() - wall0 < args.seconds:
+            sim1 = ap.estimate().time_ms
+        wall1 = time.monotonic()
+        cpu1 = (cpu_seconds(flyloop.proc.pid), cpu_seconds(ap.proc.pid))
+    finally:
+        if ap is not None:
+            ap.kill()
+        flyloop.stop()
+    sim = (sim1 - sim0) / 1000
+    wall = wall1 - wall0
+    fly_cpu, ap_cpu = cpu1[0] - cpu0[0], cpu1[1] - cpu0[1]
+    counters = flyloop.counters()
+    frames = sim * 1200  # SIM_RATE_HZ 1200: one frame per 833 us
+    print(f"ArduPilot --speedup {args.speedup}, flyloop --speed-factor 0, load {os.getloadavg()}")
+    print(f"real-time factor: {sim / wall:.1f}x ({sim:.1f} simulated s in {wall:.1f} wall s)")
+    share = 100 * fly_cpu / ap_cpu
+    print(
+        f"CPU: flyloop {fly_cpu:.2f} s, ArduPilot {ap_cpu:.2f} s, flyloop/ArduPilot = {share:.1f} %"
+    )
+    print(f"flyloop CPU per frame (incl. syscalls): {1e6 * fly_cpu / frames:.1f} us")
+    print(f"ArduPilot CPU per frame: {1e6 * ap_cpu / frames:.1f} us")
+    print(
+        "flyloop own work per frame (physics + IMU): "
+        f"{counters['physics_us_per_step']} us; per datagram incl. decoding and JSON: "
+        f"{counters['handling_us_per_datagram']} us"
+    )
+    sys.stdout.flush()
+    if args.px4:
+        print(
+            f"\nPX4 (benchmarks/px4_speed.py --seconds {args.seconds:g} "
+            f"--px4-speed {args.px4_speed}):"
+        )
+        sys.stdout.flush()
+        script = REPO / "benchmarks" / "px4_speed.py"
+        subprocess.run(
+            [
+                sys.executable,
+                str(script),
+                "--seconds",
+                f"{args.seconds:g}",
+                "--px4-speed",
+                str(args.px4_speed),
+            ],
+            check=True,
+        )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,359 @@
+//! One vehicle flown by ArduPilot, without sockets: servo packets in, JSON lines out. The
+//! server feeds it; tests drive it directly.
+
+use super::packet::{self, MAX_PWM, PacketError, ServoFrame};
+use super::reply::{self, State};
+use crate::kinematics::{attitude_ned, enu_to_ned, flu_to_frd};
+use crate::px4::config::Px4Config;
+use crate::px4::track::Track;
+use flyloop_core::ParamError;
+use flyloop_core::quadrotor::contact::rest_height;
+use flyloop_core::quadrotor::{BodyState, Quadrotor};
+use flyloop_core::rng::SimRng;
+use flyloop_core::sensors::Sensors;
+use nalgebra::Vector3;
+use std::fmt;
+use std::net::SocketAddr;
+use std::time::{Duration, Instant};
+
+/// What a session is built from.
+#[derive(Debug, Clone)]
+pub struct SessionOptions {
+    /// The vehicle and its sensors (the IMU's noise and bias; ArduPilot models the rest).
+    pub config: Px4Config,
+    /// Seed of the vehicle's and the IMU's random generators.
+    pub seed: u64,
+}
+
+/// What the session counted.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Counters {
+    /// Datagrams received.
+    pub datagrams: u64,
+    /// Frames stepped (one physics step each).
+    pub steps: u64,
+    /// Frames answered again without a step (the same frame count re-sent).
+    pub repeats: u64,
+    /// ArduPilots served (the first, and each restart after it).
+    pub connections: u64,
+    /// Frame counts that skipped ahead (stepped once).
+    pub gaps: u64,
+    // Bad input.
+    pub bad_length: u64,
+    pub bad_magic: u64,
+    pub bad_frame_rate: u64,
+    /// Frames with a motor output above the PWM limit: the previous command held.
+    pub absurd_pwm: u64,
+    /// States with a non-finite value (written as 0).
+    pub non_finite: u64,
+    /// Socket errors (logged, never fatal).
+    pub io_errors: u64,
+    /// Time in the handler (decode, physics, IMU, encoding; no socket calls).
+    pub handling: Duration,
+    /// Of which physics and the IMU.
+    pub physics: Duration,
+}
+
+impl Counters {
+    /// Every skipped or refused input.
+    pub fn bad_input(&self) -> u64 {
+        self.bad_length + self.bad_magic + self.bad_frame_rate + self.absurd_pwm
+    }
+}
+
+impl fmt::Display for Counters {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let per = |d: Duration, n: u64| {
+            if n == 0 {
+                0.0
+            } else {
+                d.as_secs_f64() * 1e6 / n as f64
+            }
+        };
+        write!(
+            f,
+            "datagrams={} steps={} repeats={} connections={} gaps={} bad_length={} bad_magic={} \
+             bad_frame_rate={} absurd_pwm={} non_finite={} io_errors={} \
+             handling_us_per_datagram={:.2} physics_us_per_step={:.2}",
+            self.datagrams,
+            self.steps,
+            self.repeats,
+            self.connections,
+            self.gaps,
+            self.bad_length,
+            self.bad_magic,
+            self.bad_frame_rate,
+            self.absurd_pwm,
+            self.non_finite,
+            self.io_errors,
+            per(self.handling, self.datagrams),
+            per(self.physics, self.steps),
+        )
+    }
+}
+
+/// The physics step of a frame at `frame_rate` Hz, whole µs (at least 1).
+pub fn frame_step_us(frame_rate: u16) -> u64 {
+    ((1e6 / f64::from(frame_rate.max(1))).round() as u64).max(1)
+}
+
+/// Kinds of bad input, each logged once.
+#[derive(Debug, Clone, Copy)]
+enum Kind {
+    Length,
+    Magic,
+    FrameRate,
+    Pwm,
+    Gap,
+    NonFinite,
+}
+
+/// The vehicle, its IMU and ArduPilot's lockstep state.
+#[derive(Debug)]
+pub struct Session {
+    start: (Quadrotor, Sensors),
+    quad: Quadrotor,
+    sensors: Sensors,
+    /// Physics time of the last reply, µs (whole microseconds, so ArduPilot's clock, which
+    /// counts whole microseconds, follows it exactly).
+    time_us: u64,
+    /// Frame count of the last frame stepped, and who sent it.
+    last: Option<(u32, SocketAddr)>,
+    /// The answer to the last frame (sent again for a repeat).
+    reply: Vec<u8>,
+    /// Kinds of bad input already logged.
+    logged: u8,
+    track: Option<Track>,
+    pub stats: Counters,
+}
+
+/// What to do with a datagram.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    /// A new frame: stepped; send [`Session::reply`].
+    Stepped,
+    /// The last frame again: send [`Session::reply`] again (no step).
+    Repeated,
+    /// Not a servo packet: no answer.
+    Skipped,
+}
+
+impl Session {
+    /// The vehicle at rest on its landing gear at home, facing north.
+    pub fn new(options: &SessionOptions) -> Result<Self, ParamError> {
+        let c = &options.config;
+        let standing = Vector3::new(0.0, 0.0, rest_height(&c.quadrotor));
+        let body = BodyState::at_rest(standing, 0.0, 0.0, std::f64::consts::FRAC_PI_2, 0.0);
+        let quad = Quadrotor::new(c.quadrotor.clone(), body, SimRng::new(options.seed))?;
+        let sensors = Sensors::new(c.sensors.clone(), options.seed)?;
+        Ok(Session {
+            start: (quad.clone(), sensors.clone()),
+            quad,
+            sensors,
+            time_us: 0,
+            last: None,
+            reply: Vec::with_capacity(512),
+            logged: 0,
+            track: None,
+            stats: Counters::default(),
+        })
+    }
+
+    /// Writes the ground truth to `track` from now on (a new `connection` number per
+    /// ArduPilot).
+    pub fn set_track(&mut self, track: Track) {
+        self.track = Some(track);
+    }
+
+    /// Writes out buffered track rows.
+    pub fn flush_track(&mut self) {
+        if let Some(track) = &mut self.track {
+            let result = track.flush();
+            self.track_result(result);
+        }
+    }
+
+    fn track_result(&mut self, result: std::io::Result<()>) {
+        if let Err(e) = result {
+            tracing::error!(error = %e, "writing the track failed: track stopped");
+            self.track = None;
+        }
+    }
+
+    /// Physics time of the last reply, µs.
+    pub fn time_us(&self) -> u64 {
+        self.time_us
+    }
+
+    /// The simulated vehicle.
+    pub fn quadrotor(&self) -> &Quadrotor {
+        &self.quad
+    }
+
+    /// Whether an ArduPilot has sent a frame (since the start).
+    pub fn is_active(&self) -> bool {
+        self.last.is_some()
+    }
+
+    /// The JSON line answering the last frame.
+    pub fn reply(&self) -> &[u8] {
+        &self.reply
+    }
+
+    fn log_once(&mut self, kind: Kind, message: fmt::Arguments<'_>) {
+        let bit = 1u8 << kind as u8;
+        if self.logged & bit == 0 {
+            self.logged |= bit;
+            tracing::warn!("{message} (logged once; counted in the stop line)");
+        } else {
+            tracing::debug!("{message}");
+        }
+    }
+
+    /// A datagram from `from`.
+    pub fn receive(&mut self, bytes: &[u8], from: SocketAddr) -> Outcome {
+        self.stats.datagrams += 1;
+        let frame = match packet::parse(bytes) {
+            Ok(frame) => frame,
+            Err(e) => {
+                let kind = match e {
+                    PacketError::Length(_) => {
+                        self.stats.bad_length += 1;
+                        Kind::Length
+                    }
+                    PacketError::Magic { .. } => {
+                        self.stats.bad_magic += 1;
+                        Kind::Magic
+                    }
+                    PacketError::FrameRate => {
+                        self.stats.bad_frame_rate += 1;
+                        Kind::FrameRate
+                    }
+                };
+                self.log_once(kind, format_args!("datagram from {from} skipped: {e}"));
+                return Outcome::Skipped;
+            }
+        };
+        match self.last {
+            None => {
+                tracing::info!(%from, frame_count = frame.frame_count, frame_rate = frame.frame_rate, "ArduPilot connected: lockstep");
+                self.connect();
+            }
+            Some((count, peer)) if frame.frame_count == count && peer == from => {
+                self.stats.repeats += 1;
+                tracing::debug!(frame_count = count, "frame repeated: answered again");
+                return Outcome::Repeated;
+            }
+            Some((count, peer)) if frame.frame_count <= count => {
+                tracing::warn!(
+                    %from,
+                    previous = %peer,
+                    frame_count = frame.frame_count,
+                    last_frame_count = count,
+                    time_us = self.time_us(),
+                    "ArduPilot restarted (its frame count went back): vehicle reset to its start state, physics time to 0"
+                );
+                self.reset();
+                self.connect();
+            }
+            Some((count, _)) if frame.frame_count != count.wrapping_add(1) => {
+                self.stats.gaps += 1;
+                self.log_once(
+                    Kind::Gap,
+                    format_args!(
+                        "frame count jumped from {count} to {}: stepped once",
+                        frame.frame_count
+                    ),
+                );
+            }
+            Some(_) => {}
+        }
+        self.step(&frame);
+        self.last = Some((frame.frame_count, from));
+        Outcome::Stepped
+    }
+
+    /// A new ArduPilot: counted, and a new connection number in the track.
+    fn connect(&mut self) {
+        self.stats.connections += 1;
+        if let Some(track) = &mut self.track {
+            let result = track.connect();
+            self.track_result(result);
+        }
+    }
+
+    /// The vehicle and IMU back to their start state, physics time to 0.
+    fn reset(&mut self) {
+        self.quad = self.start.0.clone();
+        self.sensors = self.start.1.clone();
+        self.time_us = 0;
+        self.last = None;
+    }
+
+    /// Motor commands from the frame's servo outputs; absurd ones are refused (counted) and
+    /// the previous command holds.
+    fn apply_motors(&mut self, frame: &ServoFrame) {
+        if let Some(&pwm) = frame.motors.iter().find(|&&p| p > MAX_PWM) {
+            self.stats.absurd_pwm += 1;
+            self.log_once(
+                Kind::Pwm,
+                format_args!(
+                    "motor PWM {pwm} us above {MAX_PWM} us in frame {}: previous command held",
+                    frame.frame_count
+                ),
+            );
+            return;
+        }
+        let command = frame.motors.map(packet::motor_command);
+        if let Err(e) = self.quad.set_command(command) {
+            // Commands in [0, 1] are always accepted; kept for a future bound.
+            self.stats.absurd_pwm += 1;
+            self.log_once(Kind::Pwm, format_args!("motor command refused: {e}"));
+        }
+    }
+
+    /// One physics step of 1 / frame_rate (rounded to whole microseconds: 833 µs at
+    /// 1200 Hz), then the state of the new time as the reply.
+    fn step(&mut self, frame: &ServoFrame) {
+        let start = Instant::now();
+        self.apply_motors(frame);
+        let step_us = frame_step_us(frame.frame_rate);
+        self.time_us += step_us;
+        let dt = step_us as f64 * 1e-6;
+        self.quad.step(dt);
+        let imu = self.sensors.sample_imu(&self.quad, dt);
+        self.stats.steps += 1;
+        self.stats.physics += start.elapsed();
+        let b = &self.quad.body;
+        let q = attitude_ned(&self.quad.attitude());
+        let state = State {
+            timestamp: self.time_us as f64 / 1e6,
+            gyro: imu.gyro.into(),
+            accel_body: imu.accel.into(),
+            position: enu_to_ned(&b.position).into(),
+            velocity: enu_to_ned(&b.velocity).into(),
+            quaternion: [q.w, q.i, q.j, q.k],
+        };
+        if !reply::is_finite(&state) {
+            self.stats.non_finite += 1;
+            self.log_once(
+                Kind::NonFinite,
+                format_args!("non-finite state at t = {} s written as 0", state.timestamp),
+            );
+        }
+        reply::write(&mut self.reply, &state);
+        let time_us = self.time_us;
+        if let Some(track) = &mut self.track {
+            let result = track.record(time_us, &self.quad);
+            self.track_result(result);
+        }
+    }
+
+    /// The body rates without noise, FRD (for tests).
+    pub fn true_gyro(&self) -> Vector3<f64> {
+        flu_to_frd(&self.quad.body.body_rates)
+    }
+}
+
+#[cfg(test)]
+mod tests;
