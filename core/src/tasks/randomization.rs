@@ -263,8 +263,14 @@ mod tests {
 
     #[test]
     fn the_order_ranges_are_given_in_does_not_matter() {
-        let a = Randomization::new(vec![range("roll_rate_p", 0.1, 0.2), range("mass", 1.0, 2.0)]);
-        let b = Randomization::new(vec![range("mass", 1.0, 2.0), range("roll_rate_p", 0.1, 0.2)]);
+        let a = Randomization::new(vec![
+            range("roll_rate_p", 0.1, 0.2),
+            range("mass", 1.0, 2.0),
+        ]);
+        let b = Randomization::new(vec![
+            range("mass", 1.0, 2.0),
+            range("roll_rate_p", 0.1, 0.2),
+        ]);
         let (a, b) = (a.unwrap(), b.unwrap());
         assert_eq!(a, b);
         let nominal = VehicleParams::default();
@@ -293,7 +299,10 @@ mod tests {
         let err = Randomization::new(vec![range("ground_enabled", 0.0, 1.0)])
             .unwrap_err()
             .to_string();
-        assert!(err.contains("only real parameters can be randomised"), "{err}");
+        assert!(
+            err.contains("only real parameters can be randomised"),
+            "{err}"
+        );
         let err = Randomization::new(vec![range("wind_speed_min", 0.0, 1.0)])
             .unwrap_err()
             .to_string();
