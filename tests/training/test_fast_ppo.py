@@ -49,3 +49,47 @@ def test_fast_ppo_learns_the_same_over_the_sitl_as_in_process(tmp_path, sitl_bin
     assert strip == [{k: v for k, v in r.items() if k != "wall_s"} for r in sitl["rows"]]
     assert native["evaluation"] == sitl["evaluation"]
     assert sum(r["episodes"] for r in native["rows"]) > 0
+
+
+@pytest.mark.training
+def test_fast_ppo_short_lander_run_beats_random_actions(tmp_path):
+    """A short run on Lander2D-v1 (static pad) with the lander's settings: on the same
+    held-out episodes the deterministic policy's return and episode length clearly beat
+    uniformly random actions'."""
+    from training_envs import random_policy_baseline
+
+    done = run_script(
+        TRAIN / "fast_ppo.py",
+        *("--env", "lander", "--timesteps", str(LANDER_SHORT_STEPS)),
+        *("--eval-episodes", "20", "--out", str(tmp_path), "--no-progress-bar"),
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    print(done.stdout)
+    s = summary(tmp_path, "native")
+    assert s["env_id"] == "flyloop/Lander2D-v1" and s["env"] == "lander"
+    assert s["env_steps"] == LANDER_SHORT_STEPS
+    random_return, random_success = random_policy_baseline("lander", 20, 1_000_000)
+    trained = s["evaluation"]
+    print(f"trained {trained}, random: mean return {random_return:.1f}")
+    assert random_success == 0.0
+    assert trained["mean_return"] >= random_return + LANDER_MIN_GAIN, trained
+
+
+@pytest.mark.training
+def test_fast_ppo_lander_learns_the_same_over_the_sitl_as_in_process(tmp_path, sitl_binary):
+    """As for hover: the lander's settings (reward scale, minibatches, ...) over both backends
+    give the same updates and the same held-out evaluation."""
+    done = run_script(
+        TRAIN / "fast_ppo.py",
+        *("--env", "lander", "--backend", "native", "sitl", "--timesteps", "16384"),
+        *("--num-envs", "16", "--eval-episodes", "4", "--out", str(tmp_path)),
+        "--no-progress-bar",
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    native, sitl = summary(tmp_path, "native"), summary(tmp_path, "sitl")
+    assert native["env_steps"] == sitl["env_steps"] == 16_384
+    assert native["config"] == sitl["config"] and native["config"]["reward_scale"] < 1.0
+    strip = [{k: v for k, v in r.items() if k != "wall_s"} for r in native["rows"]]
+    assert strip == [{k: v for k, v in r.items() if k != "wall_s"} for r in sitl["rows"]]
+    assert native["evaluation"] == sitl["evaluation"]
+    assert sum(r["episodes"] for r in native["rows"]) > 0
