@@ -83,11 +83,13 @@ def test_fast_ppo_short_lander_run_beats_random_actions(tmp_path):
 
 @pytest.mark.training
 def test_fast_ppo_lander_learns_the_same_over_the_sitl_as_in_process(tmp_path, sitl_binary):
-    """As for hover: the lander's settings (reward scale, minibatches, ...) over both backends
-    give the same updates and the same held-out evaluation."""
+    """As for hover, with the landing settings (reward scale, minibatches, ...) and the moving
+    pad's curriculum (8 updates: platform at 0.5 m/s, at 1.0 m/s from update 2, the task's
+    1.5 m/s from update 3): both backends give the same updates and the same held-out
+    evaluation."""
     done = run_script(
         TRAIN / "fast_ppo.py",
-        *("--env", "lander", "--backend", "native", "sitl", "--timesteps", "16384"),
+        *("--env", "lander_moving", "--backend", "native", "sitl", "--timesteps", "16384"),
         *("--num-envs", "16", "--eval-episodes", "4", "--out", str(tmp_path)),
         "--no-progress-bar",
     )
@@ -95,7 +97,13 @@ def test_fast_ppo_lander_learns_the_same_over_the_sitl_as_in_process(tmp_path, s
     native, sitl = summary(tmp_path, "native"), summary(tmp_path, "sitl")
     assert native["env_steps"] == sitl["env_steps"] == 16_384
     assert native["config"] == sitl["config"] and native["config"]["reward_scale"] < 1.0
+    assert [stage[1] for stage in native["curriculum"]] == [
+        {"platform_speed": 0.5},
+        {"platform_speed": 1.0},
+        {},
+    ]
     strip = [{k: v for k, v in r.items() if k != "wall_s"} for r in native["rows"]]
+    assert len(strip) == 8
     assert strip == [{k: v for k, v in r.items() if k != "wall_s"} for r in sitl["rows"]]
     assert native["evaluation"] == sitl["evaluation"]
     assert sum(r["episodes"] for r in native["rows"]) > 0
