@@ -9,8 +9,10 @@ import json
 import pytest
 from training_support import TRAIN, run_script
 
-# The lander's short run: 20 updates of 128 envs x 128 steps. Measured (seed 0, held-out
-# seeds 1,000,000..1,000,019): see test_fast_ppo_short_lander_run_beats_random_actions.
+# The lander's short run: 20 updates of 128 envs x 128 steps (~30 CPU seconds). Measured
+# (seed 0, held-out seeds 1,000,000..1,000,019): mean return 95.0 against -302.6 for random
+# actions, 13 of 20 landed. Seed 1, which never learned to land in 1.5M steps (README),
+# ended at a held-out mean return of -116.2 hovering: still far above random.
 LANDER_SHORT_STEPS = 327_680
 LANDER_MIN_GAIN = 150.0
 
