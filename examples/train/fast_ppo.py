@@ -11,7 +11,7 @@ MAVLink. No stable-baselines3 in the loop, big batches, a small MLP, one torch t
     .venv/bin/python examples/train/fast_ppo.py --env lander_moving   # moving pad
 
 Writes, per backend, `OUT/BACKEND/`: `progress.csv` (per update: env steps, wall seconds,
-training episodes' success rate and mean return), `policy.pt` and `summary.json` (with the
+training episodes' success rate, mean return and length), `policy.pt` and `summary.json` (with the
 held-out evaluation: the deterministic policy on `--eval-episodes` episodes seeded from
 1,000,000, which training never uses), and `OUT/learning_curve.png` (success rate against env
 steps and wall seconds, one line per backend; `--curve PATH` draws it there too).
