@@ -1,12 +1,14 @@
-"""Evaluate a model saved by train_sb3.py: N episodes, success rate and mean return.
+"""Evaluate a model saved by train_sb3.py or fast_ppo.py: N episodes, success rate and mean
+return.
 
     .venv/bin/python examples/train/evaluate.py runs/hover_ppo --episodes 100
     .venv/bin/python examples/train/evaluate.py runs/hover_ppo --random   # the random bar
     .venv/bin/python examples/train/evaluate.py policies/lander_static --episodes 100 \
         --seed-offset 1000000                                # a shipped policy
 
-The folder holds model.zip, vecnormalize.pkl and summary.json (which env and algorithm): a
-train_sb3.py output or a shipped policy under policies/.
+The folder holds summary.json (which env and algorithm) and either model.zip and
+vecnormalize.pkl (a train_sb3.py output) or policy.pt (a fast_ppo.py output, OUT/native/):
+a training output or a shipped policy under policies/.
 The policy acts deterministically (the mean of its action distribution). Episode k has seed
 --seed-offset + k (--seed is the same option), so two evaluations with the same seeds fly
 the same episodes; the default seeds (1,000,000 and up) are never among the training seeds.
@@ -35,15 +37,21 @@ EVAL_SEED = 1_000_000
 
 
 class SavedRun:
-    """A trained policy from a train_sb3.py folder, with its observation normalisation."""
+    """A trained policy from a train_sb3.py or fast_ppo.py folder, with its observation
+    normalisation."""
 
     def __init__(self, folder: Path) -> None:
         folder = Path(folder)
         summary_path = folder / "summary.json"
         if not summary_path.is_file():
-            raise FileNotFoundError(f"{summary_path} not found: is {folder} a train_sb3.py output?")
+            raise FileNotFoundError(
+                f"{summary_path} not found: is {folder} a train_sb3.py or fast_ppo.py output?"
+            )
         self.summary = json.loads(summary_path.read_text())
         self.preset = preset(self.summary["env"])
+        if self.summary.get("algo") == "fast_ppo":
+            self._load_fast_ppo(folder)
+            return
         # Imported only now: torch and stable-baselines3 take seconds to load.
         from stable_baselines3 import PPO, SAC
 
@@ -54,6 +62,28 @@ class SavedRun:
         with open(folder / "vecnormalize.pkl", "rb") as f:
             self.norm = pickle.load(f)
         self.norm.training = False
+
+    def _load_fast_ppo(self, folder: Path) -> None:
+        """fast_ppo.py's policy.pt: the actor-critic's weights and the observation mean and
+        variance; the policy acts with the mean of its Gaussian, clipped to [-1, 1]."""
+        import torch
+        from fast_ppo import ActorCritic, RunningNorm
+
+        saved = torch.load(folder / "policy.pt", weights_only=False)
+        state = saved["model"]
+        obs_size, act_size = state["mu.0.weight"].shape[1], state["log_std"].shape[0]
+        self.model = ActorCritic(obs_size, act_size, self.summary["config"]["hidden"])
+        self.model.load_state_dict(state)
+        self.model.eval()
+        self.norm = RunningNorm(obs_size)
+        self.norm.mean, self.norm.var = saved["obs_mean"], saved["obs_var"]
+
+        def act(obs: np.ndarray) -> np.ndarray:
+            with torch.no_grad():
+                mean = self.model.mu(torch.as_tensor(self.norm(obs[None, :]))).numpy()
+            return np.clip(mean[0], -1.0, 1.0)
+
+        self.act = act
 
     def act(self, obs: np.ndarray) -> np.ndarray:
         normalised = self.norm.normalize_obs(obs[None, :].astype(np.float32))
@@ -131,7 +161,9 @@ def _mean(values: list[float]) -> float | None:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("run", type=Path, nargs="?", help="train_sb3.py output folder")
+    parser.add_argument(
+        "run", type=Path, nargs="?", help="train_sb3.py or fast_ppo.py output folder"
+    )
     parser.add_argument("--episodes", type=int, default=100)
     parser.add_argument(
         "--seed-offset",

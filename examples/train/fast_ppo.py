@@ -1,4 +1,4 @@
-"""Compact PPO (torch) on a flyloop vector env: QuadHover learned in seconds, in-process.
+"""Compact PPO (torch) on a flyloop vector env: QuadHover in seconds, Lander2D in minutes.
 
 The rollouts come straight from one gymnasium VectorEnv (`gym.make_vec(...,
 vectorization_mode="vector_entry_point", backend=...)`): the native one steps all envs in one
@@ -7,15 +7,20 @@ MAVLink. No stable-baselines3 in the loop, big batches, a small MLP, one torch t
 
     .venv/bin/python examples/train/fast_ppo.py                       # QuadHover, native
     .venv/bin/python examples/train/fast_ppo.py --backend native sitl # and over the SITL
+    .venv/bin/python examples/train/fast_ppo.py --env lander          # Lander2D-v1, static pad
+    .venv/bin/python examples/train/fast_ppo.py --env lander_moving   # moving pad
 
 Writes, per backend, `OUT/BACKEND/`: `progress.csv` (per update: env steps, wall seconds,
-training episodes' success rate and mean return), `policy.pt` and `summary.json` (with the
+training episodes' success rate, mean return and length), `policy.pt` and `summary.json` (with the
 held-out evaluation: the deterministic policy on `--eval-episodes` episodes seeded from
 1,000,000, which training never uses), and `OUT/learning_curve.png` (success rate against env
 steps and wall seconds, one line per backend; `--curve PATH` draws it there too).
-Success is the hover preset's (training_envs.py): the episode reaches its time limit within
-0.5 m of the target. The vector envs autoreset NEXT_STEP: the step after an episode ends
-returns the next episode's first observation and is left out of the loss.
+Success is the preset's (training_envs.py): on hover the episode reaches its time limit
+within 0.5 m of the target, on the landers it landed (info['landed']: a safe landing). The
+env-specific settings (PPO's hyperparameters, env steps, evaluation episodes) are one entry
+of TASKS each. The vector envs autoreset NEXT_STEP: the step after an episode ends returns
+the next episode's first observation and is left out of the loss. evaluate.py loads a saved
+run folder (policy.pt with summary.json) as it loads a stable-baselines3 one.
 """
 
 from __future__ import annotations
@@ -25,7 +30,7 @@ import csv
 import json
 import sys
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import flyloop  # noqa: F401  (registers the envs)
@@ -47,12 +52,83 @@ class Config:
     minibatches: int = 4
     epochs: int = 8
     learning_rate: float = 1e-3
+    # The learning rate falls linearly from learning_rate to learning_rate * lr_end over
+    # the run (1.0: constant).
+    lr_end: float = 1.0
     gamma: float = 0.99
     gae_lambda: float = 0.95
     clip: float = 0.2
     value_coef: float = 0.5
     max_grad_norm: float = 0.5
     hidden: int = 64
+    # The learner sees reward * reward_scale (the reported returns are the env's own).
+    reward_scale: float = 1.0
+    init_log_std: float = -0.5
+
+
+@dataclass(frozen=True)
+class Task:
+    """One env's settings: the training_envs.py preset, PPO's configuration, the default
+    env steps and held-out evaluation episodes."""
+
+    preset: str
+    config: Config
+    timesteps: int
+    eval_episodes: int
+    title: str  # of the learning curve
+    # Training curriculum: (fraction of the updates from which it applies, env arguments that
+    # differ from the preset's). The last stage is the task itself ({}), and evaluation always
+    # is. At a stage change the envs are made anew and reset (episodes under way are dropped).
+    curriculum: tuple[tuple[float, dict], ...] = ()
+
+    def stage(self, update: int, updates: int) -> int:
+        """The curriculum stage of update `update` of `updates` (0 without a curriculum)."""
+        starts = [round(fraction * updates) for fraction, _ in self.curriculum]
+        return max((i for i, start in enumerate(starts) if start <= update), default=0)
+
+    def overrides(self, stage: int) -> dict:
+        return dict(self.curriculum[stage][1]) if self.curriculum else {}
+
+
+# Lander2D: the learner sees rewards / 100 (the landing's +100 as 1); gamma 0.998 (a
+# horizon of ~500 steps, the length of a landing: at 0.99 the +100 was too far off and PPO
+# settled for hovering above the pad until the time limit); 32 minibatches of 512, 10 epochs.
+LANDER = Config(
+    num_envs=128,
+    rollout_steps=128,  # 16,384 transitions per update
+    minibatches=32,
+    epochs=10,
+    learning_rate=3e-4,
+    gamma=0.998,
+    reward_scale=0.01,
+    init_log_std=0.0,
+)
+
+TASKS: dict[str, Task] = {
+    "hover": Task(
+        "hover", Config(), timesteps=300_000, eval_episodes=100, title="PPO on QuadHover-v0"
+    ),
+    "lander": Task(
+        "lander",
+        LANDER,
+        timesteps=1_500_000,
+        eval_episodes=200,
+        title="PPO on Lander2D-v1, static pad",
+    ),
+    # The moving pad, with the pad slower at first (at 0.5 m/s a drone that does not follow
+    # it still touches down slower than the 1.5 m/s limit), then 1.0 m/s, then the task's
+    # 1.5 m/s for the last 60 % of the run. NOT YET A WORKING SETTING: without the
+    # curriculum, seed 0 had not landed once after 1.6M env steps; with it, not once in
+    # its first 819k (0.5 m/s) either (both runs stopped there; see the README).
+    "lander_moving": Task(
+        "lander_moving",
+        LANDER,
+        timesteps=4_000_000,
+        eval_episodes=200,
+        title="PPO on Lander2D-v1, moving pad",
+        curriculum=((0.0, {"platform_speed": 0.5}), (0.2, {"platform_speed": 1.0}), (0.4, {})),
+    ),
+}
 
 
 class RunningNorm:
@@ -78,7 +154,7 @@ class RunningNorm:
 class ActorCritic(nn.Module):
     """Gaussian policy (state-independent log std) on [-1, 1] actions, and a value function."""
 
-    def __init__(self, obs_size: int, act_size: int, hidden: int) -> None:
+    def __init__(self, obs_size: int, act_size: int, hidden: int, log_std: float = -0.5) -> None:
         super().__init__()
 
         def mlp(out: int, gain: float) -> nn.Sequential:
@@ -92,14 +168,14 @@ class ActorCritic(nn.Module):
 
         self.mu = mlp(act_size, 0.01)
         self.value = mlp(1, 1.0)
-        self.log_std = nn.Parameter(torch.full((act_size,), -0.5))
+        self.log_std = nn.Parameter(torch.full((act_size,), log_std))
 
     def dist(self, x: torch.Tensor) -> torch.distributions.Normal:
         return torch.distributions.Normal(self.mu(x), self.log_std.exp())
 
 
-def make_envs(backend: str, num_envs: int, **overrides) -> gym.vector.VectorEnv:
-    p = preset("hover")
+def make_envs(task: str, backend: str, num_envs: int, **overrides) -> gym.vector.VectorEnv:
+    p = preset(TASKS[task].preset)
     kwargs = {**p.env_kwargs, **overrides}
     return gym.make_vec(
         p.env_id,
@@ -111,21 +187,26 @@ def make_envs(backend: str, num_envs: int, **overrides) -> gym.vector.VectorEnv:
 
 
 def to_env(action: np.ndarray, space: gym.spaces.Box) -> np.ndarray:
-    """[-1, 1] policy actions (clipped) to the env's motor commands."""
+    """[-1, 1] policy actions (clipped) to the env's motor commands (Lander2D's already are)."""
     unit = np.clip(action, -1.0, 1.0)
+    if np.all(space.low == -1.0) and np.all(space.high == 1.0):
+        return unit.astype(np.float32)
     return (space.low + (unit + 1.0) * 0.5 * (space.high - space.low)).astype(np.float32)
 
 
 def successes(terminated, truncated, infos) -> np.ndarray:
-    """The hover preset's success per sub-env, for the sub-envs whose episode ended now."""
+    """The preset's success per sub-env (meaningful for the sub-envs whose episode ended
+    now): landed on Lander2D, the hover preset's success otherwise."""
+    if "landed" in infos:
+        return np.asarray(infos["landed"], bool)
     distance = np.asarray(infos["distance_to_target"], np.float64)
     return truncated & ~terminated & (distance < HOVER_SUCCESS_DISTANCE_M)
 
 
-def evaluate(model, norm, backend: str, episodes: int, seed: int = EVAL_SEED) -> dict:
+def evaluate(model, norm, task: str, backend: str, episodes: int, seed: int = EVAL_SEED) -> dict:
     """The deterministic policy on `episodes` episodes seeded seed, seed + 1, ... (one
     sub-env each, first episode only)."""
-    envs = make_envs(backend, episodes)
+    envs = make_envs(task, backend, episodes)
     try:
         obs, _ = envs.reset(seed=seed)
         done = np.zeros(episodes, bool)
@@ -156,11 +237,12 @@ def evaluate(model, norm, backend: str, episodes: int, seed: int = EVAL_SEED) ->
 def train(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
     torch.manual_seed(args.seed)
     torch.set_num_threads(1)
-    envs = make_envs(backend, cfg.num_envs)
+    task = TASKS[args.env]
+    envs = make_envs(args.env, backend, cfg.num_envs, **task.overrides(0))
     space = envs.single_action_space
     n, t_len = cfg.num_envs, cfg.rollout_steps
     obs_size, act_size = envs.single_observation_space.shape[0], space.shape[0]
-    model = ActorCritic(obs_size, act_size, cfg.hidden)
+    model = ActorCritic(obs_size, act_size, cfg.hidden, cfg.init_log_std)
     optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate, eps=1e-5)
     norm = RunningNorm(obs_size)
     rng = np.random.default_rng(args.seed)
@@ -177,6 +259,7 @@ def train(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
     norm.update(obs)
     resetting = np.zeros(n, bool)  # the previous step ended: this step resets (NEXT_STEP)
     episode_return = np.zeros(n)
+    episode_length = np.zeros(n, np.int64)
     rows: list[dict] = []
     steps, start = 0, time.perf_counter()
     updates = -(-args.timesteps // (n * t_len))
@@ -186,8 +269,21 @@ def train(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
 
         bar = tqdm(total=updates * n * t_len, unit="step", unit_scale=True)
     try:
-        for _ in range(updates):
-            ended_success, ended_return = [], []
+        for k in range(updates):
+            stage = task.stage(k, updates)
+            if k > 0 and stage != task.stage(k - 1, updates):
+                # The next stage's envs, seeded after the previous stages' sub-env seeds.
+                envs.close()
+                envs = make_envs(args.env, backend, n, **task.overrides(stage))
+                obs, _ = envs.reset(seed=args.seed + stage * n)
+                resetting[:] = False
+                episode_return[:] = 0.0
+                episode_length[:] = 0
+            if cfg.lr_end != 1.0:
+                fraction = k / max(updates - 1, 1)
+                for group in optimiser.param_groups:
+                    group["lr"] = cfg.learning_rate * (1.0 + (cfg.lr_end - 1.0) * fraction)
+            ended_success, ended_return, ended_length = [], [], []
             raw = []
             for t in range(t_len):
                 # Normalised with the statistics of earlier rollouts: the same inputs that
@@ -204,10 +300,15 @@ def train(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
                 done = valid & (terminated | truncated)
                 rew_buf[t], term_buf[t], done_buf[t], valid_buf[t] = reward, terminated, done, valid
                 episode_return += np.where(valid, rew_buf[t], 0.0)
+                episode_length += valid
+                if cfg.reward_scale != 1.0:
+                    rew_buf[t] *= cfg.reward_scale
                 if done.any():
                     ended_success.extend(successes(terminated, truncated, infos)[done])
                     ended_return.extend(episode_return[done])
+                    ended_length.extend(episode_length[done])
                     episode_return[done] = 0.0
+                    episode_length[done] = 0
                 resetting = done
             obs_buf[t_len] = norm(obs)
             steps += n * t_len
@@ -231,12 +332,15 @@ def train(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
                 episodes=len(ended_success),
                 success_rate=float(np.mean(ended_success)) if ended_success else float("nan"),
                 mean_return=float(np.mean(ended_return)) if ended_return else float("nan"),
+                mean_length=float(np.mean(ended_length)) if ended_length else float("nan"),
             )
             rows.append(row)
             if bar is not None:
                 bar.update(n * t_len)
                 bar.set_postfix(
-                    success=f"{row['success_rate']:.2f}", ret=f"{row['mean_return']:.0f}"
+                    success=f"{row['success_rate']:.2f}",
+                    ret=f"{row['mean_return']:.0f}",
+                    len=f"{row['mean_length']:.0f}",
                 )
     finally:
         if bar is not None:
@@ -324,8 +428,10 @@ def plot(runs: dict[str, list[dict]], path: Path, title: str) -> None:
 
 def run_one(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
     """Trains and evaluates on one backend; writes its folder; returns its summary."""
+    cpu_start = time.process_time()
     run = train(args, backend, cfg)
-    result = evaluate(run["model"], run["norm"], backend, args.eval_episodes)
+    cpu = time.process_time() - cpu_start
+    result = evaluate(run["model"], run["norm"], args.env, backend, args.eval_episodes)
     rows, wall, steps = run["rows"], run["wall_s"], run["steps"]
     first = next((r for r in rows if r["success_rate"] >= 0.9), None)
     out = args.out / backend
@@ -336,13 +442,23 @@ def run_one(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
         writer.writerows(rows)
     state = {"model": run["model"].state_dict(), "obs_mean": run["norm"].mean}
     torch.save({**state, "obs_var": run["norm"].var}, out / "policy.pt")
+    p = preset(TASKS[args.env].preset)
     summary = dict(
-        env_id=preset("hover").env_id,
+        env=p.name,
+        env_id=p.env_id,
+        env_kwargs=dict(p.env_kwargs),
+        algo="fast_ppo",
+        # The policy's [-1, 1] outputs: the hover preset's rescaled motor commands, the
+        # lander's own motor commands.
+        action=p.default_action,
         backend=backend,
         seed=args.seed,
         config=asdict(cfg),
+        curriculum=[[fraction, overrides] for fraction, overrides in TASKS[args.env].curriculum],
         env_steps=steps,
         wall_time_s=wall,
+        # This process's CPU seconds while training (learner and env threads).
+        cpu_time_s=cpu,
         env_steps_per_s=steps / wall,
         first_update_at_90_percent=first,
         last_training_success_rate=rows[-1]["success_rate"],
@@ -350,9 +466,10 @@ def run_one(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
         rows=rows,
     )
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    name = p.env_id.split("/")[-1]
     print(
-        f"PPO on QuadHover-v0 ({backend}, {cfg.num_envs} envs): {steps:,} env steps in "
-        f"{wall:.1f} s ({steps / wall:,.0f} env steps/s incl. learning)"
+        f"PPO on {name} ({args.env}, {backend}, {cfg.num_envs} envs): {steps:,} env steps in "
+        f"{wall:.1f} s, {cpu:.1f} s CPU ({steps / wall:,.0f} env steps/s incl. learning)"
     )
     if first is not None:
         print(
@@ -362,14 +479,28 @@ def run_one(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
     else:
         print("  training success never reached 90 %")
     print(
-        f"  held-out evaluation ({result['episodes']} episodes, seeds {EVAL_SEED}..): "
-        f"success {100 * result['success_rate']:.0f} %, mean return {result['mean_return']:.1f}"
+        f"  held-out evaluation ({result['episodes']} episodes, seeds {result['seed']}..): "
+        f"success {100 * result['success_rate']:.1f} %, mean return {result['mean_return']:.1f}"
     )
     return summary
 
 
+def configure(task: Task, num_envs: int | None, settings: list[str]) -> Config:
+    """The task's configuration with --num-envs and --set KEY=VALUE applied."""
+    cfg = task.config
+    fields = asdict(cfg)
+    changes = {} if num_envs is None else {"num_envs": num_envs}
+    for setting in settings:
+        key, _, value = setting.partition("=")
+        if key not in fields or not value:
+            raise ValueError(f"--set {setting!r}: expected KEY=VALUE, KEY one of {list(fields)}")
+        changes[key] = type(fields[key])(value)
+    return replace(cfg, **changes)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--env", default="hover", choices=sorted(TASKS), help="the task")
     parser.add_argument(
         "--backend",
         nargs="+",
@@ -377,19 +508,36 @@ def main(argv: list[str] | None = None) -> int:
         choices=("native", "sitl"),
         help="one or both (trained one after the other with the same seed, side by side)",
     )
-    parser.add_argument("--timesteps", type=int, default=300_000, help="env steps to train for")
-    parser.add_argument("--num-envs", type=int, default=Config.num_envs)
+    parser.add_argument(
+        "--timesteps", type=int, help="env steps to train for (default: the task's)"
+    )
+    parser.add_argument("--num-envs", type=int, help="default: the task's")
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override one of the task's PPO settings (Config), e.g. --set epochs=4",
+    )
     parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--eval-episodes", type=int, default=100)
+    parser.add_argument("--eval-episodes", type=int, help="default: the task's")
     parser.add_argument("--out", type=Path, default=Path("runs/fast_ppo"))
     parser.add_argument("--curve", type=Path, help="also draw the learning curve to this file")
     parser.add_argument("--no-progress-bar", action="store_true")
     args = parser.parse_args(argv)
-    if args.timesteps <= 0 or args.num_envs < 1 or args.eval_episodes < 1:
+    task = TASKS[args.env]
+    if args.timesteps is None:
+        args.timesteps = task.timesteps
+    if args.eval_episodes is None:
+        args.eval_episodes = task.eval_episodes
+    if args.timesteps <= 0 or args.eval_episodes < 1 or (args.num_envs or 1) < 1:
         parser.error("--timesteps, --num-envs and --eval-episodes must be positive")
-    cfg = Config(num_envs=args.num_envs)
+    try:
+        cfg = configure(task, args.num_envs, args.set)
+    except ValueError as exc:
+        parser.error(str(exc))
     runs = {backend: run_one(args, backend, cfg) for backend in dict.fromkeys(args.backend)}
-    title = f"PPO on QuadHover-v0, {cfg.num_envs} envs, seed {args.seed}"
+    title = f"{task.title}, {cfg.num_envs} envs, seed {args.seed}"
     for path in (args.out / "learning_curve.png", args.curve):
         if path is not None:
             path.parent.mkdir(parents=True, exist_ok=True)

@@ -1,9 +1,10 @@
 """The trained policies shipped under policies/ load with evaluate.py and do what their
 summary says, on seeded episodes that training never saw (training used seeds from 0; these
-start at 2,000,000). No training here: 20 episodes of a saved policy, seconds."""
+start at 2,000,000). No training here: 50 episodes of a saved policy, seconds."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -13,19 +14,26 @@ POLICIES = REPO / "policies"
 HELD_BACK_SEEDS = 2_000_000
 
 
-# (policy, held-back episodes, landing rate required). Measured when shipped — lander_static:
-# 92 % on seeds 1,000,000.. (100 episodes), 18/20 here; lander_moving: 97 % on seeds
-# 1,000,000.., 88 % on 2,000,000.. and 83 % on 3,000,000.. (100 each), 42/50 here. 20 episodes
-# cannot tell an 89 % policy from a 75 % one (the moving policy lands 15 of the first 20 of
-# these seeds), so the moving policy is checked on 50.
-SHIPPED = [("lander_static", 20, 0.85), ("lander_moving", 50, 0.75)]
+# (policy, held-back episodes, landing rate required, held-out target). lander_static is a
+# fast_ppo.py run (policy.pt; its summary.json holds the held-out evaluation on seeds
+# 1,000,000..1,000,199: 200/200), measured 50/50 here; a policy meeting the 95 % target lands
+# >= 44 of 50 with probability 0.96. lander_moving is still the stable-baselines3 run (no
+# fast run met its target yet): 97 % on seeds 1,000,000.., 88 % on 2,000,000.. and 83 % on
+# 3,000,000.. (100 each), 42/50 here.
+SHIPPED = [("lander_static", 50, 0.88, 0.95), ("lander_moving", 50, 0.75, None)]
 
 
-@pytest.mark.parametrize(("name", "episodes", "required"), SHIPPED)
-def test_a_shipped_lander_policy_lands_on_held_back_seeds(name, episodes, required):
+@pytest.mark.parametrize(("name", "episodes", "required", "target"), SHIPPED)
+def test_a_shipped_lander_policy_lands_on_held_back_seeds(name, episodes, required, target):
     import evaluate
 
     folder: Path = POLICIES / name
+    summary = json.loads((folder / "summary.json").read_text())
+    if summary.get("algo") == "fast_ppo":
+        # What it was shipped for: the held-out evaluation of its training run.
+        held_out = summary["evaluation"]
+        assert held_out["episodes"] == 200 and held_out["seed"] == 1_000_000
+        assert held_out["success_rate"] >= target, held_out
     result = evaluate.evaluate(folder, episodes, HELD_BACK_SEEDS)
     assert result["env_id"] == "flyloop/Lander2D-v1"
     print(result)

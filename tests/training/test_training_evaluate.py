@@ -135,3 +135,23 @@ def test_training_continues_from_a_saved_run_with_a_decaying_learning_rate(tmp_p
     done = run_script(TRAIN / "learning_curve.py", str(first), str(second), "--out", str(curve))
     assert done.returncode == 0, done.stderr[-3000:]
     assert f"{len(log)} episodes of 2 run(s)" in done.stdout and curve.stat().st_size > 10_000
+
+
+@pytest.mark.training
+def test_evaluate_loads_a_fast_ppo_run(tmp_path):
+    """evaluate.py loads fast_ppo.py's folder (policy.pt, summary.json): the same deterministic
+    policy on the same seeded episodes as fast_ppo.py's own held-out evaluation (a batched
+    forward pass there, one observation at a time here: floats may differ in the last bits)."""
+    done = run_script(
+        TRAIN / "fast_ppo.py",
+        *("--env", "lander", "--timesteps", "16384", "--num-envs", "16"),
+        *("--eval-episodes", "4", "--out", str(tmp_path), "--no-progress-bar"),
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    run = tmp_path / "native"
+    own = json.loads((run / "summary.json").read_text())["evaluation"]
+    stdout, result = evaluate_cli(run, tmp_path, episodes=4)
+    assert "success rate" in stdout
+    assert result["env_id"] == "flyloop/Lander2D-v1" and result["first_seed"] == own["seed"]
+    assert result["success_rate"] == own["success_rate"]
+    assert result["mean_return"] == pytest.approx(own["mean_return"], abs=1.0)
