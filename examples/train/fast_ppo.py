@@ -105,6 +105,15 @@ LANDER = Config(
 )
 
 TASKS: dict[str, Task] = {
+    # The rates interface (train_offboard.py adds its held-out checks and the export for
+    # examples/px4_offboard.py): more envs per update, shorter rollouts, a slower step.
+    "offboard": Task(
+        "offboard",
+        Config(num_envs=128, rollout_steps=64, learning_rate=5e-4),
+        timesteps=4_000_000,
+        eval_episodes=200,
+        title="PPO, thrust + body rates through PX4's rate loop, Iris randomised",
+    ),
     "hover": Task(
         "hover", Config(), timesteps=300_000, eval_episodes=100, title="PPO on QuadHover-v0"
     ),

@@ -18,11 +18,13 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import flyloop  # noqa: F401  (registers the envs)
 import gymnasium as gym
 import numpy as np
+import tomllib
 from flyloop.wrappers import MotionPrimitiveActionWrapper, ThrustChangeController
 
 # A hover episode is a success when it ran to the time limit (no crash, not out of bounds)
@@ -91,6 +93,25 @@ class Preset:
         return next(iter(self.actions)) if self.actions else None
 
 
+# The Iris of flyloop-sitl --px4 (sitl/presets/px4_iris.toml; its wind is the env's use_wind).
+PRESETS_DIR = Path(__file__).resolve().parents[2] / "sitl" / "presets"
+IRIS = tomllib.loads((PRESETS_DIR / "px4_iris.toml").read_text())
+IRIS.pop("wind_enabled", None)
+# Per-episode vehicles around the Iris, and PX4 in the loop's latency (train_offboard.py).
+OFFBOARD_RANDOMIZE = {
+    "mass": (1.2, 1.85),
+    "inertia_xx": (0.023, 0.035),
+    "inertia_yy": (0.023, 0.035),
+    "inertia_zz": (0.044, 0.066),
+    "thrust_coefficient": (8.5, 11.0),
+    "yaw_torque_coefficient": (0.04, 0.08),
+    "motor_time_constant": (0.015, 0.035),
+    "drag_area": (0.02, 0.1),
+    "roll_rate_p": (0.12, 0.18),
+    "pitch_rate_p": (0.12, 0.18),
+    "action_latency": (0.0, 0.04),
+}
+
 PRESETS: dict[str, Preset] = {
     "hover": Preset(
         name="hover",
@@ -98,6 +119,35 @@ PRESETS: dict[str, Preset] = {
         # 5 s episodes (250 steps of 20 ms), the default wind (mean 0–5 m/s + turbulence).
         env_kwargs={"max_steps": 250, "dt": 0.02},
         actions=QUAD_ACTIONS,
+        success=hover_success,
+        success_text=(
+            f"reached the time limit (no crash, not out of bounds) within "
+            f"{HOVER_SUCCESS_DISTANCE_M} m of the target"
+        ),
+    ),
+    # A policy for PX4's offboard mode: thrust + body rates through the core's model of PX4's
+    # rate loop at 50 Hz, PX4-like estimator noise, 10 s episodes with a new target after 5 s,
+    # on the Iris with per-episode randomisation (train_offboard.py, examples/px4_offboard.py).
+    "offboard": Preset(
+        name="offboard",
+        env_id="flyloop/QuadHover-v0",
+        env_kwargs={
+            "action_interface": "rates",
+            "dt": 0.02,
+            "max_steps": 500,
+            "target_change_interval": 250,
+            "use_wind": False,
+            "start_attitude_range": 0.2,
+            "observation_noise": {
+                "position": 0.02,
+                "velocity": 0.05,
+                "attitude": 0.01,
+                "rates": 0.02,
+            },
+            "model_params": IRIS,
+            "randomize": OFFBOARD_RANDOMIZE,
+        },
+        actions=None,
         success=hover_success,
         success_text=(
             f"reached the time limit (no crash, not out of bounds) within "
