@@ -393,7 +393,12 @@ def fly(link: Px4Link, policy: Policy | None, args: argparse.Namespace) -> list[
             elif in_offboard:
                 raise FlightError(f"PX4 left OFFBOARD (custom mode {s.custom_mode:#x})", 3)
             elif s.time_ms - switched_ms > 3000:
-                raise FlightError("PX4 accepted OFFBOARD but did not enter it in 3 s", 3)
+                said = "; ".join(s.texts[-3:]) or "nothing"
+                raise FlightError(
+                    f"PX4 refused OFFBOARD: it acknowledged the switch but stayed in custom "
+                    f"mode {s.custom_mode:#x} for 3 s (PX4 said: {said})",
+                    3,
+                )
             if s.time_ms < next_ms:
                 continue
             next_ms += dt_ms

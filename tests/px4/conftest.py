@@ -36,8 +36,8 @@ def pair(px4_dir, sitl_binary):
             started.append(f)
             return f
 
-        def px4(self) -> Px4:
-            p = Px4(px4_dir, instance, fresh_dir("px4-work-"))
+        def px4(self, **params: float) -> Px4:
+            p = Px4(px4_dir, instance, fresh_dir("px4-work-"), **params)
             started.append(p)
             return p
 

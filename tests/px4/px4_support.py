@@ -188,7 +188,8 @@ class LocalFrame:
 class Px4:
     """A PX4 SITL instance in its own working directory, and a pymavlink link to it."""
 
-    def __init__(self, root: Path, instance: int, workdir: Path):
+    def __init__(self, root: Path, instance: int, workdir: Path, **params: float):
+        """`params`: PX4 parameters to override at start, by name."""
         self.instance = instance
         workdir.mkdir(parents=True, exist_ok=True)
         env = dict(
@@ -199,6 +200,7 @@ class Px4:
             PX4_PARAM_COM_RC_IN_MODE="4",
             # Takeoff height relative to home: a GPS altitude sample at arming cannot offset it.
             PX4_PARAM_MIS_TAKEOFF_ALT=str(TAKEOFF_ALT),
+            **{f"PX4_PARAM_{name}": str(value) for name, value in params.items()},
         )
         self.log = open(workdir / "px4.log", "w+")
         self.proc = subprocess.Popen(

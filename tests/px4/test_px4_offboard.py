@@ -133,3 +133,29 @@ def test_telemetry_stopping_mid_flight_hands_back_to_px4(pair):
     assert proc.returncode == 4, err
     assert "telemetry stopped" in err
     assert "Traceback" not in err
+
+
+def test_offboard_refused_is_said_and_px4_keeps_control(pair):
+    """A PX4 that ignores external setpoints (MAV_FWDEXTSP=0) never sees an offboard signal
+    and refuses the switch: the script says so, exits 3 and hands back."""
+    pair.flyloop()
+    px4 = pair.px4(MAV_FWDEXTSP=0)
+    result = subprocess.run(
+        [
+            sys.executable,
+            str(SCRIPT),
+            str(POLICY),
+            "--connect",
+            f"udpout:127.0.0.1:{14580 + px4.instance}",
+            "--timeout",
+            "90",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=240,
+    )
+    assert result.returncode == 3, result.stdout + result.stderr
+    # PX4 acknowledges the mode command and then stays where it is.
+    assert "refused OFFBOARD" in result.stderr or "did not accept the switch" in result.stderr
+    assert "PX4 holds position" in result.stderr
+    assert "Traceback" not in result.stderr

@@ -23,9 +23,9 @@ def test_the_list_serves_every_model_and_task_parameter_with_unique_short_ids(
     client = client_for(start_sitl("--task", "waypoints"))
     values = param_list(client)
     ids = [v.param_id for v in values]
-    # 30 quadrotor parameters (22 + 7 of the landing gear + turbulence_dt), 12 flight,
-    # 4 waypoints.
-    assert len(values) == values[0].param_count == 30 + 12 + 4
+    # 30 quadrotor parameters (22 + 7 of the landing gear + turbulence_dt), 18 flight (12 +
+    # the rates interface's 6), 4 waypoints, 39 of PX4's rate loop.
+    assert len(values) == values[0].param_count == 30 + 18 + 4 + 39
     assert [v.param_index for v in values] == list(range(len(values)))
     assert len(set(ids)) == len(ids) and all(len(i) <= 16 for i in ids)
     by_id = {v.param_id: v for v in values}
@@ -36,6 +36,7 @@ def test_the_list_serves_every_model_and_task_parameter_with_unique_short_ids(
     assert by_id["wind_enabled"].param_type == mavlink2.MAV_PARAM_TYPE_UINT8
     assert by_id["tgt_chg_intv"].param_value == 0.0  # target_change_interval
     assert by_id["max_num_wps"].param_value == 15.0  # max_num_waypoints
+    assert abs(by_id["roll_rate_p"].param_value - 0.15) < 1e-6  # MC_ROLLRATE_P
 
 
 def test_set_and_read_round_trip_and_refusals_change_nothing(start_sitl, client_for):
