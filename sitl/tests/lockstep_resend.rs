@@ -95,7 +95,10 @@ fn a_repeated_step_gets_the_cached_reply_and_does_not_step() {
     assert_eq!(lossy.stats.repeated_steps, 100);
     assert_eq!(lossy.stats.stale_controls, 49);
     assert_eq!(lossy.vehicles[0].last.step, clean.vehicles[0].last.step);
-    assert_eq!(frame(&send(&mut lossy, &reset(&mut enc, 9))).unwrap().0, 500_000);
+    assert_eq!(
+        frame(&send(&mut lossy, &reset(&mut enc, 9))).unwrap().0,
+        500_000
+    );
 }
 
 #[test]
@@ -105,11 +108,19 @@ fn unnamed_steps_always_step_and_a_reset_forgets_the_cached_step() {
     let unnamed = controls(&mut enc, 1, 0, 0.5);
     let a = frame(&send(&mut sim, &unnamed)).unwrap();
     let b = frame(&send(&mut sim, &unnamed)).unwrap();
-    assert_eq!((a.0, b.0), (10_000, 20_000), "time_usec 0: a new step each time");
+    assert_eq!(
+        (a.0, b.0),
+        (10_000, 20_000),
+        "time_usec 0: a new step each time"
+    );
     let named = controls(&mut enc, 1, 30_000, 0.5);
     assert_eq!(frame(&send(&mut sim, &named)).unwrap().0, 30_000);
     let after_reset = frame(&send(&mut sim, &reset(&mut enc, 3))).unwrap();
-    assert_eq!((after_reset.0, after_reset.1[3]), (30_000, 0.0), "reset: step 0");
+    assert_eq!(
+        (after_reset.0, after_reset.1[3]),
+        (30_000, 0.0),
+        "reset: step 0"
+    );
     // The step before the reset, repeated after it: stale, not a step of the new episode.
     assert!(send(&mut sim, &named).is_empty());
     assert_eq!(sim.vehicles[0].last.step, 0);

@@ -388,7 +388,11 @@ impl Sim {
         if v.last_step == Some(step) {
             self.stats.repeated_steps += 1;
             out.extend_from_slice(&v.last_reply);
-            tracing::debug!(system_id = v.system_id, step, "repeated step: cached reply sent again");
+            tracing::debug!(
+                system_id = v.system_id,
+                step,
+                "repeated step: cached reply sent again"
+            );
         } else if step > v.clock_us {
             return false;
         } else {
