@@ -57,16 +57,23 @@ fn a_windy_drop_gives_the_same_bits_at_every_shared_time_for_h_on_the_grid() {
         (80..120).contains(&landed),
         "reached the ground at sample {landed}"
     );
-    assert!(z[landed..].iter().all(|&z| z < 0.5 && z > 0.0), "{z:?}");
-    let bounced = z[landed..].windows(2).any(|w| w[1] > w[0] + 1e-3);
-    assert!(bounced, "it bounced");
+    // The gear springs it back up (a 20 m/s impact), lower than it fell, twice.
+    let after = &z[landed..];
+    let top = after.iter().copied().fold(f64::MIN, f64::max);
+    let bottom = after.iter().copied().fold(f64::MAX, f64::min);
+    assert!(top > 1.0 && top < 5.0 && bottom > -0.2, "{after:?}");
+    let bounces = after
+        .windows(3)
+        .filter(|w| w[1] < w[0] && w[1] < w[2])
+        .count();
+    assert!(bounces >= 2, "{after:?}");
     let end = reference.last().unwrap();
     assert!(
-        end.position.x.hypot(end.position.y) > 0.5,
+        end.position.x.hypot(end.position.y) > 0.1,
         "{:?}",
         end.position
     );
-    assert!(end.velocity.norm() < 2.0, "{:?}", end.velocity);
+    assert!(end.velocity.norm() < 10.0, "{:?}", end.velocity);
 }
 
 #[test]
