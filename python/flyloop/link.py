@@ -36,6 +36,14 @@ def _spin_seconds(default_us: float = 100.0) -> float:
 SPIN_SECONDS = _spin_seconds()
 PROCESS_CHECK_SECONDS = 0.05
 
+# Loss recovery (docs/protocol.md section 3): a request without a complete reply after
+# RESEND_AFTER seconds is sent again, then after twice that, and so on, at most MAX_RESENDS
+# times, all within the link's timeout. Every request an env sends is safe to repeat: steps
+# are named by their time_usec (the SITL re-sends its cached reply for a step it has done),
+# resets carry an explicit seed, parameter sets and requests are idempotent.
+RESEND_AFTER = 0.02
+MAX_RESENDS = 8
+
 
 class SitlLink:
     """A controller link to the SITL at `address` (our own `process`, or None if attached)."""
@@ -47,11 +55,24 @@ class SitlLink:
         timeout: float = 5.0,
         process: SitlProcess | None = None,
         spin: float = SPIN_SECONDS,
+        resend_after: float = RESEND_AFTER,
+        max_resends: int = MAX_RESENDS,
     ) -> None:
         if not timeout > 0:
             raise ValueError(f"timeout must be > 0 seconds, got {timeout!r}")
+        if not resend_after > 0 or max_resends < 0:
+            raise ValueError(
+                f"resend_after must be > 0 s and max_resends >= 0, got {resend_after!r}, "
+                f"{max_resends!r}"
+            )
         self.address = address
         self.timeout = float(timeout)
+        self.resend_after = float(resend_after)
+        self.max_resends = int(max_resends)
+        # Requests sent again for want of a reply, and datagrams from the SITL dropped as
+        # late duplicates, since the link was made.
+        self.resends = 0
+        self.stale = 0
         self.process = process
         self.broken: str | None = None
         self.decoder = Decoder()
@@ -124,10 +145,46 @@ class SitlLink:
         """Sends `data` and collects replies until `done(collected)` holds, within the
         timeout; raises SitlError if the SITL dies or stays silent. Task frames go to
         `sink` (cleared first) when one is given."""
+        self.check()
         if sink is not None:
             sink.clear()
-        self.send(data)
-        return self.collect(done, what, sink)
+        self._drain(what)
+        out = Datagram()
+        deadline = time.monotonic() + self.timeout
+        wait = self.resend_after
+        for attempt in range(self.max_resends + 1):
+            if attempt:
+                self.resends += 1
+            self.send(data)
+            until = deadline
+            if attempt < self.max_resends:
+                until = min(deadline, time.monotonic() + wait)
+            if self._collect(out, done, what, sink, until):
+                if sink is not None:
+                    sink.commit()
+                return out
+            if time.monotonic() >= deadline:
+                break
+            wait *= 2
+        resent = f" (sent {attempt + 1} times)" if attempt else ""
+        raise self._fail(f"sent no {what} within {self.timeout:g} s{resent}")
+
+    def _drain(self, what: str) -> None:
+        """Drops datagrams that arrived since the last exchange was complete: late
+        duplicates of replies already taken (a re-sent request whose first reply came after
+        all). Cheap: one non-blocking read when, as usual, there is none."""
+        while True:
+            try:
+                self.sock.recv(RECEIVE_BUFFER)
+            except BlockingIOError:
+                return
+            except ConnectionRefusedError as exc:
+                raise self._fail(
+                    f"refused the datagram (nothing listens) while waiting for {what}", exc
+                ) from exc
+            except OSError as exc:
+                raise self._fail(f"could not be read from ({exc})", exc) from exc
+            self.stale += 1
 
     def _receive(self, deadline: float) -> bytes | None:
         """The next datagram, or None at the deadline: a short busy poll, then poll(2)."""
@@ -159,15 +216,15 @@ class SitlLink:
             elif self.process is not None and self.process.poll() is not None:
                 return None
 
-    def collect(
+    def _collect(
         self,
+        out: Datagram,
         done: Callable[[Datagram], bool],
-        what: str = "a reply",
-        sink: FrameSink | None = None,
-    ) -> Datagram:
-        """Replies until `done(collected)` holds, all of them within the timeout."""
-        out = Datagram()
-        deadline = time.monotonic() + self.timeout
+        what: str,
+        sink: FrameSink | None,
+        deadline: float,
+    ) -> bool:
+        """Replies into `out` until `done(out)` holds (True) or the deadline (False)."""
         while True:
             try:
                 reply = self._receive(deadline)
@@ -180,10 +237,10 @@ class SitlLink:
             if reply is None:
                 if self.process is not None and self.process.poll() is not None:
                     raise self._fail(f"while this env waited for {what}")
-                raise self._fail(f"sent no {what} within {self.timeout:g} s")
+                return False
             try:
                 self.decoder.decode(reply, out, sink)
             except ProtocolError as exc:
                 raise self._fail(f"sent a datagram this client cannot read: {exc}", exc) from exc
             if done(out):
-                return out
+                return True

@@ -84,24 +84,30 @@ class Encoder:
             None, srcSystem=CLIENT_SYSTEM_ID, srcComponent=CLIENT_COMPONENT_ID
         )
 
-    def controls(self, system_id: int, controls) -> bytes:
+    def controls(self, system_id: int, controls, step: int = 0) -> bytes:
         """HIL_ACTUATOR_CONTROLS with the LOCKSTEP flag from vehicle `system_id` (the SITL
         steps the vehicle whose id is the frame's *sender*, as PX4 sends it). `controls`: up
-        to 16 float32 values (an array or a list of them)."""
+        to 16 float32 values (an array or a list of them); `step`: its time_usec (see
+        `controls_batch`)."""
         if isinstance(controls, np.ndarray):
             controls = controls.tolist()
-        return self.controls_batch((system_id,), (controls,))
+        return self.controls_batch((system_id,), (controls,), (step,))
 
-    def controls_batch(self, system_ids, rows) -> bytes:
+    def controls_batch(self, system_ids, rows, steps=None) -> bytes:
         """One HIL_ACTUATOR_CONTROLS frame per (system id, controls row), back to back.
+        `steps`: each command's time_usec, the step it names (docs/protocol.md section 3:
+        the simulation time the step ends at, so a re-sent command is recognised and not
+        stepped twice); None sends 0 (unnamed steps, no loss recovery).
         The hot path of every step, hence the local names."""
         pack, zeros, flag = _CONTROLS.pack, _ZEROS, LOCKSTEP_FLAG
         head = (CLIENT_COMPONENT_ID, CONTROLS_ID & 0xFF, CONTROLS_ID >> 8 & 0xFF, CONTROLS_ID >> 16)
         extra = bytes((CONTROLS_CRC_EXTRA,))
         seq = self.sequence
         out = []
-        for system_id, row in zip(system_ids, rows, strict=True):
-            payload = pack(0, flag, *row, *zeros[len(row) :], 0)
+        if steps is None:
+            steps = (0,) * len(system_ids)
+        for system_id, row, step in zip(system_ids, rows, steps, strict=True):
+            payload = pack(step, flag, *row, *zeros[len(row) :], 0)
             # MAVLink 2 drops trailing zero bytes of the payload (at least one byte stays).
             payload = payload.rstrip(b"\x00") or b"\x00"
             body = bytes((len(payload), 0, 0, seq, system_id, *head)) + payload
@@ -180,10 +186,41 @@ class FrameSink:
         self._no_slots = bytes(len(self.have))
         floats = np.frombuffer(self.raw, "<f4").reshape(self.n_rows, n_arrays, _FLOATS_PER_PAYLOAD)
         self._data = floats[:, :, _HEADER_FLOATS:]
+        # Which frames belong to the exchange under way (a late duplicate of an earlier
+        # reply must not be taken for it): per row, the simulation time (µs) of the last
+        # frame taken, -1 before the first; a step's frame is later than that, a reset's
+        # frame is at that time or later and has episode step 0. See `expect`.
+        self.last_time = [-1] * self.n_rows
+        self.resetting = bytearray(self.n_rows)
+        self.stale = 0
+        # time_usec of each row's first array (payload bytes 0-7), read in place.
+        self._times = np.ndarray((self.n_rows,), "<u8", self.raw, 0, (n_arrays * _FRAME_PAYLOAD,))
 
     def clear(self) -> None:
         self.have[:] = self._no_slots
         self.count = 0
+
+    def expect(self, resetting=None) -> None:
+        """Before an exchange: rows in `resetting` (a bool per row, or None for none)
+        expect a reset's frame, the others a step's."""
+        if resetting is None:
+            self.resetting[:] = bytes(self.n_rows)
+        else:
+            self.resetting[:] = bytes(bool(r) for r in resetting)
+
+    def accepts(self, row: int, time_usec: int, first_array: bool, step_zero: bool) -> bool:
+        last = self.last_time[row]
+        if self.resetting[row]:
+            return time_usec >= last and (step_zero or not first_array)
+        return time_usec > last
+
+    def commit(self) -> None:
+        """After a complete exchange: the frames' times become the rows' last times."""
+        self.last_time = self._times.tolist()
+
+    def step_ids(self, dt_us: int) -> list[int]:
+        """The time_usec that names each row's next step: its last frame's time + dt_us."""
+        return [max(t, 0) + dt_us for t in self.last_time]
 
     @property
     def complete(self) -> bool:
@@ -226,7 +263,16 @@ class Decoder:
                 row = sink.rows.get(data[at + 5])
                 # array_id (payload bytes 8-9) is never 0, so MAVLink 2 never truncates it.
                 k = (data[at + 18] | (data[at + 19] << 8)) - 1 if plen >= 10 else -1
-                if row is not None and 0 <= k < sink.n_arrays:
+                if not 0 <= k < sink.n_arrays:
+                    row = None
+                if row is not None:
+                    t = int.from_bytes(data[at + HEADER_LEN : at + HEADER_LEN + 8], "little")
+                    # The episode step, value 3 (payload bytes 32-35; absent when truncated).
+                    zero = plen < 36 or not any(data[at + HEADER_LEN + 32 : at + HEADER_LEN + 36])
+                    if not sink.accepts(row, t, k == 0, zero):
+                        sink.stale += 1
+                        row = None
+                if row is not None:
                     slot = row * sink.n_arrays + k
                     off = slot * _FRAME_PAYLOAD
                     sink.raw[off : off + plen] = view[at + HEADER_LEN : stop]

@@ -114,6 +114,7 @@ class FlyloopVectorEnv(VectorEnv):
         self._values = np.zeros((self.num_envs, self._n_values), np.float32)
         self._ids = list(range(1, self.num_envs + 1))
         self._sink = FrameSink(self._ids, self._n_arrays)
+        self._dt_us = max(1, round(self.dt * 1e6))  # names each step (see FlyloopEnv)
 
         self._process = start_sitl(
             spec, self.config, sitl_path=sitl_path, vehicles=self.num_envs, timeout=timeout
@@ -183,6 +184,7 @@ class FlyloopVectorEnv(VectorEnv):
         data = b""
         for i, s in enumerate(seeds):
             data += self._encoder.reset(self._episode_seed(i, s), self._ids[i])
+        self._sink.expect([True] * self.num_envs)
         d = self._exchange(data, self.num_envs, "replies to the reset commands")
         self._fill(d)
         self._autoreset[:] = False
@@ -204,17 +206,20 @@ class FlyloopVectorEnv(VectorEnv):
             raise ValueError("actions must be finite; step refused")
         resetting = self._autoreset.copy()
         enc = self._encoder
+        steps = self._sink.step_ids(self._dt_us)
         if resetting.any():
+            self._sink.expect(resetting)
             parts = []
             rows = a.tolist()
             for i, v in enumerate(self._ids):
                 if resetting[i]:
                     parts.append(enc.reset(self._episode_seed(i, None), v))
                 else:
-                    parts.append(enc.controls_batch((v,), (rows[i],)))
+                    parts.append(enc.controls_batch((v,), (rows[i],), (steps[i],)))
             data = b"".join(parts)
         else:
-            data = enc.controls_batch(self._ids, a.tolist())
+            self._sink.expect()
+            data = enc.controls_batch(self._ids, a.tolist(), steps)
         d = self._exchange(data, int(resetting.sum()), "task frames after a step")
         self._fill(d)
         values = self._values

@@ -42,6 +42,9 @@ enum StartError {
     Runtime(#[from] std::io::Error),
 }
 
+/// Bytes asked for each socket's receive and send buffer.
+const SOCKET_BUFFER: usize = 8 << 20;
+
 fn bind(link: &'static str, addr: SocketAddr) -> Result<std::net::UdpSocket, StartError> {
     let socket = std::net::UdpSocket::bind(addr).map_err(|source| StartError::Bind {
         link,
@@ -51,6 +54,18 @@ fn bind(link: &'static str, addr: SocketAddr) -> Result<std::net::UdpSocket, Sta
     socket
         .set_nonblocking(true)
         .map_err(|source| StartError::Bind { link, addr, source })?;
+    // Room for bursts (a flood beside a lockstep client, a vector env's large replies): the
+    // kernel's default (~208 KiB) overflows in a few thousand datagrams. The kernel caps the
+    // request at net.core.rmem_max / wmem_max; a smaller buffer is not an error.
+    let sock = socket2::SockRef::from(&socket);
+    for (what, r) in [
+        ("receive", sock.set_recv_buffer_size(SOCKET_BUFFER)),
+        ("send", sock.set_send_buffer_size(SOCKET_BUFFER)),
+    ] {
+        if let Err(e) = r {
+            tracing::warn!(link, error = %e, "cannot size the {what} buffer");
+        }
+    }
     Ok(socket)
 }
 

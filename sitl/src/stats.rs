@@ -33,6 +33,12 @@ pub struct Stats {
     pub refused_requests: u64,
     /// Socket errors on receive or send (logged, never fatal).
     pub io_errors: u64,
+    /// Lockstep commands that repeated the vehicle's last step (its time_usec): the cached
+    /// reply was sent again, nothing stepped.
+    pub repeated_steps: u64,
+    /// Lockstep commands for a step the vehicle is already past (a late duplicate, or a
+    /// step before its last reset): skipped, no reply.
+    pub stale_controls: u64,
     /// Wall time from a datagram's arrival to its reply being sent (controller link).
     pub busy: Duration,
     /// Of which in the handler (decoding, physics, encoding; no socket calls).
@@ -81,6 +87,7 @@ impl fmt::Display for Stats {
             "datagrams={} gcs_datagrams={} frames={} steps={} resets={} truncated={} bad_crc={} mavlink1={} \
              unknown_message={} malformed={} garbage={} refused_controls={} clamped_controls={} \
              unknown_vehicle={} ignored_messages={} refused_requests={} io_errors={} \
+             repeated_steps={} stale_controls={} \
              busy_us_per_datagram={:.2} handling_us_per_datagram={:.2} physics_us_per_step={:.2}",
             self.datagrams,
             self.gcs_datagrams,
@@ -99,6 +106,8 @@ impl fmt::Display for Stats {
             self.ignored_messages,
             self.refused_requests,
             self.io_errors,
+            self.repeated_steps,
+            self.stale_controls,
             per(self.busy, self.datagrams),
             per(self.handling, self.datagrams),
             per(self.physics, self.steps),

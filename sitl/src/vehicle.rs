@@ -71,6 +71,11 @@ pub struct Vehicle {
     /// The task's action bounds (low, high), kept so a step allocates nothing for them.
     bounds: (Vec<f64>, Vec<f64>),
     pub frame_values: Vec<f32>,
+    /// The lockstep step last done by a command that named it (its `time_usec`, ≠ 0), and
+    /// the reply bytes sent for it: a repeat of that command gets them again (protocol §3).
+    /// Cleared by a reset.
+    pub last_step: Option<u64>,
+    pub last_reply: Vec<u8>,
 }
 
 /// What one step did.
@@ -103,6 +108,8 @@ impl Vehicle {
             command,
             bounds,
             frame_values: Vec::new(),
+            last_step: None,
+            last_reply: Vec::new(),
         };
         v.reset(seed)?;
         Ok(v)
@@ -119,6 +126,8 @@ impl Vehicle {
         self.seed = seed;
         self.last = FrameHeader::default();
         self.command = self.task.motors_off();
+        self.last_step = None;
+        self.last_reply.clear();
         Ok(())
     }
 

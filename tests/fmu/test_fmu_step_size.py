@@ -1,8 +1,11 @@
 """The communication step size is the master's choice and changes nothing but where outputs
-are read: the quadrotor's turbulence lives on its own grid (turbulence_dt), and the lander's
-outputs at t are its state at t, on its period grid or not."""
+are read: the quadrotor integrates on its fixed physics grid (max_substep, 5 ms) and samples
+its turbulence on its own grid (turbulence_dt), so every step size on the grid gives the same
+bits at the shared times, on the ground too; the lander's outputs at t are its state at t, on
+its period grid or not."""
 
 import numpy as np
+import pytest
 from fmpy import simulate_fmu
 from fmu_support import HOVER
 
@@ -44,11 +47,44 @@ def test_quadrotor_weather_and_path_do_not_depend_on_the_step_size(fmus):
             # The same samples, bit for bit.
             assert np.array_equal(run[name], reference[name]), (h, name)
         for name in ("x", "y", "z"):
-            gap = float(np.max(np.abs(run[name] - reference[name])))
-            assert gap < 1e-6, (h, name, gap)
+            # The same physics grid: the same bits.
+            assert np.array_equal(run[name], reference[name]), (h, name)
     # The wind changes along the run and carries the vehicle: a real test, not still air.
     assert np.ptp(reference["wind_x"]) > 0.1
     assert np.hypot(reference["x"][-1], reference["y"][-1]) > 1.0
+
+
+@pytest.mark.parametrize("fmu", ["Quadrotor", "Quadrotor-fmi3"])
+def test_a_windy_drop_to_the_ground_is_the_same_at_every_step_size_on_the_grid(fmus, fmu):
+    """Dropped from 20 m with the motors off and wind on (seed 11): through the impact and
+    the bounces, h = 0.005, 0.01 and 0.02 s give the same positions at every 0.02 s."""
+    start = {
+        "seed": 11,
+        "initial_z": 20.0,
+        "initial_motor": 0.0,
+        "wind_speed_min": 2.0,
+        "wind_speed_max": 4.0,
+    }
+    if fmu.endswith("fmi3"):
+        start["motor_command"] = [0.0] * 4
+    else:
+        start.update({f"motor_command_{i}": 0.0 for i in range(4)})
+
+    def run(h: float) -> np.ndarray:
+        result = simulate_fmu(
+            str(fmus[fmu]), stop_time=4.0, output_interval=h, start_values=start, output=NAMES
+        )
+        return at_every(result, 0.02)
+
+    reference = run(0.02)
+    assert len(reference) == 201
+    z = reference["z"]
+    assert z.min() < 0.1 and z[-1] < 3.0, "it reached the ground (and bounces on its gear)"
+    assert np.hypot(reference["x"][-1], reference["y"][-1]) > 0.1, "the wind pushed it"
+    for h in (0.005, 0.01):
+        run_h = run(h)
+        for name in ("x", "y", "z"):
+            assert np.array_equal(run_h[name], reference[name]), (h, name)
 
 
 def test_lander_outputs_between_its_control_periods_are_the_state_there(fmus):

@@ -5,7 +5,7 @@ use super::contact::foot_heights;
 use super::dynamics::{accelerations, integrate};
 use super::params::{QuadrotorInitial, QuadrotorParams};
 use super::state::{BodyState, WindState};
-use super::wind::{OuCache, apply_transition, next_segment, reset_wind};
+use super::wind::{GRID_SLACK, OuCache, apply_transition, reset_wind};
 use crate::error::{InputError, ParamError, check_finite};
 use crate::params::Parameters;
 use crate::rng::SimRng;
@@ -23,6 +23,9 @@ pub struct Quadrotor {
     pub external_wind: Vector3<f64>,
     /// Motor commands in [0, 1], held until changed.
     command: [f64; 4],
+    /// Time since the last point of the physics grid, s, in [0, max_substep): 0 after any
+    /// step that ends on the grid (see [`Quadrotor::step`]).
+    grid_phase: f64,
     rng: SimRng,
     #[serde(skip)]
     ou_cache: OuCache,
@@ -43,6 +46,7 @@ impl Quadrotor {
             wind,
             external_wind: Vector3::zeros(),
             command: [0.0; 4],
+            grid_phase: 0.0,
             rng,
             ou_cache: OuCache::default(),
         })
@@ -57,6 +61,7 @@ impl Quadrotor {
         self.command = [body.motors[0].clamp(0.0, 1.0); 4];
         self.body = body;
         self.external_wind = Vector3::zeros();
+        self.grid_phase = 0.0;
         self.rng = rng;
         self.ou_cache = OuCache::default();
     }
@@ -94,28 +99,58 @@ impl Quadrotor {
         self.command
     }
 
-    /// Advances the vehicle by `dt` seconds. The turbulence lives on its own grid of
-    /// `turbulence_dt` seconds and holds between samples: the step is cut at each sample time
-    /// it crosses, each piece integrated under the wind of its start. So the same seed gives
-    /// the same wind for any `dt` (a step of exactly `turbulence_dt` is one piece).
+    /// Advances the vehicle by `dt` seconds on a fixed physics grid.
+    ///
+    /// The physics lives on the grid k·`max_substep` from the vehicle's start (its time 0):
+    /// each grid interval is one RK4 step in the air, or `ceil(max_substep /
+    /// contact_substep)` equal RK4 substeps when a foot may touch the ground (decided at the
+    /// interval's start). The turbulence lives on its own grid of `turbulence_dt` and holds
+    /// between samples. A step is cut at every grid point and sample time it crosses and
+    /// each piece integrated under the command and wind of its start, so any step that is a
+    /// multiple of `max_substep` integrates exactly the same intervals: h = 0.005, 0.01 and
+    /// 0.02 s give the same bits at their shared times, on the ground as in the air. A step
+    /// that ends between grid points ends with a partial piece (a shorter RK4 step), and the
+    /// next step completes that grid interval first; the path then differs from a gridded
+    /// one by the integrator's error. Points within 1e-9 of an interval count as on it.
     pub fn step(&mut self, dt: f64) {
-        if !self.params.wind_enabled {
-            let wind = self.wind_velocity();
-            integrate(&self.params, &mut self.body, &self.command, &wind, dt);
-            return;
-        }
+        let p = &self.params;
+        let grid = p.max_substep;
+        let grid_slack = GRID_SLACK * grid;
+        let sample_slack = GRID_SLACK * p.turbulence_dt;
+        let wind_enabled = p.wind_enabled;
         let mut remaining = dt;
         loop {
-            let (segment, sample) = next_segment(&self.params, &self.wind, remaining);
-            let wind = self.wind_velocity();
-            integrate(&self.params, &mut self.body, &self.command, &wind, segment);
-            remaining -= segment;
-            if !sample {
-                self.wind.since_sample += segment;
-                return;
+            if grid - self.grid_phase <= grid_slack {
+                self.grid_phase = 0.0;
             }
-            self.sample_turbulence();
-            if remaining <= 0.0 {
+            let to_grid = grid - self.grid_phase;
+            let (mut piece, mut at_grid, mut at_sample) = (remaining, false, false);
+            if to_grid <= remaining + grid_slack {
+                (piece, at_grid) = (to_grid, true);
+            }
+            if wind_enabled {
+                let to_sample = self.params.turbulence_dt - self.wind.since_sample;
+                if to_sample < piece - sample_slack {
+                    (piece, at_grid, at_sample) = (to_sample, false, true);
+                } else if to_sample <= piece + sample_slack {
+                    at_sample = true;
+                }
+            }
+            let wind = self.wind_velocity();
+            integrate(&self.params, &mut self.body, &self.command, &wind, piece);
+            self.grid_phase = if at_grid {
+                0.0
+            } else {
+                self.grid_phase + piece
+            };
+            if wind_enabled {
+                self.wind.since_sample += piece;
+                if at_sample {
+                    self.sample_turbulence();
+                }
+            }
+            remaining -= piece;
+            if remaining <= grid_slack {
                 return;
             }
         }
@@ -191,10 +226,11 @@ impl Quadrotor {
             && b.attitude.norm() > 0.0
             && b.motors.iter().chain(&quad.command).all(|v| v.is_finite())
             && b.gear_stretch.iter().flatten().all(|v| v.is_finite())
-            && (0.0..quad.params.turbulence_dt).contains(&quad.wind.since_sample);
+            && (0.0..quad.params.turbulence_dt).contains(&quad.wind.since_sample)
+            && (0.0..quad.params.max_substep).contains(&quad.grid_phase);
         if !finite {
             return Err(SnapshotError::Invalid(
-                "state holds a non-finite value, a zero quaternion or a wind sample time off its grid"
+                "state holds a non-finite value, a zero quaternion, or a wind sample or physics grid time off its grid"
                     .into(),
             ));
         }
@@ -203,5 +239,5 @@ impl Quadrotor {
 }
 
 /// Format tag of a Quadrotor snapshot (name and version; 02 added the gear's bristles, 03 the
-/// time since the last turbulence sample).
-const SNAPSHOT_TAG: &[u8; 8] = b"FLYQUA03";
+/// time since the last turbulence sample, 04 the time since the last physics grid point).
+const SNAPSHOT_TAG: &[u8; 8] = b"FLYQUA04";

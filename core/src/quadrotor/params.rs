@@ -42,8 +42,10 @@ pub struct QuadrotorParams {
     /// Non-physical "pendulum" restoring torque −c·m·g·sin(roll | pitch), m. Default 0 (off);
     /// the reference DroneEnv used 0.003.
     pub pendulum_coefficient: f64,
-    /// Largest RK4 substep, s. A step of length h uses ceil(h / max_substep) equal substeps.
-    /// Default 0.01.
+    /// Physics grid step, s: the state is integrated on the absolute grid k·max_substep,
+    /// one RK4 step per interval in the air (see `Quadrotor::step`), so every step size
+    /// that is a multiple of it gives the same bits. Default 0.005 (the tasks' 0.01 s is two
+    /// intervals; PX4's 0.004 s steps are not a multiple and end in partial pieces).
     pub max_substep: f64,
     /// Whether the ground plane z = 0 holds the vehicle (on its four landing-gear feet).
     /// Default true.
@@ -101,7 +103,7 @@ impl Default for QuadrotorParams {
             angular_damping_linear: 0.02,
             angular_damping_quadratic: 0.002,
             pendulum_coefficient: 0.0,
-            max_substep: 0.01,
+            max_substep: 0.005,
             ground_enabled: true,
             gear_x: 0.07,
             gear_y: 0.07,
@@ -136,7 +138,7 @@ static QUADROTOR_SPECS: [ParamSpec<QuadrotorParams>; 30] = [
     param!(real angular_damping_linear, "N.m.s/rad", 0.0, 1e3, "Linear angular damping"),
     param!(real angular_damping_quadratic, "N.m.s2/rad2", 0.0, 1e3, "Quadratic angular damping"),
     param!(real pendulum_coefficient, "m", 0.0, 10.0, "Non-physical restoring torque -c m g sin(roll|pitch); 0 = off"),
-    param!(real max_substep, "s", 1e-6, 1.0, "Largest RK4 substep"),
+    param!(real max_substep, "s", 1e-6, 1.0, "Physics grid step: RK4 on the absolute grid k*max_substep, so any multiple of it as step size gives the same bits"),
     param!(boolean ground_enabled, "Ground plane z = 0 holds the vehicle on its four feet"),
     param!(boolean wind_enabled, "Wind (mean + turbulence) blows"),
     param!(real wind_speed_min, "m/s", 0.0, 100.0, "Lower end of the per-episode mean wind speed"),
@@ -150,7 +152,7 @@ static QUADROTOR_SPECS: [ParamSpec<QuadrotorParams>; 30] = [
     param!(real gear_stiffness, "N/m", 1.0, 1e9, "Normal and tangential stiffness of each foot"),
     param!(real gear_damping, "N.s/m", 1e-3, 1e9, "Normal and tangential damping of each foot"),
     param!(real gear_friction, "1", 0.0, 10.0, "Coulomb friction coefficient foot-ground"),
-    param!(real contact_substep, "s", 1e-6, 1.0, "Largest RK4 substep while a foot may touch the ground"),
+    param!(real contact_substep, "s", 1e-6, 1.0, "Largest RK4 substep while a foot may touch the ground (a grid interval is split into equal substeps)"),
     param!(real turbulence_dt, "s", 1e-4, 10.0, "Time between turbulence samples (the wind's own grid, independent of the step size)"),
 ];
 

@@ -22,7 +22,7 @@ pub fn reset_wind(params: &QuadrotorParams, rng: &mut SimRng) -> WindState {
 
 /// How far a step end may miss a turbulence sample time and still count as on it, as a
 /// fraction of `turbulence_dt`: steps of h = 0.005 s add up to 0.01 s only up to rounding.
-const GRID_SLACK: f64 = 1e-9;
+pub(super) const GRID_SLACK: f64 = 1e-9;
 
 /// The next piece of a step of `remaining` seconds on the turbulence grid: how long to
 /// integrate under the current wind, and whether the turbulence is sampled at its end.

@@ -1,7 +1,8 @@
 //! The quadrotor behind Quadrotor.fmu: a communication step of h seconds is one
-//! `Quadrotor::step(h)`, which cuts the step at the turbulence's own sample times
-//! (`turbulence_dt`) and integrates each piece in ceil(piece / max_substep) equal RK4
-//! substeps under the wind of the piece's start, so h does not change the weather.
+//! `Quadrotor::step(h)`, which integrates on the model's fixed physics grid (`max_substep`,
+//! contact substeps inside each grid interval) and cuts the step at the turbulence's own
+//! sample times (`turbulence_dt`), so any h on the grid gives the same bits at the shared
+//! times and h does not change the weather.
 //!
 //! Model Exchange integrates the same right-hand side (`flyloop_core::quadrotor::continuous`):
 //! 25 continuous states (the 17 body outputs x .. motor_state_3 and 8 local bristle

@@ -274,6 +274,9 @@ class FlyloopEnv(gym.Env):
 
         self.vehicle = 1 if sitl_address is None else int(vehicle)
         self._sink = FrameSink([self.vehicle], self._n_arrays)
+        # A step's HIL_ACTUATOR_CONTROLS names it by the simulation time it ends at, in µs
+        # (the SITL's clock advances by this per step), so a re-sent one is not stepped twice.
+        self._dt_us = max(1, round(self.dt * 1e6))
         if sitl_address is None:
             self._process = start_sitl(
                 spec, self.config, sitl_path=sitl_path, vehicles=1, timeout=timeout
@@ -337,6 +340,7 @@ class FlyloopEnv(gym.Env):
 
     def _sitl_reset(self, seed: int):
         link = self._link_ok()
+        self._sink.expect((True,))
         d = link.exchange(
             self._encoder.reset(seed, self.vehicle),
             lambda d: (
@@ -373,8 +377,10 @@ class FlyloopEnv(gym.Env):
         if not math.isfinite(sum(values)):
             raise ValueError(f"action must be finite, got {action!r}")
         link = self._link_ok()
+        sink = self._sink
+        sink.expect()
         link.exchange(
-            self._encoder.controls(self.vehicle, values),
+            self._encoder.controls(self.vehicle, values, max(sink.last_time[0], 0) + self._dt_us),
             self._frame_done,
             "task frame after a step",
             self._sink,

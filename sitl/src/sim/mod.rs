@@ -329,6 +329,9 @@ impl Sim {
             );
             return;
         }
+        if self.options.mode == Mode::Lockstep && self.repeated_or_stale(i, c.time_usec, out) {
+            return;
+        }
         match self.vehicles[i].set_controls(&c.controls) {
             Ok(report) => {
                 if report.clamped {
@@ -359,10 +362,49 @@ impl Sim {
                 self.vehicles[i].step();
                 self.stats.physics += start.elapsed();
                 self.stats.steps += 1;
+                let from = out.len();
                 self.push_vehicle_reply(i, peer, out);
+                let v = &mut self.vehicles[i];
+                v.last_step = (c.time_usec != 0).then_some(c.time_usec);
+                v.last_reply.clear();
+                if v.last_step.is_some() {
+                    v.last_reply.extend_from_slice(&out[from..]);
+                }
             }
             Mode::Realtime => self.command_arrived(i, now),
         }
+    }
+
+    /// Lockstep loss recovery (protocol §3) for a command naming a step (`time_usec` ≠ 0):
+    /// if it names the vehicle's last step, the reply cached for that step goes out again
+    /// (the first reply was lost, or the command arrived twice); else, at or below the
+    /// vehicle's clock, it is a late duplicate of an older step and is skipped. Returns
+    /// whether the command was handled so (false: a new step).
+    fn repeated_or_stale(&mut self, i: usize, step: u64, out: &mut Vec<u8>) -> bool {
+        let v = &self.vehicles[i];
+        if step == 0 {
+            return false;
+        }
+        if v.last_step == Some(step) {
+            self.stats.repeated_steps += 1;
+            out.extend_from_slice(&v.last_reply);
+            tracing::debug!(
+                system_id = v.system_id,
+                step,
+                "repeated step: cached reply sent again"
+            );
+        } else if step > v.clock_us {
+            return false;
+        } else {
+            self.stats.stale_controls += 1;
+            tracing::debug!(
+                system_id = v.system_id,
+                step,
+                clock_us = v.clock_us,
+                "controls for a step the vehicle is past skipped"
+            );
+        }
+        true
     }
 
     /// HIL_STATE_QUATERNION and the task frame of vehicle `i`, as `peer` wants them.
