@@ -24,9 +24,7 @@ NOISE = {"position": 0.02, "rates": 0.01}
 @pytest.mark.parametrize("env_id", ["flyloop/QuadHover-v0", "flyloop/QuadWaypoints-v0"])
 @pytest.mark.parametrize("backend", ["sitl", "native"])
 def test_check_env_passes_on_the_rates_interface_with_randomisation(make_env, env_id, backend):
-    env = make_env(
-        env_id, backend=backend, randomize=RANDOMIZE, observation_noise=NOISE, **RATES
-    )
+    env = make_env(env_id, backend=backend, randomize=RANDOMIZE, observation_noise=NOISE, **RATES)
     max_rate = math.radians(220)
     assert env.action_space.shape == (4,)
     assert np.allclose(env.action_space.low, [0, -max_rate, -max_rate, -math.radians(200)])
