@@ -23,12 +23,10 @@ from pathlib import Path
 
 import fast_ppo
 import numpy as np
-import tomllib
 import torch
-from training_envs import IRIS, PRESETS_DIR, preset
+from training_envs import preset, px4_vehicle
 
-UNSEEN = tomllib.loads((PRESETS_DIR / "px4_iris_unseen.toml").read_text())
-UNSEEN.pop("wind_enabled", None)
+UNSEEN = px4_vehicle("px4_iris_unseen")
 TASK = "offboard"
 
 
@@ -113,7 +111,7 @@ def main(argv: list[str] | None = None) -> int:
     summary = dict(
         env_id=preset(TASK).env_id,
         env_kwargs={k: v for k, v in kwargs.items() if k not in ("model_params", "randomize")},
-        model_params=IRIS,
+        model_params=px4_vehicle(),
         randomize={k: list(v) for k, v in kwargs["randomize"].items()},
         seed=args.seed,
         config=asdict(cfg),

@@ -93,10 +93,18 @@ class Preset:
         return next(iter(self.actions)) if self.actions else None
 
 
-# The Iris of flyloop-sitl --px4 (sitl/presets/px4_iris.toml; its wind is the env's use_wind).
+# The vehicles of flyloop-sitl --px4 (sitl/presets/). Read when a preset needs them: RLlib's
+# env runners import this file from a copy of examples/train/ where sitl/ is not beside it.
 PRESETS_DIR = Path(__file__).resolve().parents[2] / "sitl" / "presets"
-IRIS = tomllib.loads((PRESETS_DIR / "px4_iris.toml").read_text())
-IRIS.pop("wind_enabled", None)
+
+
+def px4_vehicle(name: str = "px4_iris") -> dict[str, Any]:
+    """A PX4-mode preset's quadrotor parameters (its wind switch is the env's use_wind)."""
+    params = tomllib.loads((PRESETS_DIR / f"{name}.toml").read_text())
+    params.pop("wind_enabled", None)
+    return params
+
+
 # Per-episode vehicles around the Iris, and PX4 in the loop's latency (train_offboard.py).
 OFFBOARD_RANDOMIZE = {
     "mass": (1.2, 1.85),
@@ -119,35 +127,6 @@ PRESETS: dict[str, Preset] = {
         # 5 s episodes (250 steps of 20 ms), the default wind (mean 0–5 m/s + turbulence).
         env_kwargs={"max_steps": 250, "dt": 0.02},
         actions=QUAD_ACTIONS,
-        success=hover_success,
-        success_text=(
-            f"reached the time limit (no crash, not out of bounds) within "
-            f"{HOVER_SUCCESS_DISTANCE_M} m of the target"
-        ),
-    ),
-    # A policy for PX4's offboard mode: thrust + body rates through the core's model of PX4's
-    # rate loop at 50 Hz, PX4-like estimator noise, 10 s episodes with a new target after 5 s,
-    # on the Iris with per-episode randomisation (train_offboard.py, examples/px4_offboard.py).
-    "offboard": Preset(
-        name="offboard",
-        env_id="flyloop/QuadHover-v0",
-        env_kwargs={
-            "action_interface": "rates",
-            "dt": 0.02,
-            "max_steps": 500,
-            "target_change_interval": 250,
-            "use_wind": False,
-            "start_attitude_range": 0.2,
-            "observation_noise": {
-                "position": 0.02,
-                "velocity": 0.05,
-                "attitude": 0.01,
-                "rates": 0.02,
-            },
-            "model_params": IRIS,
-            "randomize": OFFBOARD_RANDOMIZE,
-        },
-        actions=None,
         success=hover_success,
         success_text=(
             f"reached the time limit (no crash, not out of bounds) within "
@@ -182,6 +161,44 @@ PRESETS: dict[str, Preset] = {
     ),
 }
 
+
+def offboard_preset() -> Preset:
+    """A policy for PX4's offboard mode: thrust + body rates through the core's model of PX4's
+    rate loop at 50 Hz, PX4-like estimator noise, 10 s episodes with a new target after 5 s,
+    on the Iris with per-episode randomisation (train_offboard.py, examples/px4_offboard.py).
+    Made when asked for: it reads the Iris from sitl/presets/."""
+    return Preset(
+        name="offboard",
+        env_id="flyloop/QuadHover-v0",
+        env_kwargs={
+            "action_interface": "rates",
+            "dt": 0.02,
+            "max_steps": 500,
+            "target_change_interval": 250,
+            "use_wind": False,
+            "start_attitude_range": 0.2,
+            "observation_noise": {
+                "position": 0.02,
+                "velocity": 0.05,
+                "attitude": 0.01,
+                "rates": 0.02,
+            },
+            "model_params": px4_vehicle(),
+            "randomize": OFFBOARD_RANDOMIZE,
+        },
+        actions=None,
+        success=hover_success,
+        success_text=(
+            f"reached the time limit (no crash, not out of bounds) within "
+            f"{HOVER_SUCCESS_DISTANCE_M} m of the target"
+        ),
+    )
+
+
+# Presets made on demand (they read files outside examples/train/).
+LAZY_PRESETS: dict[str, Callable[[], Preset]] = {"offboard": offboard_preset}
+
+
 ALIASES = {
     "QuadHover": "hover",
     "flyloop/QuadHover-v0": "hover",
@@ -193,8 +210,10 @@ ALIASES = {
 
 def preset(name: str) -> Preset:
     key = ALIASES.get(name, name)
+    if key in LAZY_PRESETS:
+        return LAZY_PRESETS[key]()
     if key not in PRESETS:
-        choices = sorted(PRESETS) + sorted(ALIASES)
+        choices = sorted(PRESETS) + sorted(LAZY_PRESETS) + sorted(ALIASES)
         raise ValueError(f"unknown env {name!r}; choose one of {choices}")
     return PRESETS[key]
 
