@@ -7,7 +7,7 @@ use crate::params::{ParamSpec, Parameters};
 use crate::quadrotor::contact::foot_heights;
 use crate::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
 use crate::rng::SimRng;
-use crate::tasks::{ActionError, Info, InfoValue, check_action, clip_f32};
+use crate::tasks::{Info, InfoValue, clip_f32};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -271,19 +271,6 @@ pub fn write_base_observation(
     for (i, &v) in values.enumerate() {
         out[i] = clip_f32(v, lo[i], hi[i]);
     }
-}
-
-/// Applies a 4-value motor action (clipped into [0, 1]) and advances the vehicle by `dt`.
-pub fn apply_action(quad: &mut Quadrotor, action: &[f64], dt: f64) -> Result<(), ActionError> {
-    check_action(action, 4)?;
-    let command = [action[0], action[1], action[2], action[3]];
-    quad.set_command(command)
-        .map_err(|e| ActionError::NotFinite {
-            index: e.index,
-            value: e.value,
-        })?;
-    quad.step(dt);
-    Ok(())
 }
 
 /// Episode bookkeeping shared by the flight tasks.

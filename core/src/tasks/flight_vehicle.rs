@@ -24,7 +24,7 @@ use super::randomization::{Randomization, VehicleParams};
 use crate::error::ParamError;
 use crate::params::Parameters;
 use crate::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
-use crate::rate_loop::{RateLoop, RateLoopParams, RatesSetpoint};
+use crate::rate_loop::{RateLoop, RatesSetpoint};
 use crate::rng::SimRng;
 use crate::sensors::frames::{attitude_ned, enu_to_ned, flu_to_frd};
 use crate::tasks::{ActionError, InfoValue, check_action};
@@ -313,15 +313,6 @@ impl FlightVehicle {
     pub fn info(&self) -> Option<(&'static str, InfoValue)> {
         (!self.randomization.is_off())
             .then(|| ("randomized", InfoValue::Vector(self.drawn.clone())))
-    }
-
-    pub fn randomization(&self) -> &Randomization {
-        &self.randomization
-    }
-
-    /// The rate loop's parameters (nominal; drawn ones are in effect when randomised).
-    pub fn nominal_rate_loop(&self) -> &RateLoopParams {
-        &self.nominal.rate_loop
     }
 }
 
