@@ -18,25 +18,22 @@ POLICY = ROOT / "policies" / "px4_offboard_hover"
 WAYPOINTS = "0,0,3;2,0,3;2,2,4"
 
 
+def command(connect: str, *args: str) -> list[str]:
+    """The deployment script with the shipped policy, talking to PX4 at `connect`."""
+    return [sys.executable, str(SCRIPT), str(POLICY), "--connect", connect, *args]
+
+
+def port(px4) -> str:
+    return f"udpout:127.0.0.1:{14580 + px4.instance}"
+
+
 def offboard(pair, *flyloop_args: str, waypoints=WAYPOINTS, hold=4.0, timeout=240):
     """flyloop (with `flyloop_args`) and PX4, then the deployment script against PX4's
     offboard port; returns the script's result and the flyloop process."""
     flyloop = pair.flyloop(*flyloop_args)
     px4 = pair.px4()
     result = subprocess.run(
-        [
-            sys.executable,
-            str(SCRIPT),
-            str(POLICY),
-            "--connect",
-            f"udpout:127.0.0.1:{14580 + px4.instance}",
-            "--waypoints",
-            waypoints,
-            "--hold",
-            str(hold),
-            "--timeout",
-            "90",
-        ],
+        command(port(px4), "--waypoints", waypoints, "--hold", str(hold), "--timeout", "90"),
         capture_output=True,
         text=True,
         timeout=timeout,
@@ -80,15 +77,7 @@ def test_the_shipped_policy_flies_a_vehicle_it_never_saw(pair):
 def test_no_px4_is_said_in_one_line_without_a_traceback(tmp_path):
     start = time.monotonic()
     result = subprocess.run(
-        [
-            sys.executable,
-            str(SCRIPT),
-            str(POLICY),
-            "--connect",
-            "udpout:127.0.0.1:9",
-            "--timeout",
-            "3",
-        ],
+        command("udpout:127.0.0.1:9", "--timeout", "3"),
         capture_output=True,
         text=True,
         timeout=60,
@@ -103,19 +92,7 @@ def test_telemetry_stopping_mid_flight_hands_back_to_px4(pair):
     flyloop = pair.flyloop()
     px4 = pair.px4()
     proc = subprocess.Popen(
-        [
-            sys.executable,
-            str(SCRIPT),
-            str(POLICY),
-            "--connect",
-            f"udpout:127.0.0.1:{14580 + px4.instance}",
-            "--waypoints",
-            "0,0,3;10,0,3",
-            "--hold",
-            "30",
-            "--stale",
-            "2",
-        ],
+        command(port(px4), "--waypoints", "0,0,3;10,0,3", "--hold", "30", "--stale", "2"),
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -141,15 +118,7 @@ def test_offboard_refused_is_said_and_px4_keeps_control(pair):
     pair.flyloop()
     px4 = pair.px4(MAV_FWDEXTSP=0)
     result = subprocess.run(
-        [
-            sys.executable,
-            str(SCRIPT),
-            str(POLICY),
-            "--connect",
-            f"udpout:127.0.0.1:{14580 + px4.instance}",
-            "--timeout",
-            "90",
-        ],
+        command(port(px4), "--timeout", "90"),
         capture_output=True,
         text=True,
         timeout=240,
