@@ -72,7 +72,9 @@ class SavedRun:
         saved = torch.load(folder / "policy.pt", weights_only=False)
         state = saved["model"]
         obs_size, act_size = state["mu.0.weight"].shape[1], state["log_std"].shape[0]
-        self.model = ActorCritic(obs_size, act_size, self.summary["config"]["hidden"])
+        config = self.summary["config"]
+        basis = config.get("action_basis", "motors")
+        self.model = ActorCritic(obs_size, act_size, config["hidden"], basis=basis)
         self.model.load_state_dict(state)
         self.model.eval()
         self.norm = RunningNorm(obs_size)
@@ -81,6 +83,7 @@ class SavedRun:
         def act(obs: np.ndarray) -> np.ndarray:
             with torch.no_grad():
                 mean = self.model.mu(torch.as_tensor(self.norm(obs[None, :]))).numpy()
+                mean = self.model.to_actions(mean)
             return np.clip(mean[0], -1.0, 1.0)
 
         self.act = act

@@ -64,6 +64,11 @@ class Config:
     # The learner sees reward * reward_scale (the reported returns are the env's own).
     reward_scale: float = 1.0
     init_log_std: float = -0.5
+    # The policy's Gaussian lives in this basis: "motors" (one output per env action) or, for
+    # a two-motor lander, "collective" ([mean thrust, half difference]; left = c - d, right =
+    # c + d). Its diagonal covariance then explores climb and turn separately, and a policy
+    # learns to hold its attitude with little turning noise while it still tries descents.
+    action_basis: str = "motors"
 
 
 @dataclass(frozen=True)
@@ -160,11 +165,26 @@ class RunningNorm:
         return np.clip(z, -10, 10).astype(np.float32)
 
 
-class ActorCritic(nn.Module):
-    """Gaussian policy (state-independent log std) on [-1, 1] actions, and a value function."""
+BASES = {"motors": None, "collective": np.array([[1.0, -1.0], [1.0, 1.0]])}
 
-    def __init__(self, obs_size: int, act_size: int, hidden: int, log_std: float = -0.5) -> None:
+
+class ActorCritic(nn.Module):
+    """Gaussian policy (state-independent log std) on [-1, 1] actions, and a value function.
+    The Gaussian is over the action basis' coordinates; `to_actions` maps them to the env's."""
+
+    def __init__(
+        self,
+        obs_size: int,
+        act_size: int,
+        hidden: int,
+        log_std: float = -0.5,
+        basis: str = "motors",
+    ) -> None:
         super().__init__()
+        matrix = BASES[basis]
+        if matrix is not None and matrix.shape != (act_size, act_size):
+            raise ValueError(f"action basis {basis!r} is for {len(matrix)} actions, not {act_size}")
+        self.basis = np.eye(act_size) if matrix is None else matrix
 
         def mlp(out: int, gain: float) -> nn.Sequential:
             layers = [nn.Linear(obs_size, hidden), nn.Tanh(), nn.Linear(hidden, hidden)]
@@ -181,6 +201,10 @@ class ActorCritic(nn.Module):
 
     def dist(self, x: torch.Tensor) -> torch.distributions.Normal:
         return torch.distributions.Normal(self.mu(x), self.log_std.exp())
+
+    def to_actions(self, coordinates: np.ndarray) -> np.ndarray:
+        """Policy outputs (rows) in the action basis to [-1, 1] actions (not yet clipped)."""
+        return coordinates @ self.basis.T
 
 
 def make_envs(task: str, backend: str, num_envs: int, **overrides) -> gym.vector.VectorEnv:
@@ -223,7 +247,7 @@ def evaluate(model, norm, task: str, backend: str, episodes: int, seed: int = EV
         returns = np.zeros(episodes)
         while not done.all():
             with torch.no_grad():
-                action = model.mu(torch.as_tensor(norm(obs))).numpy()
+                action = model.to_actions(model.mu(torch.as_tensor(norm(obs))).numpy())
             obs, reward, terminated, truncated, infos = envs.step(
                 to_env(action, envs.single_action_space)
             )
@@ -251,7 +275,7 @@ def train(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
     space = envs.single_action_space
     n, t_len = cfg.num_envs, cfg.rollout_steps
     obs_size, act_size = envs.single_observation_space.shape[0], space.shape[0]
-    model = ActorCritic(obs_size, act_size, cfg.hidden, cfg.init_log_std)
+    model = ActorCritic(obs_size, act_size, cfg.hidden, cfg.init_log_std, cfg.action_basis)
     optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate, eps=1e-5)
     norm = RunningNorm(obs_size)
     rng = np.random.default_rng(args.seed)
@@ -304,7 +328,9 @@ def train(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
                     action = d.sample()
                     logp_buf[t] = d.log_prob(action).sum(-1).numpy()
                 act_buf[t] = action.numpy()
-                obs, reward, terminated, truncated, infos = envs.step(to_env(act_buf[t], space))
+                obs, reward, terminated, truncated, infos = envs.step(
+                    to_env(model.to_actions(act_buf[t]), space)
+                )
                 valid = ~resetting
                 done = valid & (terminated | truncated)
                 rew_buf[t], term_buf[t], done_buf[t], valid_buf[t] = reward, terminated, done, valid

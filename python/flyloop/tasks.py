@@ -248,8 +248,10 @@ LANDING_ARGUMENTS: list[Argument] = [
         "initial_pos_random_range_m",
         "initial_pos_random_range_m",
         _one(as_float),
-        "half side of the spawn square around (25, 40), m; 0 = fixed start",
+        "half side of the spawn square around (spawn_x, spawn_y), m; 0 = fixed start",
     ),
+    _arg("spawn_x", "spawn_x", _one(as_float), "centre of the spawn square, x, m"),
+    _arg("spawn_y", "spawn_y", _one(as_float), "centre of the spawn square, y, m"),
     _arg(
         "initial_angle_random_range_rad",
         "initial_angle_random_range_rad",

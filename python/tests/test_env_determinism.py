@@ -111,6 +111,19 @@ def test_lander_observation_of_a_fixed_start_matches_the_documented_layout(make_
     assert info["distance"] == pytest.approx(29.5, abs=1e-5) and info["step"] == 0
 
 
+def test_lander_spawns_around_the_given_spawn_centre(make_env):
+    # spawn_x / spawn_y move the spawn square (a training curriculum starts near the pad);
+    # a spawn below the platform's top plus one drone width is raised to it.
+    env = make_env(Lander2DEnv, spawn_x=20.0, spawn_y=15.0, initial_pos_random_range_m=2.0)
+    for seed in range(5):
+        _, info = env.reset(seed=seed)
+        x, y = info["position"]
+        assert 18.0 <= x <= 22.0 and 13.0 <= y <= 17.0, (seed, x, y)
+    env = make_env(Lander2DEnv, spawn_y=11.0, initial_pos_random_range_m=0.0)
+    _, info = env.reset(seed=0)
+    np.testing.assert_allclose(info["position"], [25.0, 10.5 + 1.0])
+
+
 def test_full_thrust_lifts_and_zero_thrust_drops_the_lander(make_env):
     env = make_env(
         Lander2DEnv, initial_pos_random_range_m=0.0, use_wind=False, thrust_noise_std=0.0

@@ -63,7 +63,7 @@ class Lander2DEnv(FlyloopEnv):
 
     ## Starting state
 
-    Spawn at (25, 40) ± ``initial_pos_random_range_m`` in x and y (kept inside the world and
+    Spawn at (``spawn_x``, ``spawn_y``) = (25, 40) ± ``initial_pos_random_range_m`` in x and y (kept inside the world and
     above the platform), angle uniform in ±``initial_angle_random_range_rad``, at rest, battery
     full. Wind: a constant force of wind_speed · 0.5 · 1.0 m (2.5 N) in a direction uniform in
     [0, 2π) per episode (or ``wind_direction``). A moving platform starts in a random
@@ -89,8 +89,9 @@ class Lander2DEnv(FlyloopEnv):
     - ``max_steps=1000``, ``dt=0.02`` (s, 50 Hz control).
     - ``moving_platform=False``, ``platform_speed=1.5`` (m/s),
       ``platform_random_start_x=False``.
-    - ``initial_pos_random_range_m=5.0`` (0 = fixed start at (25, 40)),
-      ``initial_angle_random_range_rad=0.1``.
+    - ``initial_pos_random_range_m=5.0`` (0 = fixed start at (spawn_x, spawn_y)),
+      ``spawn_x=25.0``, ``spawn_y=40.0`` (m; a spawn is kept inside the world and at least a
+      drone width above the platform), ``initial_angle_random_range_rad=0.1``.
     - ``use_wind=True``, ``wind_speed=5.0`` (m/s), ``wind_direction=None`` (None = random per
       episode, else radians from +x toward +y).
     - ``thrust_noise_std=1.5`` (N), ``max_safe_landing_speed=1.5``,
@@ -135,6 +136,8 @@ class Lander2DEnv(FlyloopEnv):
         shade_distance_m: float = 2.0,
         *,
         dt: float = 0.02,
+        spawn_x: float = 25.0,
+        spawn_y: float = 40.0,
         initial_angle_random_range_rad: float = 0.1,
         use_wind: bool = True,
         wind_speed: float = 5.0,
@@ -163,6 +166,8 @@ class Lander2DEnv(FlyloopEnv):
                 moving_platform=moving_platform,
                 platform_speed=platform_speed,
                 initial_pos_random_range_m=initial_pos_random_range_m,
+                spawn_x=spawn_x,
+                spawn_y=spawn_y,
                 initial_angle_random_range_rad=initial_angle_random_range_rad,
                 use_wind=use_wind,
                 wind_speed=wind_speed,
