@@ -1,5 +1,5 @@
 """A scripted PD controller flies flyloop/QuadHover-v0 through the gym env and the SITL, and
-the flight is written to runs/demo/quadhover_demo.gif (the README's GIF is drawn with
+the flight is written to runs/demo/quadhover_demo.gif (docs/gym.md's GIF is drawn with
 ``--out docs/img/quadhover_demo.gif``).
 
     cargo build --release -p flyloop-sitl && .venv/bin/python examples/demo_gym_pd.py

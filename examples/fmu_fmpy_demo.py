@@ -1,5 +1,5 @@
 """Quadrotor.fmu in fmpy: hover for 2 s, then all four motors 0.03 above hover; plots the
-result to runs/demo/fmu_hover.png (the README's figure: ``--out docs/img/fmu_hover.png``).
+result to runs/demo/fmu_hover.png (docs/fmu.md's figure: ``--out docs/img/fmu_hover.png``).
 
     bash scripts/pack-fmus.sh && .venv/bin/python examples/fmu_fmpy_demo.py
 """

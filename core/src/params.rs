@@ -1,6 +1,6 @@
 //! Table-driven parameters: one [`ParamSpec`] row per field gives its name, unit, bounds and
 //! description. Validation, name-based get/set (the SITL's parameter protocol), the FMU's
-//! modelDescription and the README's parameter tables all read the same rows.
+//! modelDescription and the parameter reference (docs/parameters.md) all read the same rows.
 
 use crate::error::{ParamError, Role};
 use serde::Serialize;
@@ -182,7 +182,7 @@ pub trait Parameters: Sized + Clone + Default + Serialize + DeserializeOwned + '
         out
     }
 
-    /// The table as Markdown (name, unit, default, range, description), for the README.
+    /// The table as Markdown (name, unit, default, range, description), for docs/parameters.md.
     fn markdown_table() -> String {
         let defaults = Self::default();
         let mut out = String::from(

@@ -1,5 +1,6 @@
 //! Analytic checks of the quadrotor dynamics: equilibrium, free fall, torque signs, motor
-//! lag, conservation laws, drag, determinism (ground contact: quadrotor_ground.rs).
+//! lag, conservation laws, drag, determinism (ground contact: quadrotor_ground.rs). "The
+//! reference" below is seed 001's environment (docs/reference/quadrotor.md).
 
 // Helpers are test code too: a failed setup is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]

@@ -1,5 +1,6 @@
 //! Hover and Waypoints: rewards and terminations on hand-built states, reset sampling,
-//! observation layout and bounds, truncation, determinism.
+//! observation layout and bounds, truncation, determinism. "The reference" below is seed
+//! 001's environment (docs/reference/quadrotor.md).
 
 // Helpers are test code too: a failed setup is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]

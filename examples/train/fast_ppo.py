@@ -133,7 +133,7 @@ TASKS: dict[str, Task] = {
     # it still touches down slower than the 1.5 m/s limit), then 1.0 m/s, then the task's
     # 1.5 m/s for the last 60 % of the run. NOT YET A WORKING SETTING: without the
     # curriculum, seed 0 had not landed once after 1.6M env steps; with it, not once in
-    # its first 819k (0.5 m/s) either (both runs stopped there; see the README).
+    # its first 819k (0.5 m/s) either (both runs stopped there; see docs/training.md).
     "lander_moving": Task(
         "lander_moving",
         LANDER,

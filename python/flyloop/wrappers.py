@@ -1,4 +1,4 @@
-"""Action wrappers of seed 001, with the fixes noted in shared/reference/quadrotor.md.
+"""Action wrappers of seed 001, with the fixes noted in docs/reference/quadrotor.md.
 
 Both wrap QuadHover or QuadWaypoints (4 motor commands in [0, 1]) and clip their own action
 into their action space before using it.

@@ -1,5 +1,5 @@
 """A ground station flies flyloop's quadrotor through ArduPilot: a real MAVProxy on
-ArduPilot's TCP port (`mavproxy.py --master=tcp:127.0.0.1:5760`, as the README's "Fly it with
+ArduPilot's TCP port (`mavproxy.py --master=tcp:127.0.0.1:5760`, as docs/ardupilot.md's "Fly it with
 ArduPilot" starts it) is typed what an operator types (mode guided, arm, takeoff, fly to a
 point, land), and ArduPilot's reports, which MAVProxy forwards to the test, are checked
 against the targets and against flyloop's ground truth."""

@@ -87,7 +87,7 @@ def test_ardupilot_flies_an_auto_mission_uploaded_from_a_script(pair):
         print(f"waypoint {north, east}: closest approach of the truth {closest:.3f} m")
     check_landed(rows, *WAYPOINTS[-1])
 
-    # The README's plot script draws this track.
+    # docs/ardupilot.md's plot script draws this track.
     png = flyloop.track.with_suffix(".png")
     script = Path(__file__).resolve().parents[2] / "examples" / "px4_track_plot.py"
     subprocess.run(

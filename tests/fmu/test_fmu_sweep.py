@@ -1,4 +1,4 @@
-"""The README's Ray sweep (examples/fmu_sweep.py) on a small grid: the hover command it finds
+"""docs/fmu.md's Ray sweep (examples/fmu_sweep.py) on a small grid: the hover command it finds
 through the FMU is the analytic sqrt(m g / 4 k), and a heavier vehicle climbs less."""
 
 import importlib.util

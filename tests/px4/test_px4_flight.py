@@ -57,7 +57,7 @@ def test_px4_takes_off_holds_flies_10_m_and_lands_on_flyloop(pair):
 
     check_mission(rows, [(hover, hover_target), (away, away_target)], frame)
 
-    # The README's plot script draws this track.
+    # docs/px4.md's plot script draws this track.
     png = flyloop.track.with_suffix(".png")
     script = Path(__file__).resolve().parents[2] / "examples" / "px4_track_plot.py"
     subprocess.run([sys.executable, str(script), str(flyloop.track), str(png)], check=True)

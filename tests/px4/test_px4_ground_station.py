@@ -1,5 +1,5 @@
 """A ground station flies flyloop's quadrotor through PX4: a real MAVProxy on PX4's
-ground-station port (`mavproxy.py --master=udpout:127.0.0.1:18570+instance`, as the README's
+ground-station port (`mavproxy.py --master=udpout:127.0.0.1:18570+instance`, as docs/px4.md's
 "Fly it with PX4" starts it) is typed what an operator types (arm, takeoff, fly to a point,
 land), and PX4's reports, which MAVProxy forwards to the test, are checked against the targets
 and against flyloop's ground truth.

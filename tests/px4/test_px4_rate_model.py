@@ -5,7 +5,7 @@ rate-loop tick per step) on the same vehicle; the body-rate responses agree with
 the step size (RMS).
 
 With FLYLOOP_RATE_MODEL_OUT=DIR the test also writes DIR/rate_model.png (the responses side
-by side) and DIR/rate_model.json (the figures); the README's plot is made so."""
+by side) and DIR/rate_model.json (the figures); docs/px4.md's plot is made so."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The README's commands and snippets, run as written.
+"""The commands and snippets of README.md and every page under docs/, run as written.
 
 A fenced block is checked when the line before it is a marker comment:
 
@@ -11,10 +11,13 @@ A fenced block is checked when the line before it is a marker comment:
 - ``<!-- check: doctest FILE -->``: the Rust block is the doc example of FILE (run by
   ``cargo test --doc``), line for line.
 - ``<!-- check: tested-by PATH -->``: the commands run in the tests under PATH (too long
-  for this file); every script the block names must appear there.
+  for this file); every script the block names must appear there (or be a test file there).
+- ``<!-- check: sitl-config -->``: the TOML block is a ``--config`` file flyloop-sitl accepts.
 - ``<!-- check: ci -->``: the README's two top commands; ``.ci/run`` runs each line as written.
 
-Every fenced block carries a marker: a block without one fails.
+Every fenced block carries a marker: a block without one fails. Beyond the blocks: the README
+starts with its two commands and stays under 200 lines; every link and every repository path
+a page names exists; no page names a path outside the repository.
 """
 
 from __future__ import annotations
@@ -33,11 +36,13 @@ from flyloop import find_sitl_binary
 
 REPO = Path(__file__).resolve().parents[2]
 README = REPO / "README.md"
+PAGES = [README, *sorted((REPO / "docs").rglob("*.md"))]
 MARKER = re.compile(r"<!-- check: ([\w-]+)(?: (\S+))? -->")
 
 
 @dataclass
 class Block:
+    page: Path
     line: int
     language: str
     text: str
@@ -46,11 +51,15 @@ class Block:
 
     @property
     def id(self) -> str:
-        return f"README.md:{self.line}:{self.kind}"
+        return f"{self.where}:{self.kind}"
+
+    @property
+    def where(self) -> str:
+        return f"{self.page.relative_to(REPO)}:{self.line}"
 
 
-def blocks(text: str) -> list[Block]:
-    found, lines = [], text.splitlines()
+def blocks(page: Path) -> list[Block]:
+    found, lines = [], page.read_text().splitlines()
     i = 0
     while i < len(lines):
         fence = re.match(r"^```(\w*)\s*$", lines[i])
@@ -63,6 +72,7 @@ def blocks(text: str) -> list[Block]:
         marker = MARKER.fullmatch(before.strip())
         found.append(
             Block(
+                page=page,
                 line=start + 1,
                 language=fence.group(1),
                 text="\n".join(lines[start + 1 : end]) + "\n",
@@ -74,7 +84,7 @@ def blocks(text: str) -> list[Block]:
     return found
 
 
-ALL = blocks(README.read_text())
+ALL = [block for page in PAGES for block in blocks(page)]
 
 
 def of_kind(*kinds: str) -> list[Block]:
@@ -107,12 +117,96 @@ def environment(sitl: Path) -> dict[str, str]:
 
 def test_the_markers_are_known_and_the_core_blocks_are_checked():
     known = {"run", "python", "python-sitl", "sitl-commands", "doctest", "tested-by", "ci"}
+    known.add("sitl-config")
     assert {b.kind for b in ALL if b.kind} <= known
-    unchecked = [f"README.md:{b.line} ({b.language})" for b in ALL if b.kind is None]
-    assert not unchecked, f"README blocks that no test or CI step runs: {unchecked}"
-    # The snippets the README has always had stay checked.
-    assert len(of_kind("python", "python-sitl")) >= 3
+    unchecked = [f"{b.where} ({b.language})" for b in ALL if b.kind is None]
+    assert not unchecked, f"blocks that no test or CI step runs: {unchecked}"
+    # Every page with blocks is read, and the snippets the docs have always had stay checked.
+    assert {b.page.name for b in ALL} >= {"README.md", "fmu.md", "sitl.md", "gym.md", "px4.md"}
+    assert len(of_kind("python", "python-sitl")) >= 8
     assert of_kind("doctest") and of_kind("sitl-commands") and of_kind("run")
+    assert of_kind("tested-by") and of_kind("sitl-config")
+    # The README shows the core, an FMU, the SITL and the gym envs.
+    in_readme = {b.kind for b in ALL if b.page == README}
+    assert in_readme >= {"ci", "doctest", "run", "python", "sitl-commands"}
+
+
+def test_the_readme_starts_with_its_two_commands_and_stays_short():
+    lines = README.read_text().splitlines()
+    assert len(lines) <= 200, f"README.md has {len(lines)} lines; move detail into docs/"
+    first = next(b for b in ALL if b.page == README)
+    assert first.kind == "ci" and first.line <= 10, first.where
+    assert [c.split()[:2] for c in commands(first)] == [
+        ["bash", "scripts/setup.sh"],
+        ["bash", "scripts/test.sh"],
+    ]
+    # Only the README carries them: CI runs that block, so it is written once.
+    assert [b.where for b in of_kind("ci")] == [first.where]
+
+
+LINK = re.compile(r"!?\[[^\]]*\]\(([^)\s]+)\)")
+
+
+def anchors(page: Path) -> set[str]:
+    """GitHub's heading anchors of `page`: lower case, punctuation dropped, spaces to `-`."""
+    out, fenced = set(), False
+    for line in page.read_text().splitlines():
+        fenced ^= line.startswith("```")
+        heading = re.match(r"#+ (.*)", line)
+        if heading and not fenced:
+            out.add(re.sub(r"[^\w\- ]", "", heading.group(1).lower()).replace(" ", "-"))
+    return out
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: str(p.relative_to(REPO)))
+def test_links_and_images_resolve_inside_the_repository(page: Path):
+    broken = []
+    for target in LINK.findall(page.read_text()):
+        if re.match(r"[a-z]+:", target):
+            continue  # a web address
+        path, _, anchor = target.partition("#")
+        resolved = (page.parent / path).resolve() if path else page
+        inside = resolved == REPO or REPO in resolved.parents
+        if not inside or not resolved.exists():
+            broken.append(target)
+        elif anchor and resolved.suffix == ".md" and anchor not in anchors(resolved):
+            broken.append(target)
+    assert not broken, f"{page.relative_to(REPO)}: links to nothing: {broken}"
+
+
+# A machine's own places: home and work directories, a checkout's neighbours.
+OUTSIDE = re.compile(r"\$HOME|~/|(?<![\w.])/(?:home|root|work|tmp|mnt|opt|srv|Users)/|\.\./")
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: str(p.relative_to(REPO)))
+def test_no_page_names_a_path_outside_the_repository(page: Path):
+    # Links may climb out of docs/ (checked above to stay inside); nothing else may.
+    text = LINK.sub("", page.read_text())
+    found = [m.group(0) for m in OUTSIDE.finditer(text)]
+    assert not found, (
+        f"{page.relative_to(REPO)} names paths outside the repository: {found}; say what to "
+        "build and where to point it (e.g. PATH_TO_PX4_BUILD)"
+    )
+
+
+# What the checkout holds (build outputs such as target/, dist/ and runs/ are made by commands).
+TRACKED = (
+    "core fmu sitl python examples benchmarks scripts tests policies docs modelDescription .ci"
+)
+NAMED = re.compile(rf"(?<![\w./-])((?:{'|'.join(map(re.escape, TRACKED.split()))})/[\w./*-]*)")
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: str(p.relative_to(REPO)))
+def test_every_repository_path_a_page_names_exists(page: Path):
+    text = LINK.sub("", page.read_text())
+    missing = sorted(
+        {
+            name
+            for name in (m.group(1).rstrip(".") for m in NAMED.finditer(text))
+            if not any(REPO.glob(name)) and not (REPO / name).exists()
+        }
+    )
+    assert not missing, f"{page.relative_to(REPO)} names what the repository lacks: {missing}"
 
 
 @pytest.mark.parametrize("block", of_kind("run"), ids=lambda b: b.id)
@@ -211,7 +305,7 @@ def test_rust_snippets_are_doc_examples(block: Block):
     doc = [ln[4:] if ln.startswith("//! ") else ln[3:] for ln in source.splitlines()]
     doc = [ln for ln in doc if not ln.startswith("# ")]
     text = "\n".join(doc)
-    assert block.text.strip() in text, f"README.md:{block.line} differs from {block.argument}"
+    assert block.text.strip() in text, f"{block.where} differs from {block.argument}"
 
 
 @pytest.mark.parametrize("block", of_kind("ci"), ids=lambda b: b.id)
@@ -229,4 +323,23 @@ def test_long_commands_are_run_by_their_tests(block: Block):
     scripts = {w for c in commands(block) for w in shlex.split(c) if w.endswith(".py")}
     assert scripts
     for script in scripts:
-        assert Path(script).name in corpus, f"{script} is run by no test in {block.argument}"
+        is_a_test = (REPO / script) in tests
+        assert is_a_test or Path(script).name in corpus, (
+            f"{block.where}: {script} is run by no test in {block.argument}"
+        )
+
+
+@pytest.mark.parametrize("block", of_kind("sitl-config"), ids=lambda b: b.id)
+def test_config_files_are_accepted_by_the_sitl(block: Block, sitl_binary: Path, tmp_path: Path):
+    config = tmp_path / "config.toml"
+    config.write_text(block.text)
+    result = subprocess.run(
+        [str(sitl_binary), "--config", str(config), "--list-params", "toml"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert result.returncode == 0, f"{block.where}: {result.stderr}"
+    # The top-level values come back as the parameters' values.
+    for name, value in re.findall(r"^(\w+) = ([\d.]+)$", block.text.split("\n[")[0], re.M):
+        assert re.search(rf"^{name} = {re.escape(value)}\b", result.stdout, re.M), name

@@ -11,7 +11,7 @@ from training_support import TRAIN, run_script
 
 # The lander's short run: 20 updates of 128 envs x 128 steps (~30 CPU seconds). Measured
 # (seed 0, held-out seeds 1,000,000..1,000,019): mean return 95.0 against -302.6 for random
-# actions, 13 of 20 landed. Seed 1, which never learned to land in 1.5M steps (README),
+# actions, 13 of 20 landed. Seed 1, which never learned to land in 1.5M steps (docs/training.md),
 # ended at a held-out mean return of -116.2 hovering: still far above random.
 LANDER_SHORT_STEPS = 327_680
 LANDER_MIN_GAIN = 150.0
@@ -23,7 +23,7 @@ def summary(out, backend):
 
 @pytest.mark.training
 def test_fast_ppo_learns_quadhover_on_the_native_vector_env(tmp_path):
-    # The README's run. Measured (seed 0, 64 envs, 303,104 env steps; idle 2-core machine,
+    # docs/training.md's run. Measured (seed 0, 64 envs, 303,104 env steps; idle 2-core machine,
     # 10 s): training success >= 90 % after 270,336 steps (9.3 s); held-out 95 % (100
     # episodes, seeds 1,000,000..), mean return 188.3; random actions succeed 0 % (test_
     # training_sb3_hover.py: mean return 4.3). Bounds below leave room for another CPU's floats.

@@ -1,5 +1,5 @@
 """examples/lander_pilot.py: the scripted pilot (no learning) lands on Lander2D-v1 over the real
-SITL — the task is feasible, and this is the baseline of the README's table."""
+SITL — the task is feasible, and this is the baseline of docs/training.md's table."""
 
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """examples/train/train_offboard.py: a short run of the rates-interface training writes a
 policy that examples/px4_offboard.py loads and that acts, in numpy, exactly as the trained
 torch network; and the shipped policy holds its targets on the core's model of PX4 (the
-held-out check of the README, on fewer episodes)."""
+held-out check of docs/px4.md, on fewer episodes)."""
 
 from __future__ import annotations
 

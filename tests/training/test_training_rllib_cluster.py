@@ -1,6 +1,7 @@
-"""The README's Ray cluster commands, run as written on this one machine: a head node, a worker
-node joining it, and train_rllib.py attaching with `--address auto`. Only the scale is cut
-(2 env runners, one small iteration) and the port is a free one; HEAD_IP is this machine."""
+"""The Ray cluster commands of docs/training.md, run as written on this one machine: a head
+node, a worker node joining it, and train_rllib.py attaching with `--address auto`. Only the
+scale is cut (2 env runners, one small iteration) and the port is a free one; HEAD_IP is this
+machine."""
 
 from __future__ import annotations
 
@@ -17,16 +18,16 @@ from pathlib import Path
 import pytest
 from training_support import REPO
 
-# What a laptop-sized run changes in the README's cluster command.
+# What a laptop-sized run changes in the documented cluster command.
 SMALLER = {"--num-env-runners": "2", "--iterations": "1", "--train-batch": "500"}
 # Keep each node small: the machine is shared with the rest of the test run.
 NODE = ["--num-cpus", "1", "--object-store-memory", "100000000", "--node-ip-address", "127.0.0.1"]
 
 
 def readme_cluster_commands() -> list[str]:
-    text = (REPO / "README.md").read_text()
+    text = (REPO / "docs" / "training.md").read_text()
     block = re.search(r"```sh\n(ray start --head.*?)```", text, re.S)
-    assert block, "README.md has no Ray cluster block"
+    assert block, "docs/training.md has no Ray cluster block"
     return [line.split("  #")[0].strip() for line in block.group(1).splitlines() if line.strip()]
 
 

@@ -1,5 +1,5 @@
-"""The README's `tensorboard --logdir runs/hover_ppo/tb` line, run for real: TensorBoard serves
-the logs train_sb3.py writes, with the two curves the README names (rollout/ep_rew_mean,
+"""docs/training.md's `tensorboard --logdir runs/hover_ppo/tb` line, run for real: TensorBoard
+serves the logs train_sb3.py writes, with the two curves the page names (rollout/ep_rew_mean,
 rollout/success_rate)."""
 
 from __future__ import annotations

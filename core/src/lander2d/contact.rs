@@ -1,7 +1,7 @@
-//! Touch-down classification. The reference decided "landed" or "crashed" in Chipmunk's
-//! collision-begin callback, before the solver acted; here the contact appears in rapier's
-//! narrow phase at the start of a physics step and the solver acts on it in that same step,
-//! so the impact is judged on the state the drone had when that step began.
+//! Touch-down classification. The reference (docs/reference/lander2d.md) decided "landed" or
+//! "crashed" in Chipmunk's collision-begin callback, before the solver acted; here the contact
+//! appears in rapier's narrow phase at the start of a physics step and the solver acts on it in
+//! that same step, so the impact is judged on the state the drone had when that step began.
 
 use super::params::Lander2dParams;
 use super::world::DroneState;

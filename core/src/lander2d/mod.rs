@@ -1,5 +1,5 @@
 //! The 2D landing drone of seed 000 on rapier2d, with the reference's numbers and without
-//! its bugs (see shared/reference/lander2d.md).
+//! its bugs (see docs/reference/lander2d.md).
 //!
 //! [`world`] builds the rapier scene, [`model`] steps it (thrust, noise, battery, wind,
 //! moving platform), [`contact`] judges touch-downs, [`params`] holds the parameter tables,

@@ -242,13 +242,13 @@ impl Lander2d {
         self.substep = 0;
     }
 
-    /// Thrust of each motor for the coming period: commanded level times (1 + Gaussian noise
-    /// of relative σ = thrust_noise_std / max_thrust), clipped to [0, max_thrust]; zero once
-    /// the battery is empty. The noise scales with the level so that a stopped motor (command
-    /// −1) gives exactly zero thrust and drains nothing; at full thrust σ is thrust_noise_std,
-    /// the reference's. (The reference added σ at every level: at command −1 its clipped
-    /// noise still pushed ≈ 0.6 N per motor and drained the battery.) The two normal draws
-    /// happen every period, so the stream does not depend on the battery or the command.
+    /// Thrust of each motor for the coming period: commanded level times (1 + Gaussian noise of
+    /// relative σ = thrust_noise_std / max_thrust), clipped to [0, max_thrust]; zero once the
+    /// battery is empty. The noise scales with the level so that a stopped motor (command −1) gives
+    /// exactly zero thrust and drains nothing; at full thrust σ is thrust_noise_std, the
+    /// reference's (docs/reference/lander2d.md). (The reference added σ at every level: at command
+    /// −1 its clipped noise still pushed ≈ 0.6 N per motor and drained the battery.) The two normal
+    /// draws happen every period, so the stream does not depend on the battery or the command.
     fn draw_thrust(&mut self) -> [f64; 2] {
         let p = &self.params;
         let noise = [self.rng.normal(), self.rng.normal()];

@@ -5,7 +5,8 @@ use crate::param;
 use crate::params::{ParamSpec, Parameters};
 use serde::{Deserialize, Serialize};
 
-/// Physical, world and contact parameters. Defaults are the metric reference of seed 000.
+/// Physical, world and contact parameters. Defaults are the metric reference of seed 000
+/// (docs/reference/lander2d.md).
 ///
 /// The drone's three parts follow from `drone_width` (w) and `drone_height` (h): two square
 /// motors of side h centred at x = ±(w − h)/2 and a frame (w − h) × h/2 between them, with

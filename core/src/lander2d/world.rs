@@ -1,6 +1,7 @@
-//! The rapier2d scene of one lander: ground, landing platform and the drone as ONE rigid body
-//! with three colliders. The reference joined three bodies with pivot joints and stayed rigid
-//! only because the parts collided with each other; a single body is rigid by construction.
+//! The rapier2d scene of one lander: ground, landing platform and the drone as ONE rigid body with
+//! three colliders. The reference (docs/reference/lander2d.md) joined three bodies with pivot
+//! joints and stayed rigid only because the parts collided with each other; a single body is rigid
+//! by construction.
 
 use super::params::Lander2dParams;
 use rapier2d_f64::prelude::*;

@@ -1,4 +1,5 @@
-//! The 3D quadrotor of seed 001, with the reference's numbers and without its bugs.
+//! The 3D quadrotor of seed 001, with the reference's numbers and without its bugs (both
+//! listed in docs/reference/quadrotor.md).
 //!
 //! See [`dynamics`] for the equations, [`params`] for the parameter table, [`variables`] for
 //! the table the FMU and the SITL read.

@@ -6,7 +6,8 @@ use crate::param;
 use crate::params::{ParamSpec, Parameters};
 use serde::{Deserialize, Serialize};
 
-/// Physical parameters. Defaults are the reference vehicle of seed 001 (1 kg, 10 cm arms).
+/// Physical parameters. Defaults are the reference vehicle of seed 001 (1 kg, 10 cm arms;
+/// docs/reference/quadrotor.md).
 ///
 /// Units are SI; every field's range is in [`QuadrotorParams::specs`] and enforced by
 /// [`Parameters::validate`].

@@ -11,8 +11,9 @@ use crate::tasks::{Info, InfoValue, clip_f32};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-/// Arguments of a quadrotor flight task (seed 001's DroneEnv). Wind settings (`use_wind`,
-/// `wind_strength_range`) are the model's `wind_enabled` / `wind_speed_min` / `wind_speed_max`.
+/// Arguments of a quadrotor flight task (seed 001's DroneEnv, docs/reference/quadrotor.md). Wind
+/// settings (`use_wind`, `wind_strength_range`) are the model's `wind_enabled` / `wind_speed_min` /
+/// `wind_speed_max`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct FlightParams {

@@ -1,4 +1,5 @@
-//! Hover: fly to a target and hold it (seed 001's DroneEnv), without the reference's bugs.
+//! Hover: fly to a target and hold it (seed 001's DroneEnv), without the reference's bugs
+//! (docs/reference/quadrotor.md).
 //!
 //! Observation (33 × f32, world ENU / body FLU): [0:3] target − position (m), [3:6] velocity
 //! (m/s), [6:9] acceleration = total force / mass (m/s²), [9:13] attitude quaternion w x y z

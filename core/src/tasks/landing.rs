@@ -1,4 +1,5 @@
-//! Landing: bring the Lander2D down onto its platform (seed 000), without the reference's bugs.
+//! Landing: bring the Lander2D down onto its platform (seed 000), without the reference's bugs
+//! (docs/reference/lander2d.md).
 //!
 //! Observation (11 × f32, 12 with a moving platform), each value clipped to [−1, 1] (battery
 //! and distance to [0, 1]), with W, H the world's width and height (50 m by default):

@@ -1,9 +1,9 @@
 //! The Landing task's two rewards, chosen by `LandingParams::reward_version`.
 //!
-//! - **0, `seed`**: the reference's reward, bit for bit ([`seed_step_reward`],
-//!   [`seed_terminal_reward`]). It pays ≈ 2 per step for being near the pad (≈ 2,000 over a
-//!   1,000-step episode) against +100 for landing, so hovering beside the pad until the time
-//!   limit is what a learner finds optimal: it does not teach landing.
+//! - **0, `seed`**: the reference's reward (docs/reference/lander2d.md), bit for bit
+//!   ([`seed_step_reward`], [`seed_terminal_reward`]). It pays ≈ 2 per step for being near the
+//!   pad (≈ 2,000 over a 1,000-step episode) against +100 for landing, so hovering beside the pad
+//!   until the time limit is what a learner finds optimal: it does not teach landing.
 //! - **1, `landing`**: potential-based shaping r = Φ(s′) − Φ(s) (Ng et al. 1999, as gymnasium's
 //!   LunarLander), a small control cost and terminal rewards where landing dominates:
 //!   landed +100; crashed, lost control, battery empty, out of the world and the time limit

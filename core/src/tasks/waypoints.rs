@@ -1,5 +1,6 @@
 //! Waypoints: fly through a sequence of waypoints as fast as possible (seed 001's
-//! SequentialWaypointEnv), paying the checkpoint bonus the reference never paid.
+//! SequentialWaypointEnv, docs/reference/quadrotor.md), paying the checkpoint bonus the reference
+//! never paid.
 //!
 //! Observation (37 × f32 on the motor interface, 20 on the rates interface): the vehicle's
 //! observation with the current waypoint as target ([`super::flight_vehicle`]), then

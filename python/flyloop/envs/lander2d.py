@@ -11,7 +11,8 @@ from .base import FlyloopEnv
 
 
 class Lander2DEnv(FlyloopEnv):
-    """Land a 2D drone with two motors on a platform (seed 000's ``Drone2dEnv``).
+    """Land a 2D drone with two motors on a platform (seed 000's ``Drone2dEnv``, the
+    reference environment described in docs/reference/lander2d.md).
 
     ``gymnasium.make("flyloop/Lander2D-v0")`` (after ``import flyloop``). The physics
     (rapier2d), observation, reward and outcome are computed by flyloop's Rust core inside

@@ -10,7 +10,8 @@ from .base import FlyloopEnv
 
 
 class QuadHoverEnv(FlyloopEnv):
-    """Fly a quadrotor to a target point and hold it there (seed 001's ``DroneEnv``).
+    """Fly a quadrotor to a target point and hold it there (seed 001's ``DroneEnv``, the
+    reference environment described in docs/reference/quadrotor.md).
 
     ``gymnasium.make("flyloop/QuadHover-v0")`` (after ``import flyloop``). The physics,
     observation, reward and termination are computed by flyloop's Rust core inside the

@@ -11,7 +11,7 @@ from .quad_hover import QuadHoverEnv
 
 class QuadWaypointsEnv(QuadHoverEnv):
     """Fly a quadrotor through a sequence of waypoints as fast as possible (seed 001's
-    ``SequentialWaypointEnv``).
+    ``SequentialWaypointEnv``, docs/reference/quadrotor.md).
 
     ``gymnasium.make("flyloop/QuadWaypoints-v0")``. Frames, units, motors, action space,
     starting state and errors are those of ``QuadHoverEnv``.

@@ -12,7 +12,7 @@ import numpy as np
 
 from .scene import LanderScene, QuadScene
 
-# Observation slices of the Hover and Waypoints tasks (shared/reference/quadrotor.md).
+# Observation slices of the Hover and Waypoints tasks (docs/reference/quadrotor.md).
 _VELOCITY, _QUATERNION, _RATES = slice(3, 6), slice(9, 13), slice(13, 16)
 _WIND, _MOTORS = slice(22, 25), slice(25, 29)
 _LANDER_OUTCOMES = (

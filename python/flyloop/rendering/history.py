@@ -45,7 +45,8 @@ class FlightPath:
 
 class Shades:
     """Poses where the drone left a shade: the first pose of the episode, then every time it
-    is more than `spacing_m` away from the last shade (the reference's shade_distance_m)."""
+    is more than `spacing_m` away from the last shade (the reference's shade_distance_m,
+    docs/reference/lander2d.md)."""
 
     def __init__(self, spacing_m: float = 2.0, max_shades: int = 500) -> None:
         if not spacing_m > 0:

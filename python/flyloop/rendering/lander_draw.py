@@ -33,7 +33,7 @@ TEXT = (15, 15, 25)
 GOOD = (0, 140, 0)
 BAD = (200, 0, 0)
 
-THRUST_BAR_PX = 40  # length of a full-thrust bar over a motor, as the reference
+THRUST_BAR_PX = 40  # a full-thrust bar's length, as the reference (docs/reference/lander2d.md)
 
 
 def background(p: Painter, plane: PlaneView, s: LanderScene) -> None:
