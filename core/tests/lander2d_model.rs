@@ -492,10 +492,10 @@ fn garbage_restore_bytes_are_an_error() {
 }
 
 #[test]
-fn physics_substeps_refine_the_same_flight() {
-    let run = |substeps| {
+fn a_finer_physics_step_refines_the_same_flight() {
+    let run = |physics_step| {
         let p = Lander2dParams {
-            physics_substeps: substeps,
+            physics_step,
             ..quiet()
         };
         let mut l = lander(p, at(25.0, 30.0));
@@ -505,7 +505,7 @@ fn physics_substeps_refine_the_same_flight() {
         }
         l.drone()
     };
-    let (one, four) = (run(1), run(4));
+    let (one, four) = (run(0.02), run(0.005));
     // One second of a gentle turn: the two integrations agree to a few centimetres.
     assert!(
         (one.x - four.x).abs() < 0.05 && (one.y - four.y).abs() < 0.05,

@@ -235,8 +235,12 @@ fn a_negative_mass_is_refused_naming_the_parameter_and_its_bound() {
     let lander = Fmu::new(Model::Lander2D);
     assert_eq!(lander.set("drone_mass", -1.0), fmi2Error);
     assert!(lander.last_message().contains("`drone_mass` = -1 kg"));
-    assert_eq!(lander.set("physics_substeps", 0.0), fmi2Error);
-    assert!(lander.last_message().contains("`physics_substeps` = 0"));
+    assert_eq!(lander.set("physics_step", 0.0), fmi2Error);
+    assert!(
+        lander
+            .last_message()
+            .contains("`physics_step` = 0 s is out of range: it must be in [0.0001, 1] s")
+    );
     assert_eq!(lander.set("wind_speed", 101.0), fmi2Error);
     // Relations between parameters are checked too.
     assert_eq!(fmu.set("wind_speed_min", 8.0), fmi2Error);

@@ -28,21 +28,30 @@ pub struct Lander2d {
     /// The episode's constant wind force, N (derived from `params` and `draws`).
     wind_force: [f64; 2],
     draws: EpisodeDraws,
-    /// Thrust of each motor during the last control period, N.
+    /// Thrust of each motor during the last physics step (or piece of one), N.
     thrust: [f64; 2],
+    /// The current physics grid step's two normal draws of thrust noise.
+    noise: [f64; 2],
+    /// Whether the battery held charge at the start of the current grid step: its thrust
+    /// flows for the whole grid step (the drain is taken at the start).
+    powered: bool,
     battery: f64,
     /// +1 or −1: where a moving platform is heading.
     platform_direction: f64,
     /// Mean acceleration over the last control period, m/s².
     acceleration: [f64; 2],
     contact: ContactState,
-    /// Control periods since the start.
+    /// Control periods completed since the start.
     steps: u64,
-    /// Physics substeps done in the current control period, in [0, physics_substeps).
-    substep: u32,
-    /// Time into the current physics substep, s: 0 on the substep grid, more after a
-    /// shortened physics step that stopped at a communication point inside a substep.
+    /// Whole physics grid steps done since the start.
+    grid_steps: u64,
+    /// Time into the current physics grid step, s, in [0, physics_step): 0 on the grid, more
+    /// after a shortened physics step that stopped inside a grid step (a communication point
+    /// or a control period end off the grid).
     partial: f64,
+    /// Whether the current control period has begun (its start velocity taken, its contact
+    /// flags cleared); false on a period boundary.
+    period_begun: bool,
     /// Drone velocity at the start of the current control period, m/s (for `acceleration`).
     period_start_velocity: [f64; 2],
 }
@@ -117,12 +126,15 @@ impl Lander2d {
             wind_force,
             draws,
             thrust: [0.0; 2],
+            noise: [0.0; 2],
+            powered: false,
             platform_direction,
             acceleration: [0.0; 2],
             contact: ContactState::default(),
             steps: 0,
-            substep: 0,
+            grid_steps: 0,
             partial: 0.0,
+            period_begun: false,
             period_start_velocity: [0.0; 2],
         }
     }
@@ -147,66 +159,92 @@ impl Lander2d {
         Ok(())
     }
 
-    /// Advances to the end of the current control period (`params.dt`; a whole period from a
-    /// period boundary): the period's thrust noise and battery drain at its start, then
-    /// `physics_substeps` physics steps, classifying contacts after each.
+    /// Advances to the end of the current control period, `(steps + 1) · dt` (a whole
+    /// period from a period boundary), on the physics grid (see [`Lander2d::advance_to`]).
     pub fn step(&mut self) {
         let end = (self.steps + 1) as f64 * self.params.dt;
         self.advance_to(end);
     }
 
-    /// Advances to `time` seconds since the start, so that the state is the state at `time`:
-    /// whole physics substeps on the grid `k · dt / physics_substeps`, and a shortened
-    /// physics step for the last piece when `time` falls inside a substep (the rest of that
-    /// substep follows on the next call). Thrust noise and battery drain stay on the control
-    /// period grid. A `time` at or before now does nothing.
+    /// Advances to `time` seconds since the start, so that the state is the state at `time`.
+    ///
+    /// The physics lives on the fixed grid k · `physics_step` from the start, independent of
+    /// `dt`: one rapier step per grid interval, the thrust noise drawn and the battery
+    /// drained (thrust × rate × physics_step) at the start of each. A step is cut at the
+    /// grid points, at the control period ends k · `dt` and at `time`; so every `time`
+    /// sequence and every `dt` on the grid integrates the same intervals and gives the same
+    /// bits at the shared times. A cut inside a grid interval is a shortened rapier step and
+    /// the rest of the interval follows as another (the path then differs from a gridded one
+    /// by the integrator's error). The thrust of each piece is the command in effect with the
+    /// grid step's noise, so a command changed inside a grid step acts for the rest of it.
+    /// Points within 1e-6 of the smaller of the two grids count as on them. A `time` at or
+    /// before now does nothing.
     pub fn advance_to(&mut self, time: f64) {
-        let n = self.params.physics_substeps;
-        let substep = self.params.dt / f64::from(n);
-        let slack = GRID_SLACK * substep;
+        let grid = self.params.physics_step;
+        let slack = GRID_SLACK * grid.min(self.params.dt);
         loop {
-            let remaining = time - self.time();
+            let now = self.time();
+            let remaining = time - now;
             if remaining.is_nan() || remaining <= slack {
                 return;
             }
-            if self.substep == 0 && self.partial == 0.0 {
+            if self.partial == 0.0 {
+                self.begin_grid_step();
+            }
+            if !self.period_begun {
                 self.begin_period();
             }
-            let rest = substep - self.partial;
-            if remaining >= rest - slack {
+            let to_grid = grid - self.partial;
+            let to_period = (self.steps + 1) as f64 * self.params.dt - now;
+            if remaining >= to_grid - slack && to_period >= to_grid - slack {
                 // On the grid from a grid point: the world's own step, the same bits as a
                 // run that never stopped in between.
-                let length = (self.partial != 0.0).then_some(rest);
+                let length = (self.partial != 0.0).then_some(to_grid);
                 self.physics_step(length);
                 self.partial = 0.0;
-                self.substep += 1;
-                if self.substep == n {
+                self.grid_steps += 1;
+                if to_period <= to_grid + slack {
                     self.end_period();
                 }
             } else {
-                self.physics_step(Some(remaining));
-                self.partial += remaining;
+                let piece = remaining.min(to_period);
+                self.physics_step(Some(piece));
+                self.partial += piece;
+                if to_period <= piece + slack {
+                    self.end_period();
+                }
             }
         }
     }
 
-    /// The start of a control period: the period's thrust (with noise) and battery drain.
-    fn begin_period(&mut self) {
-        self.thrust = self.draw_thrust();
+    /// The start of a physics grid step: its thrust noise and the battery's drain.
+    fn begin_grid_step(&mut self) {
+        // The two normal draws happen every grid step, so the stream does not depend on the
+        // battery or the command.
+        self.noise = [self.rng.normal(), self.rng.normal()];
+        self.powered = self.battery > 0.0;
+        self.thrust = self.current_thrust();
         if self.battery > 0.0 {
             let drain = (self.thrust[0] + self.thrust[1])
                 * self.params.battery_consumption_rate
-                * self.params.dt;
+                * self.params.physics_step;
             self.battery = (self.battery - drain).max(0.0);
         }
+    }
+
+    /// The start of a control period: the velocity its mean acceleration is measured from;
+    /// its contact flags start clear.
+    fn begin_period(&mut self) {
         let v0 = self.drone_body().linvel();
         self.period_start_velocity = [v0.x, v0.y];
         self.contact.begin_period();
+        self.period_begun = true;
     }
 
-    /// One physics step of the world's substep length, or of `length` seconds (a piece of a
-    /// substep), with the contacts classified after it.
+    /// One physics step of the grid's length, or of `length` seconds (a piece of a grid
+    /// step), under the current command, with the contacts classified after it.
     fn physics_step(&mut self, length: Option<f64>) {
+        self.thrust = self.current_thrust();
         self.apply_forces();
         let before = self.drone();
         let platform_vx = self.platform_vx();
@@ -239,26 +277,25 @@ impl Lander2d {
             (v1.y - v0[1]) / self.params.dt,
         ];
         self.steps += 1;
-        self.substep = 0;
+        self.period_begun = false;
     }
 
-    /// Thrust of each motor for the coming period: commanded level times (1 + Gaussian noise of
-    /// relative σ = thrust_noise_std / max_thrust), clipped to [0, max_thrust]; zero once the
-    /// battery is empty. The noise scales with the level so that a stopped motor (command −1) gives
-    /// exactly zero thrust and drains nothing; at full thrust σ is thrust_noise_std, the
-    /// reference's (docs/reference/lander2d.md). (The reference added σ at every level: at command
-    /// −1 its clipped noise still pushed ≈ 0.6 N per motor and drained the battery.) The two normal
-    /// draws happen every period, so the stream does not depend on the battery or the command.
-    fn draw_thrust(&mut self) -> [f64; 2] {
+    /// Thrust of each motor now: commanded level times (1 + the grid step's Gaussian noise of
+    /// relative σ = thrust_noise_std / max_thrust), clipped to [0, max_thrust]; zero when the
+    /// battery was empty at the grid step's start. The noise scales with the level so that a
+    /// stopped motor (command −1) gives exactly zero thrust and drains nothing; at full
+    /// thrust σ is thrust_noise_std, the reference's. (The reference added σ at every level:
+    /// at command −1 its clipped noise still pushed ≈ 0.6 N per motor and drained the
+    /// battery.)
+    fn current_thrust(&self) -> [f64; 2] {
         let p = &self.params;
-        let noise = [self.rng.normal(), self.rng.normal()];
-        if self.battery <= 0.0 || p.max_thrust <= 0.0 {
+        if !self.powered || p.max_thrust <= 0.0 {
             return [0.0; 2];
         }
         let relative_std = p.thrust_noise_std / p.max_thrust;
         [0, 1].map(|i| {
             let level = (self.command[i] + 1.0) / 2.0 * p.max_thrust;
-            (level * (1.0 + relative_std * noise[i])).clamp(0.0, p.max_thrust)
+            (level * (1.0 + relative_std * self.noise[i])).clamp(0.0, p.max_thrust)
         })
     }
 
@@ -341,7 +378,7 @@ impl Lander2d {
         self.external_wind_force
     }
 
-    /// Thrust of each motor (left, right) during the last period, N.
+    /// Thrust of each motor (left, right) during the last physics step, N.
     pub fn thrust(&self) -> [f64; 2] {
         self.thrust
     }
@@ -379,25 +416,20 @@ impl Lander2d {
         !(d.x > 0.0 && d.x < p.world_width && d.y > 0.0 && d.y < p.world_height)
     }
 
-    /// Control periods since the start.
+    /// Control periods completed since the start.
     pub fn steps(&self) -> u64 {
         self.steps
     }
 
-    /// Simulated time since the start, s: whole periods n · dt (never accumulated), plus
-    /// the substeps and the piece of a substep done in the current period.
+    /// Simulated time since the start, s: whole grid steps k · physics_step (never
+    /// accumulated), plus the piece of a grid step done since the last grid point.
     pub fn time(&self) -> f64 {
-        let periods = self.steps as f64 * self.params.dt;
-        if self.substep == 0 && self.partial == 0.0 {
-            return periods;
-        }
-        let substep = self.params.dt / f64::from(self.params.physics_substeps);
-        periods + f64::from(self.substep) * substep + self.partial
+        self.grid_steps as f64 * self.params.physics_step + self.partial
     }
 
     /// Whether the instance stands on a control period boundary.
     pub fn at_period_boundary(&self) -> bool {
-        self.substep == 0 && self.partial == 0.0
+        !self.period_begun
     }
 
     /// The parameters in force.
@@ -417,12 +449,25 @@ impl Lander2d {
     /// first step the start follows the new parameters (platform start, battery charge, from
     /// the same random draws); after it, the scene keeps its state (drone pose and velocities,
     /// platform position and heading, battery, RNG).
+    /// `dt` and `physics_step` fix the clock, so they change only before the first step.
     pub fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), ParamError> {
         let mut params = self.params.clone();
         params.set(name, value)?;
         let drone = self.drone();
         check_start(&drone)?;
-        let fresh = self.steps == 0 && self.at_period_boundary();
+        let fresh = self.time() == 0.0;
+        if !fresh
+            && (params.dt != self.params.dt || params.physics_step != self.params.physics_step)
+        {
+            return Err(ParamError::Relation {
+                name: if params.dt != self.params.dt {
+                    "dt"
+                } else {
+                    "physics_step"
+                },
+                requirement: "dt and physics_step can change only before the first step (they fix the instance's clock)".into(),
+            });
+        }
         let platform_x = if fresh {
             self.platform_direction = self.draws.platform_heading;
             self.battery = params.initial_battery;
@@ -473,11 +518,13 @@ impl EpisodeDraws {
     }
 }
 
-/// Format tag of a Lander2d snapshot (name and version).
-const SNAPSHOT_TAG: &[u8; 8] = b"FLYL2D02";
+/// Format tag of a Lander2d snapshot (name and version; 03 put the physics on its own grid:
+/// whole grid steps, the grid step's noise draws and charge, whether a period has begun).
+const SNAPSHOT_TAG: &[u8; 8] = b"FLYL2D03";
 
-/// How far a communication point may miss the physics substep grid and still count as on
-/// it, as a fraction of a substep: t0 + n·h and k · dt agree only up to rounding.
+/// How far a communication point may miss a grid point (of the physics grid or of the
+/// control periods) and still count as on it, as a fraction of the smaller grid step:
+/// t0 + n·h, k · dt and k · physics_step agree only up to rounding.
 const GRID_SLACK: f64 = 1e-6;
 
 impl Lander2d {
@@ -519,18 +566,16 @@ impl Lander2d {
         .chain(lander.external_wind_force)
         .chain(lander.wind_force)
         .chain(lander.thrust)
+        .chain(lander.noise)
         .chain(lander.period_start_velocity);
         if numbers.into_iter().any(|v| !v.is_finite()) {
             return Err(SnapshotError::Invalid(
                 "a command, force or the battery is not finite".into(),
             ));
         }
-        let substep = lander.params.dt / f64::from(lander.params.physics_substeps);
-        if lander.substep >= lander.params.physics_substeps
-            || !(0.0..substep).contains(&lander.partial)
-        {
+        if !(0.0..lander.params.physics_step).contains(&lander.partial) {
             return Err(SnapshotError::Invalid(
-                "the position inside the control period is off its grid".into(),
+                "the time inside the physics grid step is off its grid".into(),
             ));
         }
         Ok(())

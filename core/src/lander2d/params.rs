@@ -73,11 +73,15 @@ pub struct Lander2dParams {
     pub max_safe_landing_speed: f64,
     /// Largest |angle| at first platform contact for a safe landing, rad. Default 0.2.
     pub max_safe_landing_angle: f64,
-    /// Control period: commands, thrust noise and battery update once per period, s.
-    /// Default 0.02 (50 Hz).
+    /// Control period, s: what `Lander2d::step` advances by and what the mean acceleration
+    /// is measured over. Default 0.02 (50 Hz).
     pub dt: f64,
-    /// Physics steps per control period. Default 1 (as the reference).
-    pub physics_substeps: u32,
+    /// Physics step, s: rapier steps on the fixed grid k·physics_step from the start, with
+    /// the thrust noise drawn and the battery drained once per grid step, independent of
+    /// `dt`; so every `dt` or communication step that is a multiple of it gives the same bits
+    /// at the shared times. Default 0.02 (one physics step per control period, as the
+    /// reference).
+    pub physics_step: f64,
 }
 
 impl Default for Lander2dParams {
@@ -111,7 +115,7 @@ impl Default for Lander2dParams {
             max_safe_landing_speed: 1.5,
             max_safe_landing_angle: 0.2,
             dt: 0.02,
-            physics_substeps: 1,
+            physics_step: 0.02,
         }
     }
 }
@@ -148,8 +152,8 @@ static LANDER_SPECS: [ParamSpec<Lander2dParams>; 29] = [
     param!(real platform_speed, "m/s", 0.0, 100.0, "Platform speed when moving"),
     param!(real max_safe_landing_speed, "m/s", 0.0, 100.0, "Largest speed relative to the platform at first contact for a safe landing"),
     param!(real max_safe_landing_angle, "rad", 0.0, PI, "Largest |angle| at first platform contact for a safe landing"),
-    param!(real dt, "s", 1e-4, 1.0, "Control period (commands, thrust noise, battery)"),
-    param!(integer physics_substeps, "", 1, 1000, "Physics steps per control period"),
+    param!(real dt, "s", 1e-4, 1.0, "Control period (what a step advances by; the mean acceleration's window)"),
+    param!(real physics_step, "s", 1e-4, 1.0, "Physics grid step: rapier steps, thrust noise and battery drain on the absolute grid k*physics_step, so any multiple of it as step size gives the same bits"),
 ];
 
 fn relation(name: &'static str, requirement: String) -> ParamError {
@@ -322,15 +326,11 @@ mod tests {
             ("dt", 0.0, "parameter `dt` = 0 s is out of range"),
             ("dt", -0.02, "`dt` = -0.02 s"),
             (
-                "physics_substeps",
+                "physics_step",
                 0.0,
-                "`physics_substeps` = 0 is out of range",
+                "parameter `physics_step` = 0 s is out of range: it must be in [0.0001, 1] s",
             ),
-            (
-                "physics_substeps",
-                2.5,
-                "`physics_substeps` = 2.5 is not an integer",
-            ),
+            ("physics_step", 2.0, "`physics_step` = 2 s is out of range"),
             ("gravity", f64::NAN, "`gravity` = NaN"),
             ("max_thrust", f64::INFINITY, "`max_thrust` = inf"),
             ("wind_direction", 7.0, "`wind_direction` = 7 rad"),
@@ -392,10 +392,13 @@ mod tests {
             Lander2dParams::from_toml_str("moving_platform = true\nplatform_speed = 2.5").unwrap();
         assert!(p.moving_platform);
         assert_eq!(p.platform_speed, 2.5);
-        let p = Lander2dParams::from_json_str(r#"{"wind_enabled": false, "physics_substeps": 4}"#)
+        let p = Lander2dParams::from_json_str(r#"{"wind_enabled": false, "physics_step": 0.005}"#)
             .unwrap();
         assert!(!p.wind_enabled);
-        assert_eq!(p.physics_substeps, 4);
+        assert_eq!(p.physics_step, 0.005);
+        // The old parameter is gone by name, not silently ignored.
+        let e = Lander2dParams::from_toml_str("physics_substeps = 4").unwrap_err();
+        assert_eq!(e.to_string(), "unknown parameter `physics_substeps`");
         let e = Lander2dParams::from_toml_str("drone_mas = 2").unwrap_err();
         assert_eq!(e.to_string(), "unknown parameter `drone_mas`");
         let e = Lander2dInitial::from_toml_str("seed = -1").unwrap_err();

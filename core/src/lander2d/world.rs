@@ -72,7 +72,7 @@ pub(crate) fn build(
 ) -> (PhysicsWorld, Handles) {
     let mut world = PhysicsWorld::new();
     world.gravity = Vector::new(0.0, -p.gravity);
-    world.integration_parameters.dt = p.dt / f64::from(p.physics_substeps);
+    world.integration_parameters.dt = p.physics_step;
     // Recycled contacts may be up to 5 cm stale; touch-down classification needs fresh ones,
     // and with six candidate pairs the full update costs next to nothing.
     world.integration_parameters.contact_recycling = false;

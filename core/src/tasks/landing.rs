@@ -237,7 +237,8 @@ impl Landing {
     }
 }
 
-const SNAPSHOT_TAG: &[u8; 8] = b"FLYLND01";
+/// Format tag of a Landing snapshot (02: its lander is a FLYL2D03 one, on its physics grid).
+const SNAPSHOT_TAG: &[u8; 8] = b"FLYLND02";
 
 /// The seed's per-step reward on normalised observation values (module docs).
 pub use landing_reward::seed_step_reward as shaping_reward;

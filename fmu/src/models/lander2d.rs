@@ -1,7 +1,8 @@
 //! The lander behind Lander2D.fmu. A communication step to time t leaves the core in its
-//! state at t (`Lander2d::advance_to`): whole physics substeps on the grid
-//! `start_time + k·dt/physics_substeps`, and a shortened physics step when t falls inside a
-//! substep. Thrust noise and battery drain stay on the control period grid `k·dt`.
+//! state at t (`Lander2d::advance_to`): whole rapier steps on the fixed physics grid
+//! `start_time + k·physics_step` (thrust noise and battery drain once per grid step), and a
+//! shortened rapier step when t falls inside a grid step; so every communication step size
+//! that is a multiple of `physics_step` gives the same bits at the shared times.
 
 use crate::model::{FmuModel, ModelInfo, ModelTable, StepRequest};
 use flyloop_core::lander2d::{Lander2d, Lander2dInitial};
@@ -53,10 +54,11 @@ impl FmuModel for Lander2d {
     }
 
     fn internal_steps(&self, step: &StepRequest) -> f64 {
-        // Physics steps to go: whole substeps plus at most two pieces of one.
-        let substep = self.params().dt / f64::from(self.params().physics_substeps);
-        let ahead = (step.end_time - step.start_time - self.time()) / substep;
-        ahead.max(0.0).ceil() + 2.0
+        // Physics steps to go: whole grid steps, one more cut per control period end, and
+        // at most two pieces of a grid step.
+        let p = self.params();
+        let ahead = (step.end_time - step.start_time - self.time()).max(0.0);
+        (ahead / p.physics_step).ceil() + (ahead / p.dt).ceil() + 2.0
     }
 
     fn advance(&mut self, step: &StepRequest) {

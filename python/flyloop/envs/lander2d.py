@@ -87,7 +87,12 @@ class Lander2DEnv(FlyloopEnv):
 
     ## Arguments
 
-    - ``max_steps=1000``, ``dt=0.02`` (s, 50 Hz control).
+    - ``max_steps=1000``, ``dt=0.02`` (s, 50 Hz control). The physics runs on its own fixed
+      grid, core parameter ``physics_step`` (default 0.02 s, one physics step per env step;
+      set it through ``model_params``): rapier steps, thrust noise and battery drain once per
+      grid step, so every ``dt`` that is a multiple of it gives the same bits at the shared
+      times (``model_params={"physics_step": 0.005}`` with ``dt=0.01`` or ``0.02``); a ``dt``
+      that is not ends each step in a shortened physics step (docs/reference/lander2d.md).
     - ``moving_platform=False``, ``platform_speed=1.5`` (m/s),
       ``platform_random_start_x=False``.
     - ``initial_pos_random_range_m=5.0`` (0 = fixed start at (spawn_x, spawn_y)),
