@@ -33,7 +33,7 @@ from .envs.quad_hover import QuadHoverEnv
 from .envs.quad_waypoints import QuadWaypointsEnv
 from .spaces import FastBox
 from .tasks import TaskSpec, resolve_config
-from .vector_infos import InfoColumns, task_arguments
+from .vector_infos import InfoColumns, vector_task_arguments
 
 
 def _count(name: str, value: Any) -> int:
@@ -90,9 +90,7 @@ class FlyloopVectorEnv(VectorEnv):
             raise ValueError(
                 "the flyloop vector envs do not render; use a single env with render_mode"
             )
-        self.config = resolve_config(
-            spec, task_arguments(spec, self.SINGLE, arguments), model_params
-        )
+        self.config = resolve_config(spec, vector_task_arguments(spec, arguments), model_params)
         self.core = spec.describe(self.config)
         self.render_mode = None
         self.single_observation_space, self.single_action_space = spaces_of(self.core)

@@ -3,6 +3,7 @@ one datagram per step; or the core in-process), seeding, the info dict and rende
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Mapping
 from typing import Any
 
@@ -13,8 +14,10 @@ from ..backends import check_backend, make_backend
 from ..sitl_process import SitlProcess
 from ..spaces import FastBox
 from ..tasks import TaskSpec, resolve_config
+from ..tasks import task_arguments as task_arguments_of
 
 SEED_LIMIT = 2**64
+KEYWORD_ONLY = inspect.Parameter.KEYWORD_ONLY
 
 
 def check_seed(seed: Any) -> int:
@@ -53,6 +56,33 @@ def spaces_of(description: Mapping[str, Any]) -> tuple[gym.spaces.Box, FastBox]:
     return observation, action
 
 
+def env_signature(cls: type) -> inspect.Signature:
+    """An env class's signature: its task arguments (keyword-only, the core's defaults), then
+    the env's own keyword arguments (those of every `__init__` along the class's bases)."""
+    spec = cls.SPEC
+    defaults = spec.argument_defaults()
+    task = [
+        inspect.Parameter(a.name, KEYWORD_ONLY, default=defaults[a.name], annotation=a.annotation)
+        for a in spec.arguments
+    ]
+    own = {}
+    for base in cls.__mro__:
+        if "__init__" in base.__dict__ and issubclass(base, FlyloopEnv):
+            for p in inspect.signature(base.__init__, eval_str=True).parameters.values():
+                if p.name != "self" and p.kind is not inspect.Parameter.VAR_KEYWORD:
+                    own.setdefault(p.name, p.replace(kind=KEYWORD_ONLY))
+    return inspect.Signature([*task, *own.values()])
+
+
+def arguments_doc(spec: TaskSpec) -> str:
+    """The docstring section listing the task arguments with the core's defaults."""
+    defaults = spec.argument_defaults()
+    lines = [f"    - ``{a.name}={defaults[a.name]!r}``: {a.doc}" for a in spec.arguments]
+    return (
+        "\n\n    ## Task arguments (from the core's parameter table)\n\n" + "\n".join(lines) + "\n"
+    )
+
+
 class FlyloopEnv(gym.Env):
     """Base of the flyloop envs (see QuadHoverEnv, QuadWaypointsEnv, Lander2DEnv)."""
 
@@ -62,17 +92,23 @@ class FlyloopEnv(gym.Env):
     _backend = None
     _view = None
 
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        if "SPEC" in cls.__dict__:
+            cls.__signature__ = env_signature(cls)
+            cls.__doc__ = (cls.__doc__ or "") + arguments_doc(cls.SPEC)
+
     def __init__(
         self,
         *,
-        arguments: Mapping[str, Any],
-        model_params: Mapping[str, Any] | None,
-        render_mode: str | None,
-        sitl_path: Any,
-        sitl_address: Any,
-        vehicle: int,
-        timeout: float,
+        render_mode: str | None = None,
+        model_params: Mapping[str, Any] | None = None,
+        sitl_path: str | None = None,
+        sitl_address: Any = None,
+        vehicle: int = 1,
+        timeout: float = 5.0,
         backend: str = "sitl",
+        **task_arguments: Any,
     ) -> None:
         spec = self.SPEC
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -85,6 +121,7 @@ class FlyloopEnv(gym.Env):
             raise ValueError(f"timeout must be a number of seconds > 0, got {timeout!r}")
         self._view = None
         self.render_mode = render_mode
+        arguments = task_arguments_of(spec, task_arguments, f"{type(self).__name__}()")
         self.config = resolve_config(spec, arguments, model_params)
         check_backend(backend, sitl_path, sitl_address)
         self.core = spec.describe(self.config)
