@@ -336,6 +336,15 @@ def task_arguments(spec: TaskSpec, arguments: Mapping[str, Any], who: str) -> di
     return {**defaults, **arguments}
 
 
+def observation_slices(description: Mapping[str, Any]) -> dict[str, slice]:
+    """Group name -> its slice of the observation, from a `describe` result's layout."""
+    out, at = {}, 0
+    for name, count in description["observation"]:
+        out[name] = slice(at, at + count)
+        at += count
+    return out
+
+
 def parameter_values(description: Mapping[str, Any]) -> dict[str, float]:
     """Core name -> value in effect, from a `TaskSpec.describe` result."""
     return {p["name"]: p["value"] for p in description["parameters"]}

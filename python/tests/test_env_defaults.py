@@ -1,17 +1,19 @@
-"""The envs' task arguments come from the core's parameter table: every default equals the
-core's default of the parameters it sets, every task parameter is an argument (or fixed by
-the env id), and the signature, the vector env and the docstring show those defaults."""
+"""The envs read the core's tables. Task arguments: every default equals the core's default
+of the parameters it sets, every task parameter is an argument (or fixed by the env id), and
+the signature, the vector env and the docstring show those defaults. Observation layout:
+the core's groups cover the observation and name what each part holds."""
 
 from __future__ import annotations
 
 import inspect
 
 import gymnasium as gym
+import numpy as np
 import pytest
 
 import flyloop  # noqa: F401  (registers the ids)
 from flyloop.envs import Lander2DEnv, Lander2DLandingEnv, QuadHoverEnv, QuadWaypointsEnv
-from flyloop.tasks import resolve_config
+from flyloop.tasks import observation_slices, resolve_config
 
 ENVS = [QuadHoverEnv, QuadWaypointsEnv, Lander2DEnv, Lander2DLandingEnv]
 
@@ -57,3 +59,33 @@ def test_the_docstring_lists_the_arguments_with_the_cores_defaults_and_units():
     assert "- ``crash_tilt_threshold=80.0``: Crash beyond this |roll| or |pitch| (deg)" in doc
     assert "- ``wind_strength_range=(0.0, 5.0)``:" in doc
     assert "- ``wind_direction=None``:" in Lander2DEnv.__doc__
+
+
+@pytest.mark.parametrize(
+    "env_id, kwargs",
+    [
+        ("flyloop/QuadHover-v0", {}),
+        ("flyloop/QuadHover-v0", {"action_interface": "rates"}),
+        ("flyloop/QuadWaypoints-v0", {}),
+        ("flyloop/Lander2D-v1", {}),
+        ("flyloop/Lander2D-v1", {"moving_platform": True}),
+    ],
+)
+def test_the_observation_layout_covers_the_observation_and_names_its_parts(env_id, kwargs):
+    env = gym.make(env_id, backend="native", **kwargs).unwrapped
+    try:
+        at = observation_slices(env.core)
+        sizes = [s.stop - s.start for s in at.values()]
+        assert sum(sizes) == env.observation_space.shape[0] and min(sizes) >= 1
+        obs, info = env.reset(seed=4)
+        obs, *_, info = env.step(env.action_space.sample())
+        if "quaternion" in at:
+            assert np.linalg.norm(obs[at["quaternion"]]) == pytest.approx(1.0, abs=1e-5)
+            assert ((obs[at["motor_states"]] >= 0) & (obs[at["motor_states"]] <= 1)).all()
+        if "target_offset" in at and "quaternion" in at:  # world frame (motor interface)
+            offset = np.asarray(info["target_position"]) - np.asarray(info["position"])
+            np.testing.assert_allclose(obs[at["target_offset"]], offset, atol=1e-4)
+        if "platform_velocity" in at:
+            assert at["platform_velocity"].start == 11
+    finally:
+        env.close()

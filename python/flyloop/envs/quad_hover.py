@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..tasks import HOVER, parameter_values
+from ..tasks import HOVER
 from .base import FlyloopEnv
 
 
@@ -121,14 +121,6 @@ class QuadHoverEnv(FlyloopEnv):
     def _scene(self, obs, info, reward):
         from ..rendering import quad_scene
 
-        values = parameter_values(self.core)
-        side = float(values["space_side_length"])
-        arm = float(values["arm_length"])
         return quad_scene(
-            obs,
-            info,
-            reward=reward,
-            episode_return=self._episode_return,
-            bounds_half_size=side / 2.0,
-            arm_length=arm,
+            obs, info, reward=reward, episode_return=self._episode_return, core=self.core
         )

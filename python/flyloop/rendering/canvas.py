@@ -315,6 +315,11 @@ class Painter:
         self.pg.draw.rect(self.surface, (10, 10, 20), rect, 1)
 
 
+def vector(value: Any) -> np.ndarray:
+    """`value` as a flat float64 array (a copy)."""
+    return np.array(value, dtype=float).reshape(-1)
+
+
 def rotate2d(points: np.ndarray, angle: float) -> np.ndarray:
     """Rotate (N, 2) points counter-clockwise by angle radians."""
     c, s = math.cos(angle), math.sin(angle)
@@ -379,3 +384,44 @@ class Shades:
     def poses(self) -> list[tuple[float, float, float]]:
         """(x m, y m, angle rad) of each shade, oldest first."""
         return list(self._poses)
+
+
+class View:
+    """What both views share: a Screen and its Painter, the scene type they draw, closing.
+    pygame is imported by the constructor, not before."""
+
+    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 50}
+    SCENE: type
+
+    def __init__(self, render_mode: str, size: tuple[int, int], caption: str, fps: float) -> None:
+        self.render_mode = check_render_mode(render_mode)
+        self._screen = Screen(render_mode, size, caption, fps)
+        self._painter = Painter(self._screen.pg, self._screen.surface)
+        self._closed = False
+
+    @property
+    def size(self) -> tuple[int, int]:
+        """(width, height) in pixels."""
+        return self._screen.size
+
+    @property
+    def is_open(self) -> bool:
+        """False once closed, by close() or by the user closing the window."""
+        return self._screen.is_open
+
+    def _events(self, scene: Any) -> list[Any] | None:
+        """This frame's window events; None when the user closed the window."""
+        name = type(self).__name__
+        if self._closed:
+            raise RuntimeError(f"this {name} is closed; create a new one to render again")
+        if not isinstance(scene, self.SCENE):
+            raise TypeError(
+                f"{name}.render needs a {self.SCENE.__name__}, got {type(scene).__name__}"
+            )
+        events = self._screen.poll_events()
+        return events if self._screen.is_open else None
+
+    def close(self) -> None:
+        """Close the window (if any). Safe to call more than once."""
+        self._closed = True
+        self._screen.close()

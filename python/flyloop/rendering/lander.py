@@ -12,37 +12,26 @@ from typing import Any
 
 import numpy as np
 
-from ..tasks import LANDING
-from .canvas import FlightPath, Painter, Screen, Shades, check_render_mode, rotate2d
+from .. import _native
+from ..tasks import LANDING, observation_slices
+from .canvas import FlightPath, Painter, Shades, View, check_render_mode, rotate2d, vector
 
-SKY_TOP = (196, 220, 246)
-SKY_BOTTOM = (226, 238, 250)
-OUTSIDE = (120, 130, 145)
-GROUND = (96, 148, 82)
-GROUND_EDGE = (62, 112, 58)
-BOUNDS = (200, 70, 70)
-SPAWN = (178, 160, 80)
-PLATFORM = (150, 150, 170)
-PLATFORM_EDGE = (50, 50, 60)
-PLATFORM_TOP = (245, 200, 40)
-FRAME = (52, 72, 168)
-MOTOR = (36, 48, 120)
-OUTLINE = (10, 10, 20)
-SHADE = (70, 90, 180)
-PATH = (16, 19, 97)
-SENSOR = (230, 120, 20)
-THRUST_TRACK = (170, 170, 170)
-THRUST = (235, 50, 50)
-WIND = (50, 50, 200)
-TEXT = (15, 15, 25)
-GOOD = (0, 140, 0)
-BAD = (200, 0, 0)
+SKY_TOP, SKY_BOTTOM, OUTSIDE = (196, 220, 246), (226, 238, 250), (120, 130, 145)
+GROUND, GROUND_EDGE, BOUNDS, SPAWN = (96, 148, 82), (62, 112, 58), (200, 70, 70), (178, 160, 80)
+PLATFORM, PLATFORM_EDGE, PLATFORM_TOP = (150, 150, 170), (50, 50, 60), (245, 200, 40)
+FRAME, MOTOR, OUTLINE, SHADE = (52, 72, 168), (36, 48, 120), (10, 10, 20), (70, 90, 180)
+PATH, SENSOR, THRUST_TRACK, THRUST = (16, 19, 97), (230, 120, 20), (170, 170, 170), (235, 50, 50)
+WIND, TEXT, GOOD, BAD = (50, 50, 200), (15, 15, 25), (0, 140, 0), (200, 0, 0)
 
 THRUST_BAR_PX = 40  # a full-thrust bar's length, as the reference (docs/reference/lander2d.md)
 CLOSE_UP_SIZE = (250, 180)
 CLOSE_UP_SCALE = 48.0  # px per metre: a 1 m drone is 48 px wide
 # What the scene shows when not told: the Landing task's defaults, read from the core.
 _CORE = LANDING.defaults
+# Where a moving platform's vx / platform_speed sits in the observation (the core's layout).
+_PLATFORM_VX = observation_slices(_native.describe("landing", {"moving_platform": 1.0}))[
+    "platform_velocity"
+].start
 _OUTCOMES = (
     ("lost_control", "lost control"),
     ("out_of_bounds", "out of bounds"),
@@ -51,20 +40,9 @@ _OUTCOMES = (
 )
 # The model's sizes a scene takes from the env's parameters (else the core's defaults).
 _WORLD = (
-    "world_width",
-    "world_height",
-    "ground_height",
-    "platform_width",
-    "platform_height",
-    "drone_width",
-    "drone_height",
-    "max_thrust",
-    "initial_battery",
-)
-
-
-def _vector(value: Any) -> np.ndarray:
-    return np.array(value, dtype=float).reshape(-1)
+    "world_width world_height ground_height platform_width platform_height drone_width "
+    "drone_height max_thrust initial_battery"
+).split()
 
 
 @dataclass(eq=False)
@@ -106,7 +84,7 @@ class LanderScene:
 
     def __post_init__(self) -> None:
         for name in ("position", "velocity", "thrust", "wind_force", "spawn_center"):
-            setattr(self, name, _vector(getattr(self, name)))
+            setattr(self, name, vector(getattr(self, name)))
         self.step = int(self.step)
 
     @property
@@ -131,8 +109,8 @@ def lander_scene(
     max_steps: int | None = None,
     params: Mapping[str, Any] | None = None,
 ) -> LanderScene:
-    """A LanderScene from a Landing info dict and its observation (value 11: a moving
-    platform's vx / platform_speed). `params`: the env's core parameters by name (missing
+    """A LanderScene from a Landing info dict and its observation (a moving platform's
+    vx / platform_speed). `params`: the env's core parameters by name (missing
     ones: the core's defaults)."""
     p = {**_CORE, **(params or {})}
     step = int(info["step"])
@@ -147,7 +125,9 @@ def lander_scene(
         thrust=info["thrust"],
         battery=float(info["battery"]),
         platform_x=float(info["platform_position"][0]),
-        platform_vx=float(obs[11]) * float(p["platform_speed"]) if len(obs) >= 12 else 0.0,
+        platform_vx=float(obs[_PLATFORM_VX]) * float(p["platform_speed"])
+        if len(obs) > _PLATFORM_VX
+        else 0.0,
         wind_force=info.get("wind_force", (0.0, 0.0)),
         wind_speed=float(p["wind_speed"]) if p["wind_enabled"] else 0.0,
         landed=bool(info.get("landed", False)),
@@ -434,15 +414,14 @@ def close_up(
     p.text(f"close-up ×{zoom:.0f}", (8, 6), TEXT, 18, bold=True)
 
 
-class LanderView:
+class LanderView(View):
     """Draws LanderScene frames: a window ("human") or (H, W, 3) uint8 arrays ("rgb_array").
 
     Keeps the episode's flight path and shades (a shade every `shade_distance_m` travelled);
     both restart when a scene's step goes backwards (a new episode) or on `reset()`.
-    pygame is imported by the constructor, not before.
     """
 
-    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 50}
+    SCENE = LanderScene
 
     def __init__(
         self,
@@ -458,15 +437,14 @@ class LanderView:
         show_overlay: bool = True,
         show_close_up: bool = True,
     ) -> None:
-        self.render_mode = check_render_mode(render_mode)
+        check_render_mode(render_mode)
         self.show_path = show_path
         self.show_shades = show_shades
         self.show_spawn_zone = show_spawn_zone
         self.show_overlay = show_overlay
         self._path = FlightPath()
         self._shades = Shades(shade_distance_m)
-        self._screen = Screen(render_mode, (width, height), "flyloop - Lander2D", fps)
-        self._painter = Painter(self._screen.pg, self._screen.surface)
+        super().__init__(render_mode, (width, height), "flyloop - Lander2D", fps)
         self._close_up: Painter | None = None
         if show_close_up:
             cw, ch = CLOSE_UP_SIZE
@@ -475,17 +453,6 @@ class LanderView:
                 self._close_up = Painter(self._screen.pg, window)
         self._plane: PlaneView | None = None
         self._plane_key: tuple[float, float] | None = None
-        self._closed = False
-
-    @property
-    def size(self) -> tuple[int, int]:
-        """(width, height) in pixels."""
-        return self._screen.size
-
-    @property
-    def is_open(self) -> bool:
-        """False once closed, by close() or by the user closing the window."""
-        return self._screen.is_open
 
     def world_to_screen(self, scene: LanderScene, points: np.ndarray) -> np.ndarray:
         """Pixels (u, v) where world points (..., 2) in metres are drawn for this scene."""
@@ -498,23 +465,13 @@ class LanderView:
 
     def render(self, scene: LanderScene) -> np.ndarray | None:
         """Draw one frame: returns it in rgb_array mode, None in human mode."""
-        if self._closed:
-            raise RuntimeError("this LanderView is closed; create a new one to render again")
-        if not isinstance(scene, LanderScene):
-            raise TypeError(f"LanderView.render needs a LanderScene, got {type(scene).__name__}")
-        self._screen.poll_events()
-        if not self._screen.is_open:
+        if self._events(scene) is None:
             return None  # the user closed the window: nothing to draw on any more
         if self._path.update(scene.step, scene.position):
             self._shades.clear()
         self._shades.update(scene.position, scene.angle)
         self._draw(scene)
         return self._screen.present()
-
-    def close(self) -> None:
-        """Close the window (if any). Safe to call more than once."""
-        self._closed = True
-        self._screen.close()
 
     def _plane_for(self, scene: LanderScene) -> PlaneView:
         key = (scene.world_width, scene.world_height)

@@ -18,37 +18,24 @@ from typing import Any
 
 import numpy as np
 
-from ..tasks import HOVER
+from .. import _native
+from ..tasks import observation_slices, parameter_values
 from .camera import CameraControls, OrbitCamera, Projector
-from .canvas import FlightPath, Painter, Screen, check_render_mode
+from .canvas import FlightPath, Painter, View, check_render_mode, vector
 
 # Rotor i sits at (forward, left) * L/sqrt(2) in the body frame: PX4 quad-X order.
 ROTOR_POSITION_SIGNS = np.array([(1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (-1.0, -1.0)])
 # Spin seen from above: -1 counter-clockwise, +1 clockwise (the core's ROTOR_SPIN).
 ROTOR_SPIN = (-1, -1, 1, 1)
 ROTOR_NAMES = ("FR", "RL", "FL", "RR")
-GROUND = (226, 230, 222)
-GRID = (188, 192, 186)
-GRID_MAJOR = (160, 165, 158)
-AXIS_X = (220, 40, 40)
-AXIS_Y = (30, 160, 60)
-AXIS_Z = (40, 90, 230)
-BOUNDS = (150, 160, 200)
-BODY = (0, 100, 200)
+GROUND, GRID, GRID_MAJOR, AXIS_X = (226, 230, 222), (188, 192, 186), (160, 165, 158), (220, 40, 40)
+AXIS_Y, AXIS_Z, BOUNDS, BODY = (30, 160, 60), (40, 90, 230), (150, 160, 200), (0, 100, 200)
 BODY_HIGHLIGHT = (110, 175, 245)
 ROTOR_CCW = (70, 200, 90)  # counter-clockwise (seen from above)
 ROTOR_CW = (235, 90, 80)  # clockwise
-ARM = (90, 90, 95)
-NOSE = (35, 35, 40)
-TARGET = (0, 170, 60)
-TARGET_LINE = (140, 140, 140)
-WAYPOINT = (150, 60, 200)
-UP = (255, 150, 0)
-VELOCITY = (230, 0, 220)
-WIND = (200, 0, 0)
-DROP = (128, 128, 128)
-SHADOW = (40, 40, 40)
-TRAIL = (60, 140, 220)
+ARM, NOSE, TARGET, TARGET_LINE = (90, 90, 95), (35, 35, 40), (0, 170, 60), (140, 140, 140)
+WAYPOINT, UP, VELOCITY, WIND = (150, 60, 200), (255, 150, 0), (230, 0, 220), (200, 0, 0)
+DROP, SHADOW, TRAIL = (128, 128, 128), (40, 40, 40), (60, 140, 220)
 
 TARGET_RADIUS_M = 0.08
 WAYPOINT_RADIUS_M = 0.06
@@ -56,13 +43,11 @@ UP_ARROW_M = 0.5  # length of the up vector
 VELOCITY_SECONDS = 0.5  # the velocity arrow shows where the drone is in this many seconds
 WIND_M_PER_MPS = 0.12  # wind arrow length per m/s of wind
 MAX_ARROW_M = 2.0
-TEXT = (20, 20, 30)
-PANEL = (255, 255, 236)
-BAD = (200, 0, 0)
-BACKGROUND_TOP = (232, 238, 248)
+TEXT, PANEL, BAD, BACKGROUND_TOP = (20, 20, 30), (255, 255, 236), (200, 0, 0), (232, 238, 248)
 BACKGROUND_BOTTOM = (246, 246, 250)
-# What the scene shows when not told: the hover task's defaults, read from the core.
-_CORE = HOVER.defaults
+# What a scene shows when not told: the hover task with the core's defaults.
+_HOVER = _native.describe("hover")
+_CORE = parameter_values(_HOVER)
 
 
 def rotation_matrix(q_wxyz: np.ndarray) -> np.ndarray:
@@ -109,10 +94,6 @@ def rotor_positions_body(arm_length: float) -> np.ndarray:
     return out
 
 
-def _vector(value: Any) -> np.ndarray:
-    return np.array(value, dtype=float).reshape(-1)
-
-
 @dataclass(eq=False)
 class QuadScene:
     """One frame of the quadrotor: plain per-step data in the core's frames and units."""
@@ -138,24 +119,19 @@ class QuadScene:
 
     def __post_init__(self) -> None:
         for name in ("position", "velocity", "body_rates", "wind"):
-            setattr(self, name, _vector(getattr(self, name)))
+            setattr(self, name, vector(getattr(self, name)))
         for name in ("target", "next_waypoint"):
             if getattr(self, name) is not None:
-                setattr(self, name, _vector(getattr(self, name)))
-        q = _vector(self.quaternion)
+                setattr(self, name, vector(getattr(self, name)))
+        q = vector(self.quaternion)
         self.quaternion = q / float(np.linalg.norm(q))
         # Lagged motor states may overshoot by rounding; the bars show [0, 1].
-        self.motors = np.clip(_vector(self.motors), 0.0, 1.0)
+        self.motors = np.clip(vector(self.motors), 0.0, 1.0)
         self.time_s, self.step = float(self.time_s), int(self.step)
         if self.waypoints_reached is not None:
             self.waypoints_reached = int(self.waypoints_reached)
         items = self.extras.items() if isinstance(self.extras, Mapping) else self.extras
         self.extras = tuple((str(k), str(v)) for k, v in items)
-
-
-# Observation slices of the Hover and Waypoints tasks (docs/reference/quadrotor.md).
-_VELOCITY, _QUATERNION, _RATES = slice(3, 6), slice(9, 13), slice(13, 16)
-_WIND, _MOTORS = slice(22, 25), slice(25, 29)
 
 
 def quad_scene(
@@ -164,30 +140,35 @@ def quad_scene(
     *,
     reward: float | None = None,
     episode_return: float | None = None,
-    bounds_half_size: float = QuadScene.bounds_half_size,
-    arm_length: float = QuadScene.arm_length,
+    core: Mapping[str, Any] = _HOVER,
 ) -> QuadScene:
-    """A QuadScene from a Hover/Waypoints observation and its info (the task frame's names)."""
+    """A QuadScene from a Hover/Waypoints observation and its info (the task frame's names);
+    `core`: the env's `describe` result (observation layout, parameters). An observation
+    without attitude or motors (the rates interface) is drawn level with motors at 0."""
     obs = np.asarray(observation, dtype=float).reshape(-1)
+    at, values = observation_slices(core), parameter_values(core)
+
+    def part(name: str, otherwise: Any) -> Any:
+        return obs[at[name]] if name in at else otherwise
+
     status = "crashed" if info.get("crashed") else ""
     status = status or ("out of bounds" if info.get("out_of_bounds") else "")
-    reached = info.get("waypoints_reached")
     return QuadScene(
         time_s=info["episode_time"],
         step=info["step_count"],
         position=info["position"],
-        velocity=obs[_VELOCITY],
-        quaternion=obs[_QUATERNION],
-        body_rates=obs[_RATES],
-        wind=obs[_WIND],
-        motors=obs[_MOTORS],
+        velocity=obs[at["velocity"]],
+        quaternion=part("quaternion", (1.0, 0.0, 0.0, 0.0)),
+        body_rates=obs[at["body_rates"]],
+        wind=part("wind", np.zeros(3)),
+        motors=part("motor_states", np.zeros(4)),
         target=info.get("target_position"),
         next_waypoint=info.get("next_waypoint_pos"),
         reward=reward,
         episode_return=episode_return,
-        bounds_half_size=bounds_half_size,
-        arm_length=arm_length,
-        waypoints_reached=reached,
+        bounds_half_size=float(values["space_side_length"]) / 2.0,
+        arm_length=float(values["arm_length"]),
+        waypoints_reached=info.get("waypoints_reached"),
         status=status,
     )
 
@@ -356,11 +337,7 @@ def drone(p: Painter, pr: Projector, scene: QuadScene, scale: float) -> None:
 
 
 def world(
-    p: Painter,
-    pr: Projector,
-    scene: QuadScene,
-    trail_points: np.ndarray,
-    drone_scale: float,
+    p: Painter, pr: Projector, scene: QuadScene, trail_points: np.ndarray, drone_scale: float
 ) -> None:
     """The whole 3D scene, back to front."""
     ground(p, pr, scene)
@@ -526,7 +503,7 @@ def default_camera(bounds_half_size: float) -> OrbitCamera:
     return OrbitCamera(look_at=np.array([0.0, 0.0, 0.8 * h]), distance=4.2 * h)
 
 
-class QuadrotorView:
+class QuadrotorView(View):
     """Draws QuadScene frames: a window ("human") or (H, W, 3) uint8 arrays ("rgb_array").
 
     In a window: drag with the left mouse button to orbit, wheel to zoom, W/A/S/D to move
@@ -534,10 +511,9 @@ class QuadrotorView:
     The vehicle is drawn `drone_scale` times its real size (a 0.1 m arm would be a few
     pixels); its centre is at its true position. The trail keeps the last `trail_steps`
     positions of the episode and restarts when the step number goes backwards or on reset().
-    pygame is imported by the constructor, not before.
     """
 
-    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 50}
+    SCENE = QuadScene
 
     def __init__(
         self,
@@ -551,27 +527,15 @@ class QuadrotorView:
         trail_steps: int = 400,
         hud: bool = True,
     ) -> None:
-        self.render_mode = check_render_mode(render_mode)
+        check_render_mode(render_mode)
         if not drone_scale > 0:
             raise ValueError(f"drone_scale must be > 0, got {drone_scale}")
         self.drone_scale = float(drone_scale)
         self.hud = hud
         self._camera = camera
         self._trail = FlightPath(max(2, trail_steps))
-        self._screen = Screen(render_mode, (width, height), "flyloop - Quadrotor 3D", fps)
-        self._painter = Painter(self._screen.pg, self._screen.surface)
+        super().__init__(render_mode, (width, height), "flyloop - Quadrotor 3D", fps)
         self._controls: CameraControls | None = None
-        self._closed = False
-
-    @property
-    def size(self) -> tuple[int, int]:
-        """(width, height) in pixels."""
-        return self._screen.size
-
-    @property
-    def is_open(self) -> bool:
-        """False once closed, by close() or by the user closing the window."""
-        return self._screen.is_open
 
     @property
     def camera(self) -> OrbitCamera | None:
@@ -590,25 +554,17 @@ class QuadrotorView:
 
     def render(self, scene: QuadScene) -> np.ndarray | None:
         """Draw one frame: returns it in rgb_array mode, None in human mode."""
-        if self._closed:
-            raise RuntimeError("this QuadrotorView is closed; create a new one to render again")
-        if not isinstance(scene, QuadScene):
-            raise TypeError(f"QuadrotorView.render needs a QuadScene, got {type(scene).__name__}")
+        events = self._events(scene)
         if self._camera is None:
             self._camera = default_camera(scene.bounds_half_size)
         if self._controls is None:
             self._controls = CameraControls(self._screen.pg, self._camera)
-        self._controls.handle(self._screen.poll_events())
-        if not self._screen.is_open:
+        if events is None:
             return None  # the user closed the window
+        self._controls.handle(events)
         self._trail.update(scene.step, scene.position)
         self._draw(scene)
         return self._screen.present()
-
-    def close(self) -> None:
-        """Close the window (if any). Safe to call more than once."""
-        self._closed = True
-        self._screen.close()
 
     def _draw(self, scene: QuadScene) -> None:
         p = self._painter
