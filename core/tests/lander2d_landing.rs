@@ -75,6 +75,9 @@ fn spaces_are_the_reference_ones() {
         ..Default::default()
     });
     assert_eq!(moving.observation_size(), 12);
+    let layout = |t: &Landing| t.observation_layout().iter().map(|g| g.1).sum::<usize>();
+    assert_eq!((layout(&t), layout(&moving)), (11, 12));
+    assert_eq!(moving.observation_layout()[8], ("platform_velocity", 1));
     assert_eq!(moving.observation().len(), 12);
     assert_eq!(
         moving.observation()[11].abs(),

@@ -47,6 +47,8 @@ fn rates_interface_declares_px4s_action_and_16_observations() {
     assert_eq!(lo, vec![0.0, -max, -max, -200f64.to_radians()]);
     assert_eq!(hi, vec![1.0, max, max, 200f64.to_radians()]);
     assert_eq!(task.observation_size(), 16);
+    let sizes: Vec<usize> = task.observation_layout().iter().map(|g| g.1).collect();
+    assert_eq!(sizes, vec![3, 3, 3, 3, 4]);
     let obs = task.observation();
     let (olo, ohi) = task.observation_bounds();
     for i in 0..16 {
@@ -271,6 +273,8 @@ fn waypoints_fly_the_rates_interface_with_its_frame() {
         Waypoints::with_vehicle(nominal, WaypointParams::default(), Randomization::none()).unwrap();
     task.reset(2);
     assert_eq!(task.observation_size(), 20);
+    let sizes: usize = task.observation_layout().iter().map(|g| g.1).sum();
+    assert_eq!(sizes, 20);
     task.step(&[hover_thrust(), 0.0, 0.0, 0.0]).unwrap();
     let obs = task.observation();
     // Next waypoint offset in the heading frame has the same length as in the world.

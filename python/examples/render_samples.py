@@ -16,7 +16,7 @@ import numpy as np
 from PIL import Image
 
 from flyloop.rendering import LanderScene, LanderView, QuadrotorView, QuadScene, save_video
-from flyloop.rendering.geometry import quaternion_from_euler
+from flyloop.rendering.quadrotor import quaternion_from_euler
 
 REPO = Path(__file__).resolve().parents[2]
 

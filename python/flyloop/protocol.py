@@ -16,6 +16,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import _native
+
 os.environ.setdefault("MAVLINK20", "1")  # before pymavlink is imported: MAVLink 2 framing
 
 from pymavlink.dialects.v20 import common as mavlink2  # noqa: E402
@@ -39,9 +41,10 @@ LOCKSTEP_FLAG = mavlink2.HIL_ACTUATOR_CONTROLS_FLAGS_LOCKSTEP
 RESET_COMMAND = mavlink2.MAV_CMD_USER_1
 MAV_RESULT_ACCEPTED = mavlink2.MAV_RESULT_ACCEPTED
 
-# Task frame layout (docs/protocol.md): header values, then observation, then info.
-FRAME_ARRAY_LEN = 58
-FRAME_HEADER_LEN = 6
+# Task frame layout (docs/protocol.md), the SITL's own: header values, then observation,
+# then info, over arrays of FRAME_ARRAY_LEN values.
+FRAME_ARRAY_LEN = _native.FRAME_ARRAY_LEN
+FRAME_HEADER_LEN = _native.FRAME_HEADER_LEN
 _FRAME_PAYLOAD = struct.calcsize(FRAME.unpacker.format)  # 252 bytes, data at offset 20
 _FRAME_DATA_OFFSET = struct.calcsize("<QH10s")
 _CONTROLS = struct.Struct(CONTROLS.unpacker.format)  # <QQ16fB: time, flags, controls, mode

@@ -66,16 +66,48 @@ def as_interval(arg: str, v: Any) -> tuple[float, float]:
 
 @dataclass(frozen=True)
 class Argument:
-    """One env argument: its name, the core parameters it sets, and how."""
+    """One env argument: its name, the core parameters it sets and how (`convert`: the
+    Python value -> one value per core parameter), its default (`default_of`: the core's
+    defaults -> the Python default), its type and what it means."""
 
     name: str
     core: tuple[str, ...]
     convert: Callable[[str, Any], tuple]
+    default_of: Callable[[Mapping[str, float]], Any]
+    annotation: Any
     doc: str
+
+    def default(self, core_defaults: Mapping[str, float]) -> Any:
+        return self.default_of(core_defaults)
 
 
 def _one(kind: Callable[[str, Any], Any]) -> Callable[[str, Any], tuple]:
     return lambda arg, v: (kind(arg, v),)
+
+
+# A core value kind -> the env argument's check and Python type.
+_KINDS = {"integer": (as_int, int), "real": (as_float, float), "boolean": (as_bool, bool)}
+
+
+def own_argument(row: Mapping[str, Any]) -> Argument:
+    """The env argument that is core parameter `row` under its own name: type, default and
+    description are the core's."""
+    name = row["name"]
+    check, python_type = _KINDS[row["kind"]]
+    unit = f" ({row['unit']})" if row["unit"] else ""
+    return Argument(
+        name,
+        (name,),
+        _one(check),
+        lambda d: python_type(d[name]),
+        python_type,
+        row["description"] + unit,
+    )
+
+
+def _renamed(name, core, convert, default_of, annotation, doc) -> Argument:
+    core = (core,) if isinstance(core, str) else core
+    return Argument(name, core, convert, default_of, annotation, doc)
 
 
 def _optional_interval(arg: str, v: Any) -> tuple[int]:
@@ -127,171 +159,61 @@ def randomize_entries(arg: str, v: Any) -> dict[str, tuple[float, float]]:
     return out
 
 
-def _arg(name: str, core: str | tuple[str, ...], convert, doc: str) -> Argument:
-    core = (core,) if isinstance(core, str) else core
-    return Argument(name, core, convert, doc)
-
-
-FLIGHT_ARGUMENTS: list[Argument] = [
-    _arg("max_steps", "max_steps", _one(as_int), "steps until the episode is truncated"),
-    _arg("dt", "dt", _one(as_float), "control period, s"),
-    _arg(
-        "target_change_interval",
-        "target_change_interval",
-        _optional_interval,
+# The seeds' arguments whose name or form differs from the core's parameters, mapped by
+# hand; every other argument is a core parameter under its own name (`own_argument`).
+_USE_WIND = _renamed(
+    "use_wind", "wind_enabled", _one(as_bool), lambda d: bool(d["wind_enabled"]), bool,
+    "the wind blows",
+)  # fmt: skip
+FLIGHT_RENAMED = (
+    _renamed(
+        "target_change_interval", "target_change_interval", _optional_interval,
+        lambda d: int(d["target_change_interval"]) or None, int | None,
         "steps between new targets; None = never",
     ),
-    _arg(
-        "wind_strength_range",
-        ("wind_speed_min", "wind_speed_max"),
-        as_interval,
-        "(min, max) of the per-episode mean wind speed, m/s",
+    _renamed(
+        "wind_strength_range", ("wind_speed_min", "wind_speed_max"), as_interval,
+        lambda d: (float(d["wind_speed_min"]), float(d["wind_speed_max"])),
+        tuple[float, float], "(min, max) of the per-episode mean wind speed (m/s)",
     ),
-    _arg("use_wind", "wind_enabled", _one(as_bool), "wind (mean + turbulence) blows"),
-    _arg(
-        "enable_crash_detection",
-        "enable_crash_detection",
-        _one(as_bool),
-        "terminate on a crash",
-    ),
-    _arg(
-        "enable_out_of_bounds_detection",
-        "enable_out_of_bounds_detection",
-        _one(as_bool),
-        "terminate when too far from the target",
-    ),
-    _arg(
-        "crash_z_vel_threshold",
-        "crash_z_vel_threshold",
-        _one(as_float),
-        "crash below this vertical velocity, m/s",
-    ),
-    _arg(
-        "crash_tilt_threshold",
-        "crash_tilt_threshold",
-        _one(as_float),
-        "crash beyond this |roll| or |pitch|, degrees",
-    ),
-    _arg(
-        "space_side_length",
-        "space_side_length",
-        _one(as_float),
-        "side of the target cube, m",
-    ),
-    _arg("start_height", "start_height", _one(as_float), "start height, m"),
-    _arg(
-        "start_attitude_range",
-        "start_attitude_range",
-        _one(as_float),
-        "start roll/pitch/yaw uniform in +-this, rad",
-    ),
-    _arg(
-        "min_target_distance",
-        "min_target_distance",
-        _one(as_float),
-        "a new target is at least this far away, m",
-    ),
-    _arg(
-        "velocity_scale",
-        "velocity_scale",
-        _one(as_float),
-        "speed scale of the velocity reward, m/s",
-    ),
-    _arg(
-        "action_interface",
-        "rates_action",
-        _action_interface,
+    _USE_WIND,
+    _renamed(
+        "action_interface", "rates_action", _action_interface,
+        lambda d: "rates" if d["rates_action"] else "motors", str,
         "'motors' (4 motor commands) or 'rates' (thrust + body rates through PX4's rate loop)",
     ),
-    _arg(
-        "action_latency",
-        "action_latency",
-        _one(as_float),
-        "rates interface: delay from an action to the rate loop, s",
-    ),
-    _arg(
-        "observation_noise",
-        tuple("obs_noise_" + k for k in NOISE_KEYS),
-        _observation_noise,
+    _renamed(
+        "observation_noise", tuple("obs_noise_" + k for k in NOISE_KEYS), _observation_noise,
+        lambda d: {k: d["obs_noise_" + k] for k in NOISE_KEYS if d["obs_noise_" + k]} or None,
+        Mapping[str, float] | None,
         "rates interface: observation noise std by quantity (position m, velocity m/s, "
-        "attitude rad, rates rad/s)",
+        "attitude rad, rates rad/s); None = none",
     ),
-    _arg(
-        "randomize",
-        (),
-        randomize_entries,
+    _renamed(
+        "randomize", (), randomize_entries, lambda d: None,
+        Mapping[str, tuple[float, float]] | None,
         "domain randomisation: {core parameter: (low, high)} drawn per episode from its seed",
     ),
-]
-WAYPOINT_ARGUMENTS: list[Argument] = [
-    _arg("max_num_waypoints", "max_num_waypoints", _one(as_int), "waypoints per episode"),
-    _arg(
-        "waypoint_reach_threshold_m",
-        "waypoint_reach_threshold_m",
-        _one(as_float),
-        "a waypoint is reached within this distance, m",
+)  # fmt: skip
+LANDING_RENAMED = (
+    _USE_WIND,
+    _renamed(
+        "wind_direction", ("wind_direction_random", "wind_direction"), _wind_direction,
+        lambda d: None if d["wind_direction_random"] else float(d["wind_direction"]),
+        float | None, "None = uniform per episode, else fixed, rad from +x toward +y",
     ),
-    _arg("checkpoint_bonus", "checkpoint_bonus", _one(as_float), "reward for a waypoint"),
-    _arg(
-        "bonus_decay_rate_per_sec",
-        "bonus_decay_rate_per_sec",
-        _one(as_float),
-        "bonus lost per second since the last waypoint",
-    ),
-]
-LANDING_ARGUMENTS: list[Argument] = [
-    _arg("max_steps", "max_steps", _one(as_int), "steps until the episode is truncated"),
-    _arg("dt", "dt", _one(as_float), "control period, s"),
-    _arg("moving_platform", "moving_platform", _one(as_bool), "the platform moves along x"),
-    _arg("platform_speed", "platform_speed", _one(as_float), "platform speed, m/s"),
-    _arg(
-        "initial_pos_random_range_m",
-        "initial_pos_random_range_m",
-        _one(as_float),
-        "half side of the spawn square around (spawn_x, spawn_y), m; 0 = fixed start",
-    ),
-    _arg("spawn_x", "spawn_x", _one(as_float), "centre of the spawn square, x, m"),
-    _arg("spawn_y", "spawn_y", _one(as_float), "centre of the spawn square, y, m"),
-    _arg(
-        "initial_angle_random_range_rad",
-        "initial_angle_random_range_rad",
-        _one(as_float),
-        "spawn angle uniform in +-this, rad",
-    ),
-    _arg("use_wind", "wind_enabled", _one(as_bool), "the episode's constant wind blows"),
-    _arg("wind_speed", "wind_speed", _one(as_float), "wind speed, m/s"),
-    _arg(
-        "wind_direction",
-        ("wind_direction_random", "wind_direction"),
-        _wind_direction,
-        "None = uniform per episode, else fixed, rad from +x toward +y",
-    ),
-    _arg(
-        "platform_random_start_x",
-        "platform_random_start_x",
-        _one(as_bool),
-        "platform start x drawn inside its travel range",
-    ),
-    _arg("thrust_noise_std", "thrust_noise_std", _one(as_float), "thrust noise per motor, N"),
-    _arg(
-        "max_safe_landing_speed",
-        "max_safe_landing_speed",
-        _one(as_float),
-        "largest touchdown speed of a landing, m/s",
-    ),
-    _arg(
-        "max_safe_landing_angle",
-        "max_safe_landing_angle",
-        _one(as_float),
-        "largest |angle| of a landing, rad",
-    ),
-    _arg(
-        "max_allowed_tilt_angle_rad",
-        "max_allowed_tilt_angle_rad",
-        _one(as_float),
-        "|angle| beyond which control is lost, rad",
-    ),
-]
+)  # fmt: skip
+# Lander2D's model parameters that the seed made env arguments (the rest: model_params).
+LANDING_MODEL_ARGUMENTS = (
+    "dt",
+    "moving_platform",
+    "platform_speed",
+    "wind_speed",
+    "platform_random_start_x",
+    "thrust_noise_std",
+    "max_safe_landing_speed",
+    "max_safe_landing_angle",
+)
 
 
 # ---- the core's description of a task ----
@@ -306,14 +228,44 @@ def _default_description(task: str) -> dict[str, Any]:
 
 @dataclass(frozen=True)
 class TaskSpec:
-    """A task as the adapter sees it: its env arguments; the rest comes from the core."""
+    """A task as the adapter sees it: which core parameters are env arguments; everything
+    else comes from the core."""
 
     name: str  # the core's task name: the SITL's --task and the frame's DEBUG_FLOAT_ARRAY name
     env_id: str
-    arguments: tuple[Argument, ...]
+    # Env arguments mapped by hand (the seeds' names and forms).
+    renamed: tuple[Argument, ...]
+    # Model parameters that are env arguments too (the task's own parameters all are).
+    model_arguments: tuple[str, ...] = ()
     # Core parameters the env id fixes, not the caller: (name, value) pairs, e.g.
     # Lander2D-v1's reward_version. resolve_config adds them to every config.
     fixed: tuple[tuple[str, float], ...] = ()
+
+    @functools.cached_property
+    def arguments(self) -> tuple[Argument, ...]:
+        """The env's task arguments in the core table's order: each task parameter and each
+        of `model_arguments` under its own name, except those a `renamed` argument sets
+        (placed at its first core parameter) and the `fixed` ones."""
+        first = {a.core[0]: a for a in self.renamed if a.core}
+        covered = {c for a in self.renamed for c in a.core} | {n for n, _ in self.fixed}
+        out = []
+        # The task's own parameters first, then the model's (a stable sort keeps the table's
+        # order within each).
+        rows = sorted(self.parameters, key=lambda r: r["group"].startswith("model"))
+        for row in rows:
+            name = row["name"]
+            if name in first:
+                out.append(first[name])
+            elif name not in covered and (
+                not row["group"].startswith("model") or name in self.model_arguments
+            ):
+                out.append(own_argument(row))
+        return (*out, *(a for a in self.renamed if not a.core))
+
+    def argument_defaults(self) -> dict[str, Any]:
+        """Env argument -> its default, from the core's defaults."""
+        defaults = self.defaults
+        return {a.name: a.default(defaults) for a in self.arguments}
 
     @property
     def parameters(self) -> tuple[dict[str, Any], ...]:
@@ -358,18 +310,39 @@ class TaskSpec:
             raise parameter_error(self, str(exc)) from None
 
 
-HOVER = TaskSpec("hover", "flyloop/QuadHover-v0", tuple(FLIGHT_ARGUMENTS))
-WAYPOINTS = TaskSpec(
-    "waypoints", "flyloop/QuadWaypoints-v0", tuple(FLIGHT_ARGUMENTS + WAYPOINT_ARGUMENTS)
-)
+HOVER = TaskSpec("hover", "flyloop/QuadHover-v0", FLIGHT_RENAMED)
+WAYPOINTS = TaskSpec("waypoints", "flyloop/QuadWaypoints-v0", FLIGHT_RENAMED)
 # The seed's reward (reward_version 0) and the landing reward (1): one task, two env ids.
 LANDING = TaskSpec(
-    "landing", "flyloop/Lander2D-v0", tuple(LANDING_ARGUMENTS), (("reward_version", 0),)
-)
+    "landing", "flyloop/Lander2D-v0", LANDING_RENAMED, LANDING_MODEL_ARGUMENTS,
+    (("reward_version", 0),),
+)  # fmt: skip
 LANDING_V1 = TaskSpec(
-    "landing", "flyloop/Lander2D-v1", tuple(LANDING_ARGUMENTS), (("reward_version", 1),)
-)
+    "landing", "flyloop/Lander2D-v1", LANDING_RENAMED, LANDING_MODEL_ARGUMENTS,
+    (("reward_version", 1),),
+)  # fmt: skip
 TASKS = {t.name: t for t in (HOVER, WAYPOINTS, LANDING)}
+
+
+def task_arguments(spec: TaskSpec, arguments: Mapping[str, Any], who: str) -> dict[str, Any]:
+    """Every task argument of `spec`: its default from the core unless `arguments` gives it.
+    A name that is not a task argument raises TypeError naming `who`."""
+    defaults = spec.argument_defaults()
+    unknown = set(arguments) - set(defaults)
+    if unknown:
+        raise TypeError(
+            f"{who} got unexpected arguments {sorted(unknown)}; task arguments: {sorted(defaults)}"
+        )
+    return {**defaults, **arguments}
+
+
+def observation_slices(description: Mapping[str, Any]) -> dict[str, slice]:
+    """Group name -> its slice of the observation, from a `describe` result's layout."""
+    out, at = {}, 0
+    for name, count in description["observation"]:
+        out[name] = slice(at, at + count)
+        at += count
+    return out
 
 
 def parameter_values(description: Mapping[str, Any]) -> dict[str, float]:

@@ -1,34 +1,25 @@
-"""What both vector envs (SITL and native) share: the task arguments with the single env's
+"""What the vector env needs beside the backend: the task arguments with the single env's
 defaults, and the batched info dict built from a (N, values) float32 array in the task
 frame's info layout."""
 
 from __future__ import annotations
 
-import inspect
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
-from .tasks import FLAG, INTEGER, REAL, TaskSpec
+from .tasks import FLAG, INTEGER, REAL, TaskSpec, task_arguments
 
 # Single-env arguments a vector env accepts and ignores (they only change drawing).
 RENDER_ARGUMENTS = {"render_path", "render_shade", "shade_distance_m"}
 
 
-def task_arguments(spec: TaskSpec, single: type, arguments: Mapping[str, Any]) -> dict[str, Any]:
-    """The task arguments of a vector env: the single env's defaults, then `arguments`
-    (unknown names raise TypeError), so both make the same episodes."""
-    known = {a.name for a in spec.arguments}
-    unknown = set(arguments) - known - RENDER_ARGUMENTS
-    if unknown:
-        raise TypeError(
-            f"the {spec.env_id} vector env got unexpected arguments {sorted(unknown)}; "
-            f"task arguments: {sorted(known)}"
-        )
-    params = inspect.signature(single.__init__).parameters
-    defaults = {name: p.default for name, p in params.items() if name in known}
-    return {**defaults, **{k: v for k, v in arguments.items() if k in known}}
+def vector_task_arguments(spec: TaskSpec, arguments: Mapping[str, Any]) -> dict[str, Any]:
+    """The task arguments of a vector env, as the single env's (the core's defaults, then
+    `arguments`), so both make the same episodes."""
+    given = {k: v for k, v in arguments.items() if k not in RENDER_ARGUMENTS}
+    return task_arguments(spec, given, f"the {spec.env_id} vector env")
 
 
 class InfoColumns:

@@ -33,5 +33,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sitl_command::sitl_main, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_test, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    // The task frame's layout (flyloop_sitl::task_frame), for the SITL backend's reader.
+    m.add("FRAME_HEADER_LEN", flyloop_sitl::task_frame::HEADER_LEN)?;
+    m.add("FRAME_ARRAY_LEN", flyloop_sitl::task_frame::ARRAY_LEN)?;
     Ok(())
 }

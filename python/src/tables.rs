@@ -88,9 +88,10 @@ pub fn info_layout(task: &TaskInstance) -> Vec<(&'static str, &'static str, usiz
 }
 
 /// Everything Python declares about `task` with parameters `params`: a dict with
-/// `observation_low`/`observation_high` (float32 arrays), `action_low`/`action_high`
-/// (float64), `dt` (s), `info` (list of (name, kind, count)), `parameters` (list of dicts:
-/// name, id, group, kind, unit, min, max, default, value, description), `model`, `task`.
+/// `observation_low`/`observation_high` (float32 arrays), `observation` (its layout: list of
+/// (name, count)), `action_low`/`action_high` (float64), `dt` (s), `info` (list of (name,
+/// kind, count)), `parameters` (list of dicts: name, id, group, kind, unit, min, max,
+/// default, value, description), `model`, `task`.
 #[pyfunction]
 #[pyo3(signature = (task, params=None))]
 pub fn describe<'py>(
@@ -111,6 +112,7 @@ pub fn describe<'py>(
     let (lo, hi) = instance.action_bounds();
     out.set_item("action_low", PyArray1::from_slice(py, &lo))?;
     out.set_item("action_high", PyArray1::from_slice(py, &hi))?;
+    out.set_item("observation", instance.observation_layout())?;
     out.set_item("dt", instance.dt())?;
     out.set_item("info", info_layout(&instance))?;
     let defaults = TaskConfig::default();

@@ -48,8 +48,8 @@ def test_native_single_env_equals_the_sitl_backend_over_thousands_of_steps(make_
     # Regression: QuadWaypoints dropped `backend` on its way to QuadHover's constructor and
     # flew a SITL of its own (this comparison then compared the SITL with itself).
     assert native.unwrapped.backend == "native"
-    assert native.unwrapped._process is None and native.unwrapped._link is None
-    assert sitl.unwrapped._process is not None
+    assert native.unwrapped.sitl_process is None
+    assert sitl.unwrapped.sitl_process is not None
     assert native.observation_space == sitl.observation_space
     assert native.action_space == sitl.action_space
     steps, resets = 3000, 0

@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 
 from flyloop.rendering.camera import OrbitCamera, clip_polygon_near
-from flyloop.rendering.geometry import (
+from flyloop.rendering.lander import PlaneView
+from flyloop.rendering.quadrotor import (
     ROTOR_SPIN,
     euler_rpy,
     quaternion_from_euler,
     rotation_matrix,
     rotor_positions_body,
 )
-from flyloop.rendering.plane import PlaneView
 
 W, H = 800, 600
 
@@ -153,7 +153,7 @@ def test_plane_fits_the_world_and_round_trips():
 
 
 def test_batched_segments_match_one_by_one_clipping():
-    from flyloop.rendering.quad_world import Projector
+    from flyloop.rendering.camera import Projector
 
     cam = OrbitCamera(look_at=np.zeros(3), distance=3.0, azimuth_deg=20, elevation_deg=10)
     pr = Projector(cam, (W, H))

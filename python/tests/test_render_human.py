@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from flyloop.rendering import LanderScene, LanderView, QuadrotorView, QuadScene
-from flyloop.rendering.screen import import_pygame
+from flyloop.rendering.canvas import import_pygame
 
 pygame = import_pygame("human")  # a hard dependency: its absence must fail, not skip
 

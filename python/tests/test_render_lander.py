@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from flyloop.rendering import LanderScene, LanderView
-from flyloop.rendering import lander_draw as ld
+from flyloop.rendering import lander as ld
 
 # A 10 m world makes the 1 m drone 78 px wide: its own colours outnumber its outline.
 SMALL = dict(

@@ -12,9 +12,13 @@ import pytest
 
 import flyloop
 from flyloop.rendering import OrbitCamera, QuadrotorView, QuadScene
-from flyloop.rendering import quad_world as qw
-from flyloop.rendering.geometry import quaternion_from_euler, rotation_matrix, rotor_positions_body
-from flyloop.rendering.quad_hud import info_lines
+from flyloop.rendering import quadrotor as qw
+from flyloop.rendering.quadrotor import (
+    info_lines,
+    quaternion_from_euler,
+    rotation_matrix,
+    rotor_positions_body,
+)
 
 
 def scene(**over):

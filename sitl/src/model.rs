@@ -156,6 +156,11 @@ impl TaskInstance {
         self.task().observation_size()
     }
 
+    /// The observation's groups: (name, number of values), as the core declares them.
+    pub fn observation_layout(&self) -> Vec<(&'static str, usize)> {
+        self.task().observation_layout()
+    }
+
     /// Inclusive per-value observation bounds, as the core declares them.
     pub fn observation_bounds(&self) -> (Vec<f32>, Vec<f32>) {
         self.task().observation_bounds()

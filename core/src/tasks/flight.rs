@@ -135,6 +135,20 @@ impl Parameters for FlightParams {
 /// Number of values in the base observation.
 pub const BASE_OBSERVATION_SIZE: usize = 33;
 
+/// The base observation's groups (motor interface): (name, number of values), in order.
+pub const BASE_OBSERVATION: [(&str, usize); 10] = [
+    ("target_offset", 3), // target − position, world ENU
+    ("velocity", 3),
+    ("acceleration", 3),
+    ("quaternion", 4),
+    ("body_rates", 3),
+    ("angular_acceleration", 3),
+    ("body_z_axis", 3),
+    ("wind", 3),
+    ("motor_states", 4),
+    ("motor_commands", 4),
+];
+
 /// Draws the start state: (0, 0, start_height), roll/pitch/yaw uniform in ±range, at rest,
 /// motors at the hover state (0 if the vehicle cannot hover).
 pub fn sample_start(task: &FlightParams, model: &QuadrotorParams, rng: &mut SimRng) -> BodyState {
@@ -210,22 +224,23 @@ pub fn wind_bound(model: &QuadrotorParams) -> f64 {
 /// Per-value bounds of the base observation; `position_bound` bounds target − position.
 pub fn base_bounds(model: &QuadrotorParams, position_bound: f64) -> ([f32; 33], [f32; 33]) {
     let wind = wind_bound(model);
-    let groups: [(usize, f64, f64); 10] = [
-        (3, -position_bound, position_bound), // target − position
-        (3, -40.0, 40.0),                     // velocity
-        (3, -50.0, 50.0),                     // acceleration
-        (4, -1.0, 1.0),                       // quaternion
-        (3, -10.0, 10.0),                     // body rates
-        (3, -100.0, 100.0),                   // angular acceleration
-        (3, -1.0, 1.0),                       // body z axis
-        (3, -wind, wind),                     // wind
-        (4, 0.0, 1.0),                        // motor states
-        (4, 0.0, 1.0),                        // motor commands
+    // In BASE_OBSERVATION's order.
+    let bounds: [(f64, f64); 10] = [
+        (-position_bound, position_bound),
+        (-40.0, 40.0),
+        (-50.0, 50.0),
+        (-1.0, 1.0),
+        (-10.0, 10.0),
+        (-100.0, 100.0),
+        (-1.0, 1.0),
+        (-wind, wind),
+        (0.0, 1.0),
+        (0.0, 1.0),
     ];
     let mut lo = [0.0f32; 33];
     let mut hi = [0.0f32; 33];
     let mut i = 0;
-    for (n, l, h) in groups {
+    for ((_, n), (l, h)) in BASE_OBSERVATION.into_iter().zip(bounds) {
         for _ in 0..n {
             lo[i] = l as f32;
             hi[i] = h as f32;

@@ -19,7 +19,7 @@
 //! applied (clipped). Optional Gaussian noise (`obs_noise_*`) is drawn from a generator of
 //! the episode's own, so the same seed gives the same noise.
 
-use super::flight::{BASE_OBSERVATION_SIZE, base_bounds, write_base_observation};
+use super::flight::{BASE_OBSERVATION, BASE_OBSERVATION_SIZE, base_bounds, write_base_observation};
 use super::randomization::{Randomization, VehicleParams};
 use crate::error::ParamError;
 use crate::params::Parameters;
@@ -34,6 +34,14 @@ use std::collections::VecDeque;
 
 /// Number of values in the rates interface's observation.
 pub const ESTIMATE_OBSERVATION_SIZE: usize = 16;
+/// The rates interface's observation groups, in order (see `write_observation`).
+pub const ESTIMATE_OBSERVATION: [(&str, usize); 5] = [
+    ("target_offset", 3),
+    ("velocity", 3),
+    ("down_axis", 3),
+    ("body_rates", 3),
+    ("last_action", 4),
+];
 
 /// Salt of the observation noise's generator (independent of the episode's own stream).
 const NOISE_STREAM: u64 = 0x0b5e_7e57_1a7e_0002;
@@ -253,6 +261,15 @@ impl FlightVehicle {
             ESTIMATE_OBSERVATION_SIZE
         } else {
             BASE_OBSERVATION_SIZE
+        }
+    }
+
+    /// The interface's observation groups: (name, number of values), in order.
+    pub fn observation_layout(&self) -> Vec<(&'static str, usize)> {
+        if self.rates.is_some() {
+            ESTIMATE_OBSERVATION.to_vec()
+        } else {
+            BASE_OBSERVATION.to_vec()
         }
     }
 

@@ -135,6 +135,10 @@ impl Task for Hover {
         (self.obs_low.clone(), self.obs_high.clone())
     }
 
+    fn observation_layout(&self) -> Vec<(&'static str, usize)> {
+        self.vehicle.observation_layout()
+    }
+
     fn reset(&mut self, seed: u64) {
         let mut rng = SimRng::new(seed);
         let model = self.vehicle.draw(seed);

@@ -260,6 +260,23 @@ impl Task for Landing {
         }
     }
 
+    fn observation_layout(&self) -> Vec<(&'static str, usize)> {
+        let mut layout = vec![
+            ("position", 2), // x/25 − 1, y/25 − 1
+            ("velocity", 2),
+            ("angle", 1),
+            ("angular_velocity", 1),
+            ("battery", 1),
+            ("platform_offset", 2),
+            ("platform_bearing", 1),
+            ("platform_distance", 1),
+        ];
+        if self.observation_size() == 12 {
+            layout.push(("platform_velocity", 1)); // vx / platform_speed
+        }
+        layout
+    }
+
     fn observation_bounds(&self) -> (Vec<f32>, Vec<f32>) {
         let n = self.observation_size();
         let mut low = vec![-1.0f32; n];

@@ -61,6 +61,9 @@ pub trait Task {
     fn observation_size(&self) -> usize;
     /// Inclusive per-value observation bounds; every observation lies inside them.
     fn observation_bounds(&self) -> (Vec<f32>, Vec<f32>);
+    /// The observation's consecutive groups: (name, number of values), in order; the
+    /// numbers sum to [`Task::observation_size`].
+    fn observation_layout(&self) -> Vec<(&'static str, usize)>;
     /// Starts a new episode; the same seed gives the same episode, bit for bit.
     fn reset(&mut self, seed: u64);
     /// Applies `action` for one control period.

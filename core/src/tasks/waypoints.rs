@@ -193,6 +193,12 @@ impl Task for Waypoints {
         (self.obs_low.clone(), self.obs_high.clone())
     }
 
+    fn observation_layout(&self) -> Vec<(&'static str, usize)> {
+        let mut layout = self.vehicle.observation_layout();
+        layout.extend([("next_waypoint_offset", 3), ("time_since_checkpoint", 1)]);
+        layout
+    }
+
     fn reset(&mut self, seed: u64) {
         let mut rng = SimRng::new(seed);
         let model = self.vehicle.draw(seed);

@@ -3,7 +3,6 @@ v0 keeps the seed's reward, v1 pays for landing."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from typing import Any
 
 from ..tasks import LANDING, LANDING_V1, parameter_values
@@ -64,11 +63,12 @@ class Lander2DEnv(FlyloopEnv):
 
     ## Starting state
 
-    Spawn at (``spawn_x``, ``spawn_y``) = (25, 40) ± ``initial_pos_random_range_m`` in x and y (kept inside the world and
-    above the platform), angle uniform in ±``initial_angle_random_range_rad``, at rest, battery
-    full. Wind: a constant force of wind_speed · 0.5 · 1.0 m (2.5 N) in a direction uniform in
-    [0, 2π) per episode (or ``wind_direction``). A moving platform starts in a random
-    direction. All drawn from the episode's seed.
+    Spawn at (``spawn_x``, ``spawn_y``) = (25, 40) ± ``initial_pos_random_range_m`` in x and
+    y (kept inside the world and above the platform), angle uniform in
+    ±``initial_angle_random_range_rad``, at rest, battery full. Wind: a constant force of
+    wind_speed · 0.5 · 1.0 m (2.5 N) in a direction uniform in [0, 2π) per episode (or
+    ``wind_direction``). A moving platform starts in a random direction. All drawn from the
+    episode's seed.
 
     ## Episode end
 
@@ -87,26 +87,26 @@ class Lander2DEnv(FlyloopEnv):
 
     ## Arguments
 
-    - ``max_steps=1000``, ``dt=0.02`` (s, 50 Hz control). The physics runs on its own fixed
-      grid, core parameter ``physics_step`` (default 0.02 s, one physics step per env step;
-      set it through ``model_params``): rapier steps, thrust noise and battery drain once per
-      grid step, so every ``dt`` that is a multiple of it gives the same bits at the shared
-      times (``model_params={"physics_step": 0.005}`` with ``dt=0.01`` or ``0.02``); a ``dt``
-      that is not ends each step in a shortened physics step (docs/reference/lander2d.md).
-    - ``moving_platform=False``, ``platform_speed=1.5`` (m/s),
-      ``platform_random_start_x=False``.
-    - ``initial_pos_random_range_m=5.0`` (0 = fixed start at (spawn_x, spawn_y)),
-      ``spawn_x=25.0``, ``spawn_y=40.0`` (m; a spawn is kept inside the world and at least a
-      drone width above the platform), ``initial_angle_random_range_rad=0.1``.
-    - ``use_wind=True``, ``wind_speed=5.0`` (m/s), ``wind_direction=None`` (None = random per
-      episode, else radians from +x toward +y).
-    - ``thrust_noise_std=1.5`` (N), ``max_safe_landing_speed=1.5``,
-      ``max_safe_landing_angle=0.2``, ``max_allowed_tilt_angle_rad=π/2``.
+    The physics runs on its own fixed grid, core parameter ``physics_step`` (default 0.02 s,
+    one physics step per env step; set it through ``model_params``): rapier steps, thrust
+    noise and battery drain once per grid step, so every ``dt`` that is a multiple of it gives
+    the same bits at the shared times (``model_params={"physics_step": 0.005}`` with
+    ``dt=0.01`` or ``0.02``); a ``dt`` that is not ends each step in a shortened physics step
+    (docs/reference/lander2d.md).
+
+    The task arguments (listed below with the core's defaults, units and descriptions) are the
+    core's parameters under their own names, except the seed's ``use_wind`` (core
+    ``wind_enabled``) and ``wind_direction`` (None = random per episode, else radians from +x
+    toward +y). A spawn is kept inside the world and at least a drone width above the
+    platform; ``initial_pos_random_range_m=0`` is a fixed start at (spawn_x, spawn_y). The
+    env's own:
+
     - ``model_params=None``: other Lander2D parameters by core name (``drone_mass``,
       ``max_thrust``, ``initial_battery``, ``world_width``, ...; docs/parameters.md).
     - ``render_mode=None`` / ``"human"`` / ``"rgb_array"``; ``render_path=True``,
       ``render_shade=True``, ``shade_distance_m=2.0`` (the seed's drawing options).
-    - ``sitl_path``, ``sitl_address``, ``vehicle``, ``timeout``: as ``QuadHoverEnv``.
+    - ``sitl_path``, ``sitl_address``, ``vehicle``, ``timeout``, ``backend``: as
+      ``QuadHoverEnv``.
 
     ## Errors
 
@@ -132,66 +132,18 @@ class Lander2DEnv(FlyloopEnv):
 
     def __init__(
         self,
-        max_steps: int = 1000,
-        moving_platform: bool = False,
-        platform_speed: float = 1.5,
-        initial_pos_random_range_m: float = 5.0,
-        render_mode: str | None = None,
+        *,
         render_path: bool = True,
         render_shade: bool = True,
         shade_distance_m: float = 2.0,
-        *,
-        dt: float = 0.02,
-        spawn_x: float = 25.0,
-        spawn_y: float = 40.0,
-        initial_angle_random_range_rad: float = 0.1,
-        use_wind: bool = True,
-        wind_speed: float = 5.0,
-        wind_direction: float | None = None,
-        platform_random_start_x: bool = False,
-        thrust_noise_std: float = 1.5,
-        max_safe_landing_speed: float = 1.5,
-        max_safe_landing_angle: float = 0.2,
-        max_allowed_tilt_angle_rad: float = 1.5707963267948966,
-        model_params: Mapping[str, Any] | None = None,
-        sitl_path: str | None = None,
-        sitl_address: Any = None,
-        vehicle: int = 1,
-        timeout: float = 5.0,
-        backend: str = "sitl",
+        **arguments: Any,
     ) -> None:
         self._render_options = dict(
             show_path=bool(render_path),
             show_shades=bool(render_shade),
             shade_distance_m=float(shade_distance_m),
         )
-        super().__init__(
-            arguments=dict(
-                max_steps=max_steps,
-                dt=dt,
-                moving_platform=moving_platform,
-                platform_speed=platform_speed,
-                initial_pos_random_range_m=initial_pos_random_range_m,
-                spawn_x=spawn_x,
-                spawn_y=spawn_y,
-                initial_angle_random_range_rad=initial_angle_random_range_rad,
-                use_wind=use_wind,
-                wind_speed=wind_speed,
-                wind_direction=wind_direction,
-                platform_random_start_x=platform_random_start_x,
-                thrust_noise_std=thrust_noise_std,
-                max_safe_landing_speed=max_safe_landing_speed,
-                max_safe_landing_angle=max_safe_landing_angle,
-                max_allowed_tilt_angle_rad=max_allowed_tilt_angle_rad,
-            ),
-            model_params=model_params,
-            render_mode=render_mode,
-            sitl_path=sitl_path,
-            sitl_address=sitl_address,
-            vehicle=vehicle,
-            timeout=timeout,
-            backend=backend,
-        )
+        super().__init__(**arguments)
 
     def _make_view(self, render_mode: str):
         from ..rendering import LanderView

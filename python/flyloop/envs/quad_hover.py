@@ -2,10 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
-
-from ..tasks import HOVER, parameter_values
+from ..tasks import HOVER
 from .base import FlyloopEnv
 
 
@@ -79,16 +76,13 @@ class QuadHoverEnv(FlyloopEnv):
 
     ## Arguments
 
-    - ``max_steps=1000``: steps until truncation.
-    - ``dt=0.01``: control period, s (one action per dt; the core integrates with RK4).
-    - ``target_change_interval=None``: steps between new targets (None: never).
-    - ``wind_strength_range=(0.0, 5.0)``: per-episode mean wind speed drawn in this range, m/s,
-      plus Ornstein–Uhlenbeck turbulence.
-    - ``use_wind=True``: wind on or off.
-    - ``enable_crash_detection=True``, ``enable_out_of_bounds_detection=True``,
-      ``crash_z_vel_threshold=-20.0`` (m/s), ``crash_tilt_threshold=80.0`` (degrees).
-    - ``space_side_length=3.0``, ``start_height=1.5``, ``start_attitude_range=0.1``,
-      ``min_target_distance=1.0``, ``velocity_scale=3.0``: task geometry and reward scale.
+    The task arguments (listed below with the core's defaults, units and descriptions, and in
+    ``inspect.signature(QuadHoverEnv)``) are the core's parameters of the task under their own
+    names, except the seed's ``use_wind`` (core ``wind_enabled``), ``wind_strength_range``
+    ((``wind_speed_min``, ``wind_speed_max``): per-episode mean wind speed drawn in this range,
+    plus Ornstein–Uhlenbeck turbulence), ``target_change_interval`` (None: never),
+    ``action_interface``, ``observation_noise`` and ``randomize``. The env's own:
+
     - ``model_params=None``: other physical parameters of the quadrotor by their core name,
       e.g. ``{"mass": 1.2, "pendulum_coefficient": 0.03}`` (docs/parameters.md).
     - ``render_mode=None``: ``"human"`` (a pygame window) or ``"rgb_array"``.
@@ -119,67 +113,6 @@ class QuadHoverEnv(FlyloopEnv):
 
     SPEC = HOVER
 
-    def __init__(
-        self,
-        max_steps: int = 1000,
-        dt: float = 0.01,
-        target_change_interval: int | None = None,
-        wind_strength_range: tuple[float, float] = (0.0, 5.0),
-        use_wind: bool = True,
-        render_mode: str | None = None,
-        enable_crash_detection: bool = True,
-        enable_out_of_bounds_detection: bool = True,
-        crash_z_vel_threshold: float = -20.0,
-        crash_tilt_threshold: float = 80.0,
-        *,
-        space_side_length: float = 3.0,
-        start_height: float = 1.5,
-        start_attitude_range: float = 0.1,
-        min_target_distance: float = 1.0,
-        velocity_scale: float = 3.0,
-        model_params: Mapping[str, Any] | None = None,
-        sitl_path: str | None = None,
-        sitl_address: Any = None,
-        vehicle: int = 1,
-        timeout: float = 5.0,
-        backend: str = "sitl",
-        **task_arguments: Any,
-    ) -> None:
-        arguments = dict(
-            max_steps=max_steps,
-            dt=dt,
-            target_change_interval=target_change_interval,
-            wind_strength_range=wind_strength_range,
-            use_wind=use_wind,
-            enable_crash_detection=enable_crash_detection,
-            enable_out_of_bounds_detection=enable_out_of_bounds_detection,
-            crash_z_vel_threshold=crash_z_vel_threshold,
-            crash_tilt_threshold=crash_tilt_threshold,
-            space_side_length=space_side_length,
-            start_height=start_height,
-            start_attitude_range=start_attitude_range,
-            min_target_distance=min_target_distance,
-            velocity_scale=velocity_scale,
-        )
-        known = {a.name for a in self.SPEC.arguments}
-        unknown = set(task_arguments) - known
-        if unknown:
-            raise TypeError(
-                f"{type(self).__name__}() got unexpected arguments {sorted(unknown)}; "
-                f"task arguments: {sorted(known)}"
-            )
-        arguments.update(task_arguments)
-        super().__init__(
-            arguments=arguments,
-            model_params=model_params,
-            render_mode=render_mode,
-            sitl_path=sitl_path,
-            sitl_address=sitl_address,
-            vehicle=vehicle,
-            timeout=timeout,
-            backend=backend,
-        )
-
     def _make_view(self, render_mode: str):
         from ..rendering import QuadrotorView
 
@@ -188,14 +121,6 @@ class QuadHoverEnv(FlyloopEnv):
     def _scene(self, obs, info, reward):
         from ..rendering import quad_scene
 
-        values = parameter_values(self.core)
-        side = float(values["space_side_length"])
-        arm = float(values["arm_length"])
         return quad_scene(
-            obs,
-            info,
-            reward=reward,
-            episode_return=self._episode_return,
-            bounds_half_size=side / 2.0,
-            arm_length=arm,
+            obs, info, reward=reward, episode_return=self._episode_return, core=self.core
         )

@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
-
 from ..tasks import WAYPOINTS
 from .quad_hover import QuadHoverEnv
 
@@ -53,8 +50,7 @@ class QuadWaypointsEnv(QuadHoverEnv):
 
     ## Arguments
 
-    QuadHover's, plus ``max_num_waypoints=15``, ``waypoint_reach_threshold_m=0.1``,
-    ``checkpoint_bonus=10.0``, ``bonus_decay_rate_per_sec=2.0``.
+    QuadHover's, plus the waypoint parameters (listed below).
 
     ## Version history
 
@@ -62,62 +58,3 @@ class QuadWaypointsEnv(QuadHoverEnv):
     """
 
     SPEC = WAYPOINTS
-
-    def __init__(
-        self,
-        max_num_waypoints: int = 15,
-        waypoint_reach_threshold_m: float = 0.1,
-        checkpoint_bonus: float = 10.0,
-        bonus_decay_rate_per_sec: float = 2.0,
-        *,
-        max_steps: int = 1000,
-        dt: float = 0.01,
-        target_change_interval: int | None = None,
-        wind_strength_range: tuple[float, float] = (0.0, 5.0),
-        use_wind: bool = True,
-        render_mode: str | None = None,
-        enable_crash_detection: bool = True,
-        enable_out_of_bounds_detection: bool = True,
-        crash_z_vel_threshold: float = -20.0,
-        crash_tilt_threshold: float = 80.0,
-        space_side_length: float = 3.0,
-        start_height: float = 1.5,
-        start_attitude_range: float = 0.1,
-        min_target_distance: float = 1.0,
-        velocity_scale: float = 3.0,
-        model_params: Mapping[str, Any] | None = None,
-        sitl_path: str | None = None,
-        sitl_address: Any = None,
-        vehicle: int = 1,
-        timeout: float = 5.0,
-        backend: str = "sitl",
-        **flight_arguments: Any,
-    ) -> None:
-        super().__init__(
-            max_steps=max_steps,
-            dt=dt,
-            target_change_interval=target_change_interval,
-            wind_strength_range=wind_strength_range,
-            use_wind=use_wind,
-            render_mode=render_mode,
-            enable_crash_detection=enable_crash_detection,
-            enable_out_of_bounds_detection=enable_out_of_bounds_detection,
-            crash_z_vel_threshold=crash_z_vel_threshold,
-            crash_tilt_threshold=crash_tilt_threshold,
-            space_side_length=space_side_length,
-            start_height=start_height,
-            start_attitude_range=start_attitude_range,
-            min_target_distance=min_target_distance,
-            velocity_scale=velocity_scale,
-            model_params=model_params,
-            sitl_path=sitl_path,
-            sitl_address=sitl_address,
-            vehicle=vehicle,
-            timeout=timeout,
-            backend=backend,
-            max_num_waypoints=max_num_waypoints,
-            waypoint_reach_threshold_m=waypoint_reach_threshold_m,
-            checkpoint_bonus=checkpoint_bonus,
-            bonus_decay_rate_per_sec=bonus_decay_rate_per_sec,
-            **flight_arguments,
-        )

@@ -5,15 +5,15 @@
     frame = view.render(QuadScene(...))        # (720, 960, 3) uint8; None in human mode
     view.close()
 
-Importing this package does not import pygame: each view's constructor does.
+One file per view (quadrotor.py, lander.py: scene, drawing, view), the 3D camera
+(camera.py), what both draw with (canvas.py) and saving frames (recording.py). Importing
+this package does not import pygame: each view's constructor does.
 """
 
 from .camera import OrbitCamera
-from .from_task import lander_scene, quad_scene
-from .lander_view import LanderView
-from .quadrotor_view import QuadrotorView
+from .lander import LanderScene, LanderView, lander_scene
+from .quadrotor import QuadrotorView, QuadScene, quad_scene
 from .recording import FrameRecorder, Recording, record_episode, save_video
-from .scene import LanderScene, QuadScene
 
 __all__ = [
     "FrameRecorder",

@@ -1,0 +1,493 @@
+"""The Lander2D view (task Landing): its scene, the plane (metres to pixels), the picture
+(one function per element, drawn in that order) and LanderView. World metres, x right, y up,
+angles counter-clockwise.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .. import _native
+from ..tasks import LANDING, observation_slices
+from .canvas import FlightPath, Painter, Shades, View, check_render_mode, rotate2d, vector
+
+SKY_TOP, SKY_BOTTOM, OUTSIDE = (196, 220, 246), (226, 238, 250), (120, 130, 145)
+GROUND, GROUND_EDGE, BOUNDS, SPAWN = (96, 148, 82), (62, 112, 58), (200, 70, 70), (178, 160, 80)
+PLATFORM, PLATFORM_EDGE, PLATFORM_TOP = (150, 150, 170), (50, 50, 60), (245, 200, 40)
+FRAME, MOTOR, OUTLINE, SHADE = (52, 72, 168), (36, 48, 120), (10, 10, 20), (70, 90, 180)
+PATH, SENSOR, THRUST_TRACK, THRUST = (16, 19, 97), (230, 120, 20), (170, 170, 170), (235, 50, 50)
+WIND, TEXT, GOOD, BAD = (50, 50, 200), (15, 15, 25), (0, 140, 0), (200, 0, 0)
+
+THRUST_BAR_PX = 40  # a full-thrust bar's length, as the reference (docs/reference/lander2d.md)
+CLOSE_UP_SIZE = (250, 180)
+CLOSE_UP_SCALE = 48.0  # px per metre: a 1 m drone is 48 px wide
+# What the scene shows when not told: the Landing task's defaults, read from the core.
+_CORE = LANDING.defaults
+# Where a moving platform's vx / platform_speed sits in the observation (the core's layout).
+_PLATFORM_VX = observation_slices(_native.describe("landing", {"moving_platform": 1.0}))[
+    "platform_velocity"
+].start
+_OUTCOMES = (
+    ("lost_control", "lost control"),
+    ("out_of_bounds", "out of bounds"),
+    ("battery_empty", "battery empty"),
+    ("time_limit", "time limit reached"),
+)
+# The model's sizes a scene takes from the env's parameters (else the core's defaults).
+_WORLD = (
+    "world_width world_height ground_height platform_width platform_height drone_width "
+    "drone_height max_thrust initial_battery"
+).split()
+
+
+@dataclass(eq=False)
+class LanderScene:
+    """One frame of the Lander2D; sizes default to the core's Lander2D defaults."""
+
+    time_s: float  # episode time, s
+    step: int  # steps since reset
+    position: np.ndarray  # (2,) m, drone centre
+    velocity: np.ndarray  # (2,) m/s
+    angle: float  # rad, counter-clockwise
+    angular_velocity: float  # rad/s, counter-clockwise
+    thrust: np.ndarray  # (2,) N, (left, right) motor thrust of the last step
+    battery: float  # charge left, units
+    platform_x: float  # m, platform centre x
+    wind_force: np.ndarray = field(default_factory=lambda: np.zeros(2))  # (2,) N on the drone
+    wind_speed: float = 0.0  # m/s, for the label (the force is what acts)
+    platform_vx: float = 0.0  # m/s
+    landed: bool = False
+    crashed: bool = False
+    outcome: str = ""  # another ending: "lost control", "out of bounds", "battery empty", ...
+    max_steps: int | None = None
+    reward: float | None = None
+    episode_return: float | None = None
+    max_thrust: float = _CORE["max_thrust"]  # N per motor
+    initial_battery: float = _CORE["initial_battery"]  # units
+    world_width: float = _CORE["world_width"]  # m: the world is x in (0, W)
+    world_height: float = _CORE["world_height"]  # m: y in (0, H)
+    ground_height: float = _CORE["ground_height"]  # m
+    platform_width: float = _CORE["platform_width"]  # m
+    platform_height: float = _CORE["platform_height"]  # m above the ground
+    drone_width: float = _CORE["drone_width"]  # m, tip to tip
+    drone_height: float = _CORE["drone_height"]  # m, side of each square motor
+    # (2,) m, centre of the spawn square, and its half side (0 = fixed start)
+    spawn_center: np.ndarray = field(
+        default_factory=lambda: np.array([_CORE["spawn_x"], _CORE["spawn_y"]])
+    )
+    spawn_half_range: float = _CORE["initial_pos_random_range_m"]
+
+    def __post_init__(self) -> None:
+        for name in ("position", "velocity", "thrust", "wind_force", "spawn_center"):
+            setattr(self, name, vector(getattr(self, name)))
+        self.step = int(self.step)
+
+    @property
+    def platform_top(self) -> tuple[float, float]:
+        """Top centre of the platform, m: where the sensor line points."""
+        return self.platform_x, self.ground_height + self.platform_height
+
+    @property
+    def distance_to_platform(self) -> float:
+        """Distance from the drone centre to the platform's top centre, m."""
+        tx, ty = self.platform_top
+        return math.hypot(tx - self.position[0], ty - self.position[1])
+
+
+def lander_scene(
+    info: Mapping[str, Any],
+    observation: Any = None,
+    *,
+    dt: float | None = None,
+    reward: float | None = None,
+    episode_return: float | None = None,
+    max_steps: int | None = None,
+    params: Mapping[str, Any] | None = None,
+) -> LanderScene:
+    """A LanderScene from a Landing info dict and its observation (a moving platform's
+    vx / platform_speed). `params`: the env's core parameters by name (missing
+    ones: the core's defaults)."""
+    p = {**_CORE, **(params or {})}
+    step = int(info["step"])
+    obs = () if observation is None else np.asarray(observation, dtype=float).reshape(-1)
+    return LanderScene(
+        time_s=step * (p["dt"] if dt is None else dt),
+        step=step,
+        position=info["position"],
+        velocity=info["velocity"],
+        angle=float(info["angle"]),
+        angular_velocity=float(info["angular_velocity"]),
+        thrust=info["thrust"],
+        battery=float(info["battery"]),
+        platform_x=float(info["platform_position"][0]),
+        platform_vx=float(obs[_PLATFORM_VX]) * float(p["platform_speed"])
+        if len(obs) > _PLATFORM_VX
+        else 0.0,
+        wind_force=info.get("wind_force", (0.0, 0.0)),
+        wind_speed=float(p["wind_speed"]) if p["wind_enabled"] else 0.0,
+        landed=bool(info.get("landed", False)),
+        crashed=bool(info.get("crashed", False)),
+        outcome=next((text for key, text in _OUTCOMES if info.get(key)), ""),
+        max_steps=max_steps,
+        reward=reward,
+        episode_return=episode_return,
+        spawn_center=(float(p["spawn_x"]), float(p["spawn_y"])),
+        spawn_half_range=float(p["initial_pos_random_range_m"]),
+        **{name: float(p[name]) for name in _WORLD},
+    )
+
+
+class PlaneView:
+    """A uniform scale (px per metre) and the pixel (u0, v0) where world (0, 0) lands."""
+
+    def __init__(self, scale: float, u0: float, v0: float) -> None:
+        if not scale > 0:
+            raise ValueError(f"scale must be > 0 px/m, got {scale}")
+        self.scale, self.u0, self.v0 = float(scale), float(u0), float(v0)
+
+    @classmethod
+    def fit_world(
+        cls, world_width: float, world_height: float, size: tuple[int, int], margin_px: int = 12
+    ) -> PlaneView:
+        """The world box (0, 0)-(W, H), centred, filling the frame less margin_px per side."""
+        width, height = size
+        usable_w, usable_h = width - 2 * margin_px, height - 2 * margin_px
+        if usable_w <= 0 or usable_h <= 0 or world_width <= 0 or world_height <= 0:
+            raise ValueError(
+                f"cannot fit a {world_width} x {world_height} m world in {width} x {height} px"
+            )
+        scale = min(usable_w / world_width, usable_h / world_height)
+        return cls(
+            scale, (width - world_width * scale) / 2.0, (height + world_height * scale) / 2.0
+        )
+
+    @classmethod
+    def centred_on(cls, center: np.ndarray, scale: float, size: tuple[int, int]) -> PlaneView:
+        """World point `center` at the middle of a frame of `size` pixels."""
+        return cls(scale, size[0] / 2.0 - center[0] * scale, size[1] / 2.0 + center[1] * scale)
+
+    def to_screen(self, points: np.ndarray) -> np.ndarray:
+        p = np.asarray(points, dtype=float)
+        return np.stack([self.u0 + p[..., 0] * self.scale, self.v0 - p[..., 1] * self.scale], -1)
+
+    def to_world(self, pixels: np.ndarray) -> np.ndarray:
+        q = np.asarray(pixels, dtype=float)
+        return np.stack(
+            [(q[..., 0] - self.u0) / self.scale, (self.v0 - q[..., 1]) / self.scale], -1
+        )
+
+
+def background(p: Painter, plane: PlaneView, s: LanderScene) -> None:
+    """Grey outside the world, a sky gradient (by altitude) inside it."""
+    p.surface.fill(OUTSIDE)
+    width, height = p.surface.get_size()
+    (u0, v_top), (u1, v_bottom) = plane.to_screen(
+        np.array([[0.0, s.world_height], [s.world_width, 0.0]])
+    )
+    left, right = max(0, round(u0)), min(width, round(u1))
+    top, bottom = max(0, round(v_top)), min(height, round(v_bottom))
+    span = max(1.0, v_bottom - v_top)
+    for v in range(top, bottom, 4):
+        t = (v - v_top) / span
+        color = tuple(round(a + (b - a) * t) for a, b in zip(SKY_TOP, SKY_BOTTOM, strict=True))
+        p.pg.draw.rect(p.surface, color, (left, v, right - left, min(4, bottom - v)))
+
+
+def ground(p: Painter, plane: PlaneView, s: LanderScene) -> None:
+    top_left = plane.to_screen((0.0, s.ground_height))
+    bottom_right = plane.to_screen((s.world_width, 0.0))
+    rect = (*top_left, *(bottom_right - top_left))
+    p.pg.draw.rect(p.surface, GROUND, tuple(round(x) for x in rect))
+    p.line(top_left, (bottom_right[0], top_left[1]), GROUND_EDGE, 4)
+
+
+def bounds(p: Painter, plane: PlaneView, s: LanderScene) -> None:
+    w, h = s.world_width, s.world_height
+    corners = plane.to_screen(np.array([[0, 0], [w, 0], [w, h], [0, h], [0, 0]], dtype=float))
+    for a, b in zip(corners[:-1], corners[1:], strict=True):
+        p.dashed_line(a, b, BOUNDS, 2, dash_px=8)
+
+
+def spawn_zone(p: Painter, plane: PlaneView, s: LanderScene) -> None:
+    r = s.spawn_half_range
+    if r <= 0:
+        return
+    cx, cy = s.spawn_center
+    lo = plane.to_screen((cx - r, cy + r))
+    hi = plane.to_screen((cx + r, cy - r))
+    p.pg.draw.rect(p.surface, SPAWN, (*np.round(lo), *np.round(hi - lo)), 1)
+    p.text("spawn zone", (lo[0] + 4, lo[1] + 3), SPAWN, 16)
+
+
+def platform(p: Painter, plane: PlaneView, s: LanderScene) -> None:
+    half = s.platform_width / 2.0
+    x0, x1 = s.platform_x - half, s.platform_x + half
+    y0, y1 = s.ground_height, s.ground_height + s.platform_height
+    box = plane.to_screen(np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]))
+    p.polygon(box, PLATFORM, PLATFORM_EDGE, 2)
+    p.line(box[3], box[2], PLATFORM_TOP, 3)
+    if abs(s.platform_vx) > 1e-6:
+        mid = plane.to_screen((s.platform_x, y0 - 0.6))
+        tip = mid + np.array(
+            [math.copysign(min(30.0, 12 + 8 * abs(s.platform_vx)), s.platform_vx), 0]
+        )
+        p.arrow(mid, tip, PLATFORM_EDGE, 2, head_px=7)
+
+
+def path(p: Painter, plane: PlaneView, points: np.ndarray) -> None:
+    if len(points) >= 2:
+        p.polyline(plane.to_screen(points), PATH, 1)
+
+
+def _drone_parts(s: LanderScene, x: float, y: float, angle: float) -> list[np.ndarray]:
+    """World polygons of the frame and the two motors (the core's three colliders)."""
+    w, h = s.drone_width, s.drone_height
+    motor_x = (w - h) / 2.0
+    frame = np.array([[-motor_x, -h / 4], [motor_x, -h / 4], [motor_x, h / 4], [-motor_x, h / 4]])
+    square = np.array([[-h / 2, -h / 2], [h / 2, -h / 2], [h / 2, h / 2], [-h / 2, h / 2]])
+    parts = [frame, square + [-motor_x, 0.0], square + [motor_x, 0.0]]
+    return [rotate2d(part, angle) + [x, y] for part in parts]
+
+
+def shades(p: Painter, plane: PlaneView, s: LanderScene, poses: list) -> None:
+    for x, y, angle in poses:
+        for part in _drone_parts(s, x, y, angle):
+            p.translucent_polygon(plane.to_screen(part), SHADE, 95)
+
+
+def sensor_line(p: Painter, plane: PlaneView, s: LanderScene, label: bool = True) -> None:
+    a = plane.to_screen(s.position)
+    b = plane.to_screen(s.platform_top)
+    p.dashed_line(a, b, SENSOR, 2, dash_px=7)
+    p.disc(b, 4, SENSOR)
+    if not label:
+        return
+    mid = (a + b) / 2.0
+    p.text(f"{s.distance_to_platform:.1f} m", (mid[0] + 8, mid[1]), SENSOR, 18, "midleft", True)
+
+
+def drone(p: Painter, plane: PlaneView, s: LanderScene) -> None:
+    x, y = s.position
+    frame, left, right = _drone_parts(s, x, y, s.angle)
+    for part, color in ((frame, FRAME), (left, MOTOR), (right, MOTOR)):
+        p.polygon(plane.to_screen(part), color, OUTLINE, 1)
+
+
+def thrust_bars(
+    p: Painter, plane: PlaneView, s: LanderScene, full_px: float = THRUST_BAR_PX
+) -> None:
+    """Over each motor, along the body's +y: grey = max thrust, red = this step's thrust."""
+    motor_x = (s.drone_width - s.drone_height) / 2.0
+    up = rotate2d(np.array([[0.0, 1.0]]), s.angle)[0] * np.array([1.0, -1.0])  # screen v down
+    for side, thrust in ((-1.0, s.thrust[0]), (1.0, s.thrust[1])):
+        attach = rotate2d(np.array([[side * motor_x, s.drone_height / 2]]), s.angle)[0]
+        start = plane.to_screen(attach + s.position)
+        fraction = min(max(thrust / s.max_thrust, 0.0), 1.0)
+        p.line(start, start + up * full_px, THRUST_TRACK, 3)
+        if fraction > 0:
+            p.line(start, start + up * full_px * fraction, THRUST, 3)
+
+
+def wind_indicator(p: Painter, s: LanderScene) -> None:
+    """Top-right dial: arrow along the wind force, with speed and direction."""
+    width = p.surface.get_width()
+    center = np.array([width - 66.0, 62.0])
+    p.disc(center, 36, (250, 250, 255), WIND, 2)
+    magnitude = float(np.hypot(*s.wind_force))
+    if magnitude > 1e-9:
+        direction = s.wind_force / magnitude
+        tip = center + np.array([direction[0], -direction[1]]) * 30
+        p.arrow(center - (tip - center) * 0.6, tip, WIND, 3, head_px=11)
+        heading = math.degrees(math.atan2(s.wind_force[1], s.wind_force[0])) % 360
+        label = f"Wind {s.wind_speed:.1f} m/s @ {heading:.0f}°"
+    else:
+        label = "Wind: calm"
+    p.text(label, (width - 20, center[1] + 42), TEXT, 19, "topright")
+    p.text(f"force {magnitude:.2f} N", (width - 20, center[1] + 60), TEXT, 17, "topright")
+
+
+def status_text(s: LanderScene) -> tuple[str, tuple[int, int, int]]:
+    if s.landed:
+        return "Landed safely!", GOOD
+    if s.crashed:
+        return "Crashed!", BAD
+    if s.outcome:
+        return s.outcome[:1].upper() + s.outcome[1:] + "!", BAD
+    if s.max_steps is not None and s.step >= s.max_steps:
+        return "Time limit reached", BAD
+    return "Flying", TEXT
+
+
+def overlay(p: Painter, plane: PlaneView, s: LanderScene) -> None:
+    """Text panel over the ground band: battery, status, step, position, velocity, angle,
+    angular velocity, distance, and the two motor force bars."""
+    steps = f"{s.step} / {s.max_steps}" if s.max_steps is not None else f"{s.step}"
+    angle_deg = math.degrees(math.remainder(s.angle, math.tau))
+    status, status_color = status_text(s)
+    reward = "Reward: -" if s.reward is None else f"Reward: {s.reward:+.3f}"
+    if s.episode_return is not None:
+        reward += f"  (return {s.episode_return:.1f})"
+    columns = [
+        [
+            (f"Battery: {s.battery:.1f} / {s.initial_battery:.0f}", TEXT),
+            (f"Status: {status}", status_color),
+            (f"Step: {steps}   t = {s.time_s:.2f} s", TEXT),
+            (reward, TEXT),
+        ],
+        [
+            (f"Position: ({s.position[0]:.2f}, {s.position[1]:.2f}) m", TEXT),
+            (f"Velocity: ({s.velocity[0]:+.2f}, {s.velocity[1]:+.2f}) m/s", TEXT),
+            (f"Angle: {angle_deg:+.1f}°", TEXT),
+            (f"Angular velocity: {s.angular_velocity:+.2f} rad/s", TEXT),
+        ],
+        [
+            (f"Distance to platform: {s.distance_to_platform:.2f} m", TEXT),
+            (f"Thrust L: {s.thrust[0]:.1f} N", TEXT),
+            (f"Thrust R: {s.thrust[1]:.1f} N", TEXT),
+            (f"Platform: x {s.platform_x:.1f} m, {s.platform_vx:+.1f} m/s", TEXT),
+        ],
+    ]
+    width, height = p.surface.get_size()
+    line_h, pad = 22, 10
+    panel_h = 4 * line_h + 2 * pad
+    ground_v = float(plane.to_screen((0.0, s.ground_height))[1])
+    top = min(max(ground_v + 14, 0), height - panel_h - 16)
+    rect = (16, round(top), width - 32, panel_h)
+    p.panel(rect, (255, 255, 248))
+    col_w = (rect[2] - 2 * pad) // 3
+    for c, lines in enumerate(columns):
+        x = rect[0] + pad + c * col_w
+        for i, (text, color) in enumerate(lines):
+            p.text(text, (x, rect[1] + pad + i * line_h), color, 19, bold=(c == 0 and i == 1))
+    bar_x = rect[0] + pad + 2 * col_w + 120
+    for i, thrust in enumerate(s.thrust):
+        p.bar(
+            (bar_x, rect[1] + pad + (i + 1) * line_h + 2, col_w - 130, 11),
+            thrust / s.max_thrust,
+            THRUST,
+        )
+    fraction = s.battery / s.initial_battery
+    fill = GOOD if fraction > 0.3 else (230, 150, 0) if fraction > 0.1 else BAD
+    p.bar((rect[0] + pad + 175, rect[1] + pad + 2, col_w - 190, 11), fraction, fill)
+
+
+def world(
+    p: Painter,
+    plane: PlaneView,
+    s: LanderScene,
+    shade_poses: list,
+    path_points: np.ndarray,
+    *,
+    spawn: bool = True,
+    labels: bool = True,
+    thrust_px: float = THRUST_BAR_PX,
+) -> None:
+    """Everything that lives in world coordinates, back to front."""
+    background(p, plane, s)
+    if spawn:
+        spawn_zone(p, plane, s)
+    ground(p, plane, s)
+    bounds(p, plane, s)
+    shades(p, plane, s, shade_poses)
+    path(p, plane, path_points)
+    platform(p, plane, s)
+    sensor_line(p, plane, s, label=labels)
+    drone(p, plane, s)
+    thrust_bars(p, plane, s, thrust_px)
+
+
+def close_up(
+    p: Painter, s: LanderScene, shade_poses: list, path_points: np.ndarray, zoom: float
+) -> None:
+    """A zoomed window on the drone (top-left), framed and titled; p draws on that window."""
+    width, height = p.surface.get_size()
+    # The drone sits a little low so its thrust bars fit above it.
+    center = np.array(s.position) + np.array([0.0, 0.12 * height / CLOSE_UP_SCALE])
+    plane = PlaneView.centred_on(center, CLOSE_UP_SCALE, (width, height))
+    world(p, plane, s, shade_poses, path_points, spawn=False, labels=False, thrust_px=70)
+    p.pg.draw.rect(p.surface, (40, 40, 50), (0, 0, width, height), 2)
+    p.text(f"close-up ×{zoom:.0f}", (8, 6), TEXT, 18, bold=True)
+
+
+class LanderView(View):
+    """Draws LanderScene frames: a window ("human") or (H, W, 3) uint8 arrays ("rgb_array").
+
+    Keeps the episode's flight path and shades (a shade every `shade_distance_m` travelled);
+    both restart when a scene's step goes backwards (a new episode) or on `reset()`.
+    """
+
+    SCENE = LanderScene
+
+    def __init__(
+        self,
+        render_mode: str,
+        width: int = 800,
+        height: int = 800,
+        fps: float = 50.0,
+        *,
+        show_path: bool = True,
+        show_shades: bool = True,
+        shade_distance_m: float = 2.0,
+        show_spawn_zone: bool = True,
+        show_overlay: bool = True,
+        show_close_up: bool = True,
+    ) -> None:
+        check_render_mode(render_mode)
+        self.show_path = show_path
+        self.show_shades = show_shades
+        self.show_spawn_zone = show_spawn_zone
+        self.show_overlay = show_overlay
+        self._path = FlightPath()
+        self._shades = Shades(shade_distance_m)
+        super().__init__(render_mode, (width, height), "flyloop - Lander2D", fps)
+        self._close_up: Painter | None = None
+        if show_close_up:
+            cw, ch = CLOSE_UP_SIZE
+            if width >= 3 * cw and height >= 3 * ch:  # a small frame has no room for it
+                window = self._screen.surface.subsurface((20, 20, cw, ch))
+                self._close_up = Painter(self._screen.pg, window)
+        self._plane: PlaneView | None = None
+        self._plane_key: tuple[float, float] | None = None
+
+    def world_to_screen(self, scene: LanderScene, points: np.ndarray) -> np.ndarray:
+        """Pixels (u, v) where world points (..., 2) in metres are drawn for this scene."""
+        return self._plane_for(scene).to_screen(points)
+
+    def reset(self) -> None:
+        """Forget the flight path and shades (an env calls this from reset())."""
+        self._path.clear()
+        self._shades.clear()
+
+    def render(self, scene: LanderScene) -> np.ndarray | None:
+        """Draw one frame: returns it in rgb_array mode, None in human mode."""
+        if self._events(scene) is None:
+            return None  # the user closed the window: nothing to draw on any more
+        if self._path.update(scene.step, scene.position):
+            self._shades.clear()
+        self._shades.update(scene.position, scene.angle)
+        self._draw(scene)
+        return self._screen.present()
+
+    def _plane_for(self, scene: LanderScene) -> PlaneView:
+        key = (scene.world_width, scene.world_height)
+        if self._plane is None or self._plane_key != key:
+            self._plane = PlaneView.fit_world(scene.world_width, scene.world_height, self.size)
+            self._plane_key = key
+        return self._plane
+
+    def _draw(self, s: LanderScene) -> None:
+        p, plane = self._painter, self._plane_for(s)
+        shade_poses = self._shades.poses if self.show_shades else []
+        path_points = self._path.points if self.show_path else np.zeros((0, 2))
+        world(p, plane, s, shade_poses, path_points, spawn=self.show_spawn_zone)
+        zoom = CLOSE_UP_SCALE / plane.scale
+        if self._close_up is not None and zoom >= 1.5:  # in a small world it adds nothing
+            close_up(self._close_up, s, shade_poses, path_points, zoom)
+        wind_indicator(p, s)
+        if self.show_overlay:
+            overlay(p, plane, s)

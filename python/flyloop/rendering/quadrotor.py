@@ -1,0 +1,582 @@
+"""The quadrotor view (tasks Hover and Waypoints): its scene, the 3D world drawn through an
+orbit camera, the overlays (info panel, motor bars, axis gizmo, wind dial, legend) and
+QuadrotorView.
+
+Frames as the core: world ENU (x east, y north, z up), body FLU (x forward, y left, z up),
+quaternion [w, x, y, z] rotating body to world; motors in PX4's quad-X order (0 front-right,
+1 rear-left, 2 front-left, 3 rear-right). The world is drawn with a painter's algorithm: the
+ground and lines first, then solid things far to near, the drone's hub last (its pixels are
+what tests track).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .. import _native
+from ..tasks import observation_slices, parameter_values
+from .camera import CameraControls, OrbitCamera, Projector
+from .canvas import FlightPath, Painter, View, check_render_mode, vector
+
+# Rotor i sits at (forward, left) * L/sqrt(2) in the body frame: PX4 quad-X order.
+ROTOR_POSITION_SIGNS = np.array([(1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (-1.0, -1.0)])
+# Spin seen from above: -1 counter-clockwise, +1 clockwise (the core's ROTOR_SPIN).
+ROTOR_SPIN = (-1, -1, 1, 1)
+ROTOR_NAMES = ("FR", "RL", "FL", "RR")
+GROUND, GRID, GRID_MAJOR, AXIS_X = (226, 230, 222), (188, 192, 186), (160, 165, 158), (220, 40, 40)
+AXIS_Y, AXIS_Z, BOUNDS, BODY = (30, 160, 60), (40, 90, 230), (150, 160, 200), (0, 100, 200)
+BODY_HIGHLIGHT = (110, 175, 245)
+ROTOR_CCW = (70, 200, 90)  # counter-clockwise (seen from above)
+ROTOR_CW = (235, 90, 80)  # clockwise
+ARM, NOSE, TARGET, TARGET_LINE = (90, 90, 95), (35, 35, 40), (0, 170, 60), (140, 140, 140)
+WAYPOINT, UP, VELOCITY, WIND = (150, 60, 200), (255, 150, 0), (230, 0, 220), (200, 0, 0)
+DROP, SHADOW, TRAIL = (128, 128, 128), (40, 40, 40), (60, 140, 220)
+
+TARGET_RADIUS_M = 0.08
+WAYPOINT_RADIUS_M = 0.06
+UP_ARROW_M = 0.5  # length of the up vector
+VELOCITY_SECONDS = 0.5  # the velocity arrow shows where the drone is in this many seconds
+WIND_M_PER_MPS = 0.12  # wind arrow length per m/s of wind
+MAX_ARROW_M = 2.0
+TEXT, PANEL, BAD, BACKGROUND_TOP = (20, 20, 30), (255, 255, 236), (200, 0, 0), (232, 238, 248)
+BACKGROUND_BOTTOM = (246, 246, 250)
+# What a scene shows when not told: the hover task with the core's defaults.
+_HOVER = _native.describe("hover")
+_CORE = parameter_values(_HOVER)
+
+
+def rotation_matrix(q_wxyz: np.ndarray) -> np.ndarray:
+    """The 3x3 matrix of a unit quaternion [w, x, y, z]: world = R @ body."""
+    w, x, y, z = q_wxyz
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def euler_rpy(q_wxyz: np.ndarray) -> tuple[float, float, float]:
+    """Roll, pitch, yaw in radians (intrinsic Z-Y-X) of a unit quaternion [w, x, y, z]."""
+    w, x, y, z = q_wxyz
+    roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+    pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
+    yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    return roll, pitch, yaw
+
+
+def quaternion_from_euler(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """The unit quaternion [w, x, y, z] of intrinsic Z-Y-X angles in radians."""
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    return np.array(
+        [
+            cr * cp * cy + sr * sp * sy,
+            sr * cp * cy - cr * sp * sy,
+            cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy,
+        ]
+    )
+
+
+def rotor_positions_body(arm_length: float) -> np.ndarray:
+    """(4, 3) rotor centres in the body frame, metres, in PX4 motor order."""
+    lever = arm_length / math.sqrt(2.0)
+    out = np.zeros((4, 3))
+    out[:, :2] = ROTOR_POSITION_SIGNS * lever
+    return out
+
+
+@dataclass(eq=False)
+class QuadScene:
+    """One frame of the quadrotor: plain per-step data in the core's frames and units."""
+
+    time_s: float  # episode time, s
+    step: int  # steps since reset
+    position: np.ndarray  # (3,) m, world ENU
+    velocity: np.ndarray  # (3,) m/s, world ENU
+    quaternion: np.ndarray  # (4,) [w, x, y, z], body FLU -> world ENU; normalised here
+    motors: np.ndarray = field(default_factory=lambda: np.zeros(4))  # (4,) states, [0, 1]
+    body_rates: np.ndarray = field(default_factory=lambda: np.zeros(3))  # (3,) rad/s, body FLU
+    wind: np.ndarray = field(default_factory=lambda: np.zeros(3))  # (3,) m/s, world ENU
+    target: np.ndarray | None = None  # (3,) m, world ENU: the current target / waypoint
+    next_waypoint: np.ndarray | None = None  # (3,) m, the waypoint after the target
+    reward: float | None = None  # reward of the last step
+    episode_return: float | None = None  # sum of rewards since reset
+    # m: targets live in x, y in [-h, h], z in [0, 2h]
+    bounds_half_size: float = _CORE["space_side_length"] / 2.0
+    arm_length: float = _CORE["arm_length"]  # m, centre to rotor
+    waypoints_reached: int | None = None  # Waypoints task only
+    status: str = ""  # e.g. "crashed", "out of bounds"; empty while flying
+    extras: tuple[tuple[str, str], ...] = ()  # more (label, text) lines for the info panel
+
+    def __post_init__(self) -> None:
+        for name in ("position", "velocity", "body_rates", "wind"):
+            setattr(self, name, vector(getattr(self, name)))
+        for name in ("target", "next_waypoint"):
+            if getattr(self, name) is not None:
+                setattr(self, name, vector(getattr(self, name)))
+        q = vector(self.quaternion)
+        self.quaternion = q / float(np.linalg.norm(q))
+        # Lagged motor states may overshoot by rounding; the bars show [0, 1].
+        self.motors = np.clip(vector(self.motors), 0.0, 1.0)
+        self.time_s, self.step = float(self.time_s), int(self.step)
+        if self.waypoints_reached is not None:
+            self.waypoints_reached = int(self.waypoints_reached)
+        items = self.extras.items() if isinstance(self.extras, Mapping) else self.extras
+        self.extras = tuple((str(k), str(v)) for k, v in items)
+
+
+def quad_scene(
+    observation: Any,
+    info: Mapping[str, Any],
+    *,
+    reward: float | None = None,
+    episode_return: float | None = None,
+    core: Mapping[str, Any] = _HOVER,
+) -> QuadScene:
+    """A QuadScene from a Hover/Waypoints observation and its info (the task frame's names);
+    `core`: the env's `describe` result (observation layout, parameters). An observation
+    without attitude or motors (the rates interface) is drawn level with motors at 0."""
+    obs = np.asarray(observation, dtype=float).reshape(-1)
+    at, values = observation_slices(core), parameter_values(core)
+
+    def part(name: str, otherwise: Any) -> Any:
+        return obs[at[name]] if name in at else otherwise
+
+    status = "crashed" if info.get("crashed") else ""
+    status = status or ("out of bounds" if info.get("out_of_bounds") else "")
+    return QuadScene(
+        time_s=info["episode_time"],
+        step=info["step_count"],
+        position=info["position"],
+        velocity=obs[at["velocity"]],
+        quaternion=part("quaternion", (1.0, 0.0, 0.0, 0.0)),
+        body_rates=obs[at["body_rates"]],
+        wind=part("wind", np.zeros(3)),
+        motors=part("motor_states", np.zeros(4)),
+        target=info.get("target_position"),
+        next_waypoint=info.get("next_waypoint_pos"),
+        reward=reward,
+        episode_return=episode_return,
+        bounds_half_size=float(values["space_side_length"]) / 2.0,
+        arm_length=float(values["arm_length"]),
+        waypoints_reached=info.get("waypoints_reached"),
+        status=status,
+    )
+
+
+def rotor_color(index: int) -> tuple[int, int, int]:
+    return ROTOR_CCW if ROTOR_SPIN[index] < 0 else ROTOR_CW
+
+
+def _line(p: Painter, pr: Projector, a, b, color, width: int = 1) -> None:
+    seg = pr.segment(a, b)
+    if seg is not None:
+        p.line(seg[0], seg[1], color, width)
+
+
+def _dashed(p: Painter, pr: Projector, a, b, color, width: int = 1) -> None:
+    seg = pr.segment(a, b)
+    if seg is not None:
+        p.dashed_line(seg[0], seg[1], color, width, dash_px=5)
+
+
+def _arrow(p: Painter, pr: Projector, start, vector, color, width: int = 3) -> None:
+    seg = pr.segment(start, np.asarray(start) + vector)
+    if seg is not None and float(np.hypot(*(seg[1] - seg[0]))) > 2.0:
+        p.arrow(seg[0], seg[1], color, width)
+
+
+def _circle_points(center: np.ndarray, radius: float, axes: np.ndarray, n: int = 20) -> np.ndarray:
+    t = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
+    return center + radius * (np.outer(np.cos(t), axes[0]) + np.outer(np.sin(t), axes[1]))
+
+
+def grid_extent(scene: QuadScene) -> float:
+    """Half side of the drawn ground grid, m: the target box and a margin, on 0.5 m lines."""
+    return math.ceil((scene.bounds_half_size * 2.0 + 1.0) * 2.0) / 2.0
+
+
+def ground(p: Painter, pr: Projector, scene: QuadScene) -> None:
+    g = grid_extent(scene)
+    square = np.array([[-g, -g, 0.0], [g, -g, 0.0], [g, g, 0.0], [-g, g, 0.0]])
+    poly = pr.polygon(square)
+    if len(poly):
+        p.polygon(poly, GROUND)
+    ticks = np.arange(-g, g + 1e-9, 0.5)
+    n = len(ticks)
+    zeros, lo, hi = np.zeros(n), np.full(n, -g), np.full(n, g)
+    starts = np.concatenate([np.stack([ticks, lo, zeros], 1), np.stack([lo, ticks, zeros], 1)])
+    ends = np.concatenate([np.stack([ticks, hi, zeros], 1), np.stack([hi, ticks, zeros], 1)])
+    major = np.concatenate([np.arange(n) % 2 == 0] * 2)
+    for is_major in (False, True):  # minor lines first, the metre lines over them
+        pick = major == is_major
+        for a, b in pr.segments(starts[pick], ends[pick]):
+            p.line(a, b, GRID_MAJOR if is_major else GRID, 1)
+
+
+def axes(p: Painter, pr: Projector, scene: QuadScene) -> None:
+    """World axes from the origin, 1 m long, labelled."""
+    origin = np.zeros(3)
+    for axis, color, label in (
+        ((1.0, 0, 0), AXIS_X, "x E"),
+        ((0, 1.0, 0), AXIS_Y, "y N"),
+        ((0, 0, 1.0), AXIS_Z, "z"),
+    ):
+        _arrow(p, pr, origin, np.array(axis), color, 2)
+        tip = pr.point(np.array(axis) * 1.15)
+        if tip is not None:
+            p.text(label, tip[0], color, 18, "center", bold=True)
+
+
+def bounds(p: Painter, pr: Projector, scene: QuadScene) -> None:
+    """Wireframe of the target box: x, y in [-h, h], z in [0, 2h]."""
+    h = scene.bounds_half_size
+    corners = [np.array([x, y, z]) for z in (0.0, 2 * h) for x in (-h, h) for y in (-h, h)]
+    for i, a in enumerate(corners):
+        for b in corners[i + 1 :]:
+            if np.count_nonzero(np.abs(a - b) > 1e-9) == 1:  # an edge, not a diagonal
+                _dashed(p, pr, a, b, BOUNDS, 1)
+
+
+def shadow(p: Painter, pr: Projector, position: np.ndarray, radius: float) -> None:
+    """A soft dark disc on the ground under a point, and a dashed drop line to it."""
+    foot = np.array([position[0], position[1], 0.0])
+    if position[2] > 0:
+        _dashed(p, pr, position, foot, DROP, 1)
+    ring = pr.polygon(_circle_points(foot, radius, np.eye(3)[:2]))
+    if len(ring):
+        p.translucent_polygon(ring, SHADOW, 60)
+
+
+def trail(p: Painter, pr: Projector, points: np.ndarray) -> None:
+    if len(points) < 2:
+        return
+    for a, b in pr.segments(points[:-1], points[1:]):
+        p.line(a, b, TRAIL, 2)
+
+
+def target(p: Painter, pr: Projector, scene: QuadScene) -> None:
+    """The target sphere with a 3-axis crosshair, its line from the drone."""
+    if scene.target is None:
+        return
+    _line(p, pr, scene.position, scene.target, TARGET_LINE, 1)
+    for axis in np.eye(3) * 0.2:
+        _line(p, pr, scene.target - axis, scene.target + axis, TARGET, 2)
+    _sphere(p, pr, scene.target, TARGET_RADIUS_M, TARGET)
+
+
+def next_waypoint(p: Painter, pr: Projector, scene: QuadScene) -> None:
+    if scene.next_waypoint is None:
+        return
+    if scene.target is not None:
+        _dashed(p, pr, scene.target, scene.next_waypoint, WAYPOINT, 1)
+    hit = pr.point(scene.next_waypoint)
+    if hit is not None:
+        r = max(4.0, pr.radius(WAYPOINT_RADIUS_M, hit[1]))
+        p.ring(hit[0], r, WAYPOINT, 3)
+        p.text("next", hit[0] + np.array([r + 4, -r - 4]), WAYPOINT, 17, "bottomleft")
+
+
+def _sphere(p: Painter, pr: Projector, center: np.ndarray, radius_m: float, color) -> None:
+    hit = pr.point(center)
+    if hit is None:
+        return
+    r = max(3.0, pr.radius(radius_m, hit[1]))
+    p.disc(hit[0], r, color)
+    light = tuple(min(255, c + 70) for c in color)
+    p.disc(hit[0] - r * 0.3, max(1.0, r * 0.3), light)
+
+
+def drone(p: Painter, pr: Projector, scene: QuadScene, scale: float) -> None:
+    """Arms, rotor discs (coloured by spin, in the body plane), nose, vectors, hub on top.
+
+    Drawn `scale` times the real size so a 0.1 m arm stays visible in a metres-wide box.
+    """
+    rot = rotation_matrix(scene.quaternion)
+    pos = scene.position
+    arm = scene.arm_length * scale
+    rotors = pos + rotor_positions_body(arm) @ rot.T
+    rotor_radius = 0.38 * arm
+    disc_axes = rot.T[:2]  # body x and y in world coordinates
+    cam = pr.camera
+    order = np.argsort(-cam.to_camera(rotors)[:, 2])  # far first
+    for i in order:
+        _line(p, pr, pos, rotors[i], ARM, 4)
+        poly = pr.polygon(_circle_points(rotors[i], rotor_radius, disc_axes))
+        if len(poly):
+            color = rotor_color(int(i))
+            p.translucent_polygon(poly, color, 150)
+            p.polyline(np.vstack([poly, poly[:1]]), tuple(int(c * 0.6) for c in color), 2)
+        level = pr.polygon(_circle_points(rotors[i], rotor_radius * scene.motors[i], disc_axes))
+        if len(level) and scene.motors[i] > 0.02:
+            p.translucent_polygon(level, rotor_color(int(i)), 170)
+    _arrow(p, pr, pos, rot[:, 2] * UP_ARROW_M, UP, 3)
+    speed = float(np.linalg.norm(scene.velocity))
+    if speed > 0.05:
+        length = min(speed * VELOCITY_SECONDS, MAX_ARROW_M)
+        _arrow(p, pr, pos, scene.velocity / speed * length, VELOCITY, 3)
+    wind = float(np.linalg.norm(scene.wind))
+    if wind > 0.05:
+        length = min(wind * WIND_M_PER_MPS, MAX_ARROW_M)
+        _arrow(p, pr, pos, scene.wind / wind * length, WIND, 2)
+    _line(p, pr, pos, pos + rot[:, 0] * arm * 0.8, NOSE, 4)
+    hub = pr.point(pos)
+    if hub is not None:
+        r = max(4.0, pr.radius(0.22 * arm, hub[1]))
+        p.disc(hub[0], r, BODY, (0, 50, 110), 1)
+        p.disc(hub[0] - r * 0.28, max(1.0, r * 0.32), BODY_HIGHLIGHT)
+
+
+def world(
+    p: Painter, pr: Projector, scene: QuadScene, trail_points: np.ndarray, drone_scale: float
+) -> None:
+    """The whole 3D scene, back to front."""
+    ground(p, pr, scene)
+    axes(p, pr, scene)
+    bounds(p, pr, scene)
+    for point, radius in ((scene.target, 0.1), (scene.next_waypoint, 0.07)):
+        if point is not None:
+            shadow(p, pr, point, radius)
+    shadow(p, pr, scene.position, 0.7 * scene.arm_length * drone_scale)
+    trail(p, pr, trail_points)
+    solids = [(lambda: target(p, pr, scene), scene.target)]
+    solids.append((lambda: next_waypoint(p, pr, scene), scene.next_waypoint))
+    solids.append((lambda: drone(p, pr, scene, drone_scale), scene.position))
+    depth = [-float(pr.camera.to_camera(at)[2]) if at is not None else math.inf for _, at in solids]
+    for i in np.argsort(depth, kind="stable"):
+        solids[i][0]()
+
+
+def info_lines(scene: QuadScene) -> list[tuple[str, tuple[int, int, int]]]:
+    """The info panel's text: time, step, distance, height, speed, wind, attitude, reward."""
+    roll, pitch, yaw = (math.degrees(a) for a in euler_rpy(scene.quaternion))
+    distance = (
+        f"{np.linalg.norm(scene.target - scene.position):.2f} m"
+        if scene.target is not None
+        else "-"
+    )
+    reward = "-" if scene.reward is None else f"{scene.reward:+.3f}"
+    lines = [
+        (f"Time {scene.time_s:.2f} s    Step {scene.step}", TEXT),
+        (f"Distance {distance}    Height {scene.position[2]:.2f} m", TEXT),
+        (
+            f"Speed {np.linalg.norm(scene.velocity):.2f} m/s    "
+            f"Wind {np.linalg.norm(scene.wind):.2f} m/s",
+            TEXT,
+        ),
+        (f"Roll {roll:+.1f}°  Pitch {pitch:+.1f}°  Yaw {yaw:+.1f}°", TEXT),
+    ]
+    if scene.episode_return is not None:
+        lines.append((f"Reward {reward}    Return {scene.episode_return:.2f}", TEXT))
+    else:
+        lines.append((f"Reward {reward}", TEXT))
+    if scene.waypoints_reached is not None:
+        lines.append((f"Waypoints reached {scene.waypoints_reached}", TEXT))
+    if scene.status:
+        lines.append((scene.status[:1].upper() + scene.status[1:], BAD))
+    lines.extend((f"{label}: {text}", TEXT) for label, text in scene.extras)
+    return lines
+
+
+def info_panel(p: Painter, scene: QuadScene) -> None:
+    lines = info_lines(scene)
+    line_h = 24
+    width = max(p.text_size(t, 21)[0] for t, _ in lines) + 28
+    p.panel((12, 12, width, len(lines) * line_h + 18), PANEL)
+    for i, (text, color) in enumerate(lines):
+        p.text(text, (26, 22 + i * line_h), color, 21, bold=(color == BAD))
+
+
+def motor_bars(p: Painter, scene: QuadScene) -> None:
+    """Bottom-right: one bar per motor (PX4 order), labelled with position and spin colour."""
+    width, height = p.surface.get_size()
+    bar_w, bar_h, gap = 26, 120, 20
+    x0 = width - 4 * (bar_w + gap) - 14
+    y0 = height - bar_h - 50
+    p.panel((x0 - 12, y0 - 34, 4 * (bar_w + gap) + 8, bar_h + 76), PANEL)
+    for i, level in enumerate(scene.motors):
+        x = x0 + i * (bar_w + gap)
+        fill = round(bar_h * float(level))
+        p.pg.draw.rect(p.surface, (215, 215, 215), (x, y0, bar_w, bar_h))
+        color = (255, round(230 * (1 - float(level))), 0)
+        p.pg.draw.rect(p.surface, color, (x, y0 + bar_h - fill, bar_w, fill))
+        p.pg.draw.rect(p.surface, (0, 0, 0), (x, y0, bar_w, bar_h), 1)
+        p.text(f"{round(float(level) * 100)}%", (x + bar_w / 2, y0 - 6), TEXT, 17, "midbottom")
+        p.disc((x + bar_w / 2, y0 - 26), 5, rotor_color(i))
+        spin = "CCW" if ROTOR_SPIN[i] < 0 else "CW"
+        p.text(f"M{i} {ROTOR_NAMES[i]}", (x + bar_w / 2, y0 + bar_h + 4), TEXT, 17, "midtop")
+        p.text(spin, (x + bar_w / 2, y0 + bar_h + 20), TEXT, 15, "midtop")
+
+
+def axis_gizmo(p: Painter, camera: OrbitCamera) -> None:
+    """Bottom-left: the world axes as the camera sees them (far axis drawn first)."""
+    height = p.surface.get_height()
+    origin = np.array([70.0, height - 70.0])
+    right, up, forward = camera.basis()
+    p.disc(origin, 50, (250, 250, 250), (180, 180, 180), 1)
+    items = []
+    for axis, color, label in ((0, AXIS_X, "X"), (1, AXIS_Y, "Y"), (2, AXIS_Z, "Z")):
+        unit = np.eye(3)[axis]
+        tip = origin + np.array([unit @ right, -(unit @ up)]) * 36
+        items.append((float(unit @ forward), tip, color, label))
+    for _, tip, color, label in sorted(items, key=lambda item: -item[0]):
+        p.arrow(origin, tip, color, 3, head_px=8)
+        direction = tip - origin
+        norm = float(np.hypot(*direction))
+        label_at = tip + (direction / norm * 9 if norm > 1e-6 else 0)
+        p.text(label, label_at, color, 19, "center", bold=True)
+    p.disc(origin, 3, (0, 0, 0))
+
+
+def wind_dial(p: Painter, scene: QuadScene, camera: OrbitCamera) -> None:
+    """Top-right: the horizontal wind seen from above, turned so 'up' is where the camera
+    looks; its length grows with speed (full radius at 5 m/s)."""
+    width = p.surface.get_width()
+    center = np.array([width - 70.0, 72.0])
+    radius = 44.0
+    p.disc(center, radius, (255, 255, 255), (0, 0, 0), 2)
+    az = math.radians(camera.azimuth_deg)
+    ground_right = np.array([math.cos(az), -math.sin(az), 0.0])
+    ground_forward = np.array([math.sin(az), math.cos(az), 0.0])
+    dial = np.array([scene.wind @ ground_right, -(scene.wind @ ground_forward)])
+    speed = float(np.linalg.norm(scene.wind))
+    horizontal = float(np.hypot(*dial))
+    if horizontal > 0.05:
+        length = radius * 0.85 * min(1.0, 0.3 + horizontal / 5.0)
+        p.arrow(center, center + dial / horizontal * length, WIND, 4, head_px=11)
+    p.disc(center, 3, (0, 0, 0))
+    p.text("Wind", (center[0], center[1] - radius - 4), TEXT, 19, "midbottom", bold=True)
+    p.text(f"{speed:.2f} m/s", (center[0], center[1] + radius + 4), TEXT, 18, "midtop")
+    p.text(f"vz {scene.wind[2]:+.2f}", (center[0], center[1] + radius + 20), TEXT, 16, "midtop")
+
+
+LEGEND = (
+    ("Drone body", BODY, "disc"),
+    ("CCW rotor", ROTOR_CCW, "disc"),
+    ("CW rotor", ROTOR_CW, "disc"),
+    ("Nose (front)", NOSE, "line"),
+    ("Target", TARGET, "disc"),
+    ("Next waypoint", WAYPOINT, "ring"),
+    ("Up vector", UP, "line"),
+    ("Velocity", VELOCITY, "line"),
+    ("Wind", WIND, "line"),
+    ("Trail", TRAIL, "line"),
+)
+
+
+def legend(p: Painter) -> None:
+    """Right side, under the wind dial: what each colour means."""
+    width = p.surface.get_width()
+    line_h = 20
+    x, y = width - 168, 170
+    p.panel((x - 10, y - 8, 166, len(LEGEND) * line_h + 12), PANEL)
+    for i, (label, color, kind) in enumerate(LEGEND):
+        cy = y + i * line_h + 8
+        if kind == "disc":
+            p.disc((x + 8, cy), 6, color)
+        elif kind == "ring":
+            p.ring((x + 8, cy), 6, color, 2)
+        else:
+            p.line((x, cy), (x + 18, cy), color, 3)
+        p.text(label, (x + 26, cy), TEXT, 17, "midleft")
+
+
+def controls_hint(p: Painter) -> None:
+    """Bottom centre in a window: how to move the camera."""
+    width, height = p.surface.get_size()
+    hint = "drag: rotate   wheel: zoom   W/A/S/D: move   Q/E: down/up   R: reset   Esc: close"
+    p.text(hint, (width / 2, height - 8), (90, 90, 100), 17, "midbottom")
+
+
+def default_camera(bounds_half_size: float) -> OrbitCamera:
+    """Looking at the middle of the target box from the south-west, above, the box in view."""
+    h = bounds_half_size
+    return OrbitCamera(look_at=np.array([0.0, 0.0, 0.8 * h]), distance=4.2 * h)
+
+
+class QuadrotorView(View):
+    """Draws QuadScene frames: a window ("human") or (H, W, 3) uint8 arrays ("rgb_array").
+
+    In a window: drag with the left mouse button to orbit, wheel to zoom, W/A/S/D to move
+    along the ground, Q/E down/up, R to reset the camera, Esc or the close box to close.
+    The vehicle is drawn `drone_scale` times its real size (a 0.1 m arm would be a few
+    pixels); its centre is at its true position. The trail keeps the last `trail_steps`
+    positions of the episode and restarts when the step number goes backwards or on reset().
+    """
+
+    SCENE = QuadScene
+
+    def __init__(
+        self,
+        render_mode: str,
+        width: int = 960,
+        height: int = 720,
+        fps: float = 50.0,
+        *,
+        camera: OrbitCamera | None = None,
+        drone_scale: float = 4.0,
+        trail_steps: int = 400,
+        hud: bool = True,
+    ) -> None:
+        check_render_mode(render_mode)
+        if not drone_scale > 0:
+            raise ValueError(f"drone_scale must be > 0, got {drone_scale}")
+        self.drone_scale = float(drone_scale)
+        self.hud = hud
+        self._camera = camera
+        self._trail = FlightPath(max(2, trail_steps))
+        super().__init__(render_mode, (width, height), "flyloop - Quadrotor 3D", fps)
+        self._controls: CameraControls | None = None
+
+    @property
+    def camera(self) -> OrbitCamera | None:
+        """The camera (created at the first render from the scene's bounds if not given)."""
+        return self._camera
+
+    def world_to_screen(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Pixels (..., 2) of world points (..., 3) and whether each is in front of the camera."""
+        if self._camera is None:
+            raise RuntimeError("the camera is set up by the first render (or pass camera=...)")
+        return self._camera.project(points, *self.size)
+
+    def reset(self) -> None:
+        """Forget the trail (an env calls this from reset())."""
+        self._trail.clear()
+
+    def render(self, scene: QuadScene) -> np.ndarray | None:
+        """Draw one frame: returns it in rgb_array mode, None in human mode."""
+        events = self._events(scene)
+        if self._camera is None:
+            self._camera = default_camera(scene.bounds_half_size)
+        if self._controls is None:
+            self._controls = CameraControls(self._screen.pg, self._camera)
+        if events is None:
+            return None  # the user closed the window
+        self._controls.handle(events)
+        self._trail.update(scene.step, scene.position)
+        self._draw(scene)
+        return self._screen.present()
+
+    def _draw(self, scene: QuadScene) -> None:
+        p = self._painter
+        p.vertical_gradient(BACKGROUND_TOP, BACKGROUND_BOTTOM)
+        projector = Projector(self._camera, self.size)
+        trail = self._trail.points
+        world(p, projector, scene, trail if len(trail) else np.zeros((0, 3)), self.drone_scale)
+        if self.hud:
+            info_panel(p, scene)
+            motor_bars(p, scene)
+            axis_gizmo(p, self._camera)
+            wind_dial(p, scene, self._camera)
+            legend(p)
+            if self.render_mode == "human":
+                controls_hint(p)
