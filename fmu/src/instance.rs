@@ -2,10 +2,11 @@
 //! Co-Simulation and Model Exchange: the stage it is in and, per function, the stages it may
 //! be called in (the masks of modelica/Reference-FMUs' fmi2Functions.c).
 
+use crate::engine::Simulation;
 use crate::error::FmuError;
 use crate::fmi2_types::fmi2Status;
 use crate::log::{Category, LogFilter, Logger, category_of};
-use crate::simulation::Simulation;
+use crate::table::Api;
 use std::collections::HashMap;
 
 /// The stages of an instance: EventMode and ContinuousTimeMode for Model Exchange, the Step*
@@ -61,31 +62,6 @@ impl Stage {
         match interface {
             Interface::CoSimulation => !model_exchange,
             Interface::ModelExchange => !co_simulation,
-        }
-    }
-}
-
-/// The FMI version an instance was created through.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Api {
-    Fmi2,
-    Fmi3,
-}
-
-impl Api {
-    /// Stage names as this version's standard calls them (FMI 3.0: Step Mode).
-    pub fn stage_name(self, names: &str) -> String {
-        match self {
-            Api::Fmi2 => names.to_string(),
-            Api::Fmi3 => names.replace("StepComplete", "StepMode"),
-        }
-    }
-
-    /// What the modelDescription calls the string that ties it to the binary.
-    pub fn token_name(self) -> &'static str {
-        match self {
-            Api::Fmi2 => "fmuGUID",
-            Api::Fmi3 => "instantiationToken",
         }
     }
 }

@@ -5,7 +5,7 @@
 //! date), so the checked-in copies under modelDescription/ can be compared byte for byte.
 
 use crate::log::CATEGORIES;
-use crate::model::{ModelInfo, ModelTable, type_name};
+use crate::table::{Api, ModelInfo, ModelTable};
 use crate::units::{self, BASE_UNITS};
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::{Causality, Variability, Variable};
@@ -158,7 +158,7 @@ fn scalar_variable(out: &mut String, v: &Variable, derivative: Option<usize>) {
         causality(v.causality),
         variability(v.variability)
     );
-    let _ = write!(out, "      <{}", type_name(v.kind));
+    let _ = write!(out, "      <{}", Api::Fmi2.type_name(v.kind));
     // FMI 2.0 gives units to Real variables only.
     if v.kind == ValueKind::Real && !v.unit.is_empty() {
         let _ = write!(out, " unit=\"{}\"", escape(v.unit));

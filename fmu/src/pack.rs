@@ -3,9 +3,9 @@
 //! `binaries/x86_64-linux/<modelIdentifier>.so` in `<identifier>-fmi3.fmu` (FMI 3.0). Also
 //! writes the checked-in modelDescription copies.
 
-use crate::model::ModelTable;
 use crate::model_description::{self, UnknownUnit};
 use crate::model_description3;
+use crate::table::ModelTable;
 use std::fs::{self, File};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};

@@ -139,7 +139,13 @@ pub(crate) unsafe fn write_out<T>(
 }
 
 #[cfg(test)]
+#[allow(dead_code)]
+#[path = "../../tests/support/importer_logger.rs"]
+mod importer_logger;
+
+#[cfg(test)]
 mod tests {
+    use super::importer_logger;
     use super::*;
     use crate::exports::{fmi2DoStep, fmi2FreeInstance, fmi2GetReal, fmi2Instantiate};
     use crate::fmi2_types::*;
@@ -147,7 +153,7 @@ mod tests {
 
     #[test]
     fn a_panic_becomes_fatal_with_a_message_and_only_free_instance_remains() {
-        let recorder = crate::importer_logger::Recorder::default();
+        let recorder = importer_logger::Recorder::default();
         let callbacks = recorder.callbacks();
         let guid = crate::models::tables()[0].guid_c.clone();
         // SAFETY: valid strings and callbacks.

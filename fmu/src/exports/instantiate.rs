@@ -3,9 +3,10 @@
 //! of it fails.
 
 use crate::fmi2_types::fmi2Status;
-use crate::instance::{Api, Instance, Interface};
+use crate::instance::{Instance, Interface};
 use crate::log::{Category, Logger, Sink};
 use crate::models;
+use crate::table::Api;
 use std::ffi::CStr;
 
 /// An instantiation request, its C arguments already read.

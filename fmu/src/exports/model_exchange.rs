@@ -5,10 +5,10 @@
 //! status plus a log line, never a crash.
 
 use super::guard::{c_slice, c_slice_mut, with_instance, write_out};
+use crate::engine::Simulation;
 use crate::error::FmuError;
 use crate::fmi2_types::*;
 use crate::instance::{Instance, Mask, Stage, masks};
-use crate::simulation::Simulation;
 use flyloop_core::number::Compact;
 
 /// [`with_instance`] for a Model Exchange function: also refuses a Co-Simulation instance.

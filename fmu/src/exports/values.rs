@@ -4,8 +4,9 @@
 
 use super::guard::{c_slice, c_slice_mut, with_instance};
 use crate::fmi2_types::*;
-use crate::instance::{Instance, Mask, Stage, masks};
-use crate::simulation::FmiType;
+use crate::instance::{Instance, Stage, masks};
+use crate::table::{Api, ValueType};
+use flyloop_core::params::ValueKind;
 
 pub(crate) fn initialised(instance: &Instance) -> bool {
     !matches!(
@@ -14,237 +15,106 @@ pub(crate) fn initialised(instance: &Instance) -> bool {
     )
 }
 
-/// Reads `vr` into `value` through `to_c`.
-///
-/// # Safety
-/// `vr` and `value` must be NULL or hold `nvr` elements.
-unsafe fn get_values<T>(
-    c: fmi2Component,
-    function: &'static str,
-    ty: FmiType,
-    vr: *const fmi2ValueReference,
-    nvr: usize,
-    value: *mut T,
-    to_c: fn(f64) -> T,
-) -> fmi2Status {
-    with_instance(c, function, masks::GET_VALUE, |instance| {
-        // SAFETY: per the function's contract.
-        let vrs = unsafe { c_slice(vr, nvr, "vr[]") }?;
-        // SAFETY: per the function's contract.
-        let values = unsafe { c_slice_mut(value, nvr, "value[]") }?;
-        let mut worst = fmi2Status::fmi2OK;
-        for (&vr, slot) in vrs.iter().zip(values) {
-            match instance.sim.get(vr, ty) {
-                Ok(v) => *slot = to_c(v),
-                Err(e) => worst = worst.max(instance.report(function, &e)),
-            }
+/// Defines fmi2Get<T> and fmi2Set<T> for C type `$t` and value type `$ty`: the getter
+/// converts through `$to_c`, the setter (allowed in `$mask`) through `$from_c`. The body is
+/// here, not in a helper, so the model is two calls away: the guard, then the engine.
+macro_rules! accessors {
+    ($get:ident, $set:ident, $t:ty, $ty:expr, $mask:expr, $to_c:expr, $from_c:expr) => {
+        /// # Safety
+        /// `vr` and `value` must be NULL or hold `nvr` elements.
+        #[unsafe(no_mangle)]
+        pub unsafe extern "C" fn $get(
+            c: fmi2Component,
+            vr: *const fmi2ValueReference,
+            nvr: usize,
+            value: *mut $t,
+        ) -> fmi2Status {
+            let function = stringify!($get);
+            with_instance(c, function, masks::GET_VALUE, |instance| {
+                // SAFETY: per the function's contract.
+                let vrs = unsafe { c_slice(vr, nvr, "vr[]") }?;
+                // SAFETY: per the function's contract.
+                let values = unsafe { c_slice_mut(value, nvr, "value[]") }?;
+                let table = instance.sim.table();
+                let mut worst = fmi2Status::fmi2OK;
+                for (&vr, slot) in vrs.iter().zip(values) {
+                    match table.lookup(vr, $ty) {
+                        Ok(index) => *slot = $to_c(instance.sim.get(index)),
+                        Err(e) => worst = worst.max(instance.report(function, &e)),
+                    }
+                }
+                Ok(worst)
+            })
         }
-        Ok(worst)
-    })
-}
 
-/// One fmi2Set* function: its name, its allowed stages and its type.
-struct Setter {
-    function: &'static str,
-    mask: Mask,
-    ty: FmiType,
-}
-
-/// Writes `value` (converted by `from_c`) to `vr`.
-///
-/// # Safety
-/// `vr` and `value` must be NULL or hold `nvr` elements.
-unsafe fn set_values<T: Copy>(
-    c: fmi2Component,
-    setter: Setter,
-    vr: *const fmi2ValueReference,
-    nvr: usize,
-    value: *const T,
-    from_c: fn(T) -> f64,
-) -> fmi2Status {
-    let Setter { function, mask, ty } = setter;
-    with_instance(c, function, mask, |instance| {
-        // SAFETY: per the function's contract.
-        let vrs = unsafe { c_slice(vr, nvr, "vr[]") }?;
-        // SAFETY: per the function's contract.
-        let values = unsafe { c_slice(value, nvr, "value[]") }?;
-        let initialised = initialised(instance);
-        let mut worst = fmi2Status::fmi2OK;
-        for (&vr, &v) in vrs.iter().zip(values) {
-            if let Err(e) = instance.sim.set(vr, ty, from_c(v), initialised) {
-                worst = worst.max(instance.report(function, &e));
-            }
+        /// # Safety
+        /// `vr` and `value` must be NULL or hold `nvr` elements.
+        #[unsafe(no_mangle)]
+        pub unsafe extern "C" fn $set(
+            c: fmi2Component,
+            vr: *const fmi2ValueReference,
+            nvr: usize,
+            value: *const $t,
+        ) -> fmi2Status {
+            let function = stringify!($set);
+            with_instance(c, function, $mask, |instance| {
+                // SAFETY: per the function's contract.
+                let vrs = unsafe { c_slice(vr, nvr, "vr[]") }?;
+                // SAFETY: per the function's contract.
+                let values = unsafe { c_slice(value, nvr, "value[]") }?;
+                let initialised = initialised(instance);
+                let table = instance.sim.table();
+                let mut worst = fmi2Status::fmi2OK;
+                for (&vr, &v) in vrs.iter().zip(values) {
+                    let result = table
+                        .lookup(vr, $ty)
+                        .and_then(|index| instance.sim.set(index, $from_c(v), initialised));
+                    if let Err(e) = result {
+                        worst = worst.max(instance.report(function, &e));
+                    }
+                }
+                Ok(worst)
+            })
         }
-        Ok(worst)
-    })
-}
-
-fn real_to_c(v: f64) -> fmi2Real {
-    v
-}
-
-fn integer_to_c(v: f64) -> fmi2Integer {
-    // Integer variables hold integers within i32 (their table ranges say so).
-    v as fmi2Integer
-}
-
-fn boolean_to_c(v: f64) -> fmi2Boolean {
-    if v != 0.0 { fmi2True } else { fmi2False }
-}
-
-fn boolean_from_c(v: fmi2Boolean) -> f64 {
-    if v != fmi2False { 1.0 } else { 0.0 }
-}
-
-/// # Safety
-/// `vr` and `value` must be NULL or hold `nvr` elements.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetReal(
-    c: fmi2Component,
-    vr: *const fmi2ValueReference,
-    nvr: usize,
-    value: *mut fmi2Real,
-) -> fmi2Status {
-    // SAFETY: forwarded contract.
-    unsafe { get_values(c, "fmi2GetReal", FmiType::Real, vr, nvr, value, real_to_c) }
-}
-
-/// # Safety
-/// `vr` and `value` must be NULL or hold `nvr` elements.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetInteger(
-    c: fmi2Component,
-    vr: *const fmi2ValueReference,
-    nvr: usize,
-    value: *mut fmi2Integer,
-) -> fmi2Status {
-    // SAFETY: forwarded contract.
-    unsafe {
-        get_values(
-            c,
-            "fmi2GetInteger",
-            FmiType::Integer,
-            vr,
-            nvr,
-            value,
-            integer_to_c,
-        )
-    }
-}
-
-/// # Safety
-/// `vr` and `value` must be NULL or hold `nvr` elements.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetBoolean(
-    c: fmi2Component,
-    vr: *const fmi2ValueReference,
-    nvr: usize,
-    value: *mut fmi2Boolean,
-) -> fmi2Status {
-    // SAFETY: forwarded contract.
-    unsafe {
-        get_values(
-            c,
-            "fmi2GetBoolean",
-            FmiType::Boolean,
-            vr,
-            nvr,
-            value,
-            boolean_to_c,
-        )
-    }
-}
-
-/// There are no String variables: every value reference is refused (with its real type
-/// when it exists).
-///
-/// # Safety
-/// `vr` and `value` must be NULL or hold `nvr` elements.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetString(
-    c: fmi2Component,
-    vr: *const fmi2ValueReference,
-    nvr: usize,
-    value: *mut fmi2String,
-) -> fmi2Status {
-    // SAFETY: forwarded contract; no value is ever converted.
-    unsafe {
-        get_values(c, "fmi2GetString", FmiType::String, vr, nvr, value, |_| {
-            std::ptr::null()
-        })
-    }
-}
-
-/// # Safety
-/// `vr` and `value` must be NULL or hold `nvr` elements.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetReal(
-    c: fmi2Component,
-    vr: *const fmi2ValueReference,
-    nvr: usize,
-    value: *const fmi2Real,
-) -> fmi2Status {
-    let setter = Setter {
-        function: "fmi2SetReal",
-        mask: masks::SET_REAL,
-        ty: FmiType::Real,
     };
-    // SAFETY: forwarded contract.
-    unsafe { set_values(c, setter, vr, nvr, value, real_to_c) }
 }
 
-/// # Safety
-/// `vr` and `value` must be NULL or hold `nvr` elements.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetInteger(
-    c: fmi2Component,
-    vr: *const fmi2ValueReference,
-    nvr: usize,
-    value: *const fmi2Integer,
-) -> fmi2Status {
-    let setter = Setter {
-        function: "fmi2SetInteger",
-        mask: masks::SET_OTHER,
-        ty: FmiType::Integer,
-    };
-    // SAFETY: forwarded contract.
-    unsafe { set_values(c, setter, vr, nvr, value, f64::from) }
-}
-
-/// # Safety
-/// `vr` and `value` must be NULL or hold `nvr` elements.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetBoolean(
-    c: fmi2Component,
-    vr: *const fmi2ValueReference,
-    nvr: usize,
-    value: *const fmi2Boolean,
-) -> fmi2Status {
-    let setter = Setter {
-        function: "fmi2SetBoolean",
-        mask: masks::SET_OTHER,
-        ty: FmiType::Boolean,
-    };
-    // SAFETY: forwarded contract.
-    unsafe { set_values(c, setter, vr, nvr, value, boolean_from_c) }
-}
-
-/// There are no String variables: every value reference is refused.
-///
-/// # Safety
-/// `vr` and `value` must be NULL or hold `nvr` elements.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetString(
-    c: fmi2Component,
-    vr: *const fmi2ValueReference,
-    nvr: usize,
-    value: *const fmi2String,
-) -> fmi2Status {
-    let setter = Setter {
-        function: "fmi2SetString",
-        mask: masks::SET_OTHER,
-        ty: FmiType::String,
-    };
-    // SAFETY: forwarded contract; the strings are never read.
-    unsafe { set_values(c, setter, vr, nvr, value, |_| f64::NAN) }
-}
+accessors!(
+    fmi2GetReal,
+    fmi2SetReal,
+    fmi2Real,
+    ValueType::of(Api::Fmi2, ValueKind::Real),
+    masks::SET_REAL,
+    |v| v,
+    |v| v
+);
+// Integer variables hold integers within i32 (their table ranges say so).
+accessors!(
+    fmi2GetInteger,
+    fmi2SetInteger,
+    fmi2Integer,
+    ValueType::of(Api::Fmi2, ValueKind::Integer),
+    masks::SET_OTHER,
+    |v| v as fmi2Integer,
+    f64::from
+);
+accessors!(
+    fmi2GetBoolean,
+    fmi2SetBoolean,
+    fmi2Boolean,
+    ValueType::of(Api::Fmi2, ValueKind::Boolean),
+    masks::SET_OTHER,
+    |v| if v != 0.0 { fmi2True } else { fmi2False },
+    |v| if v != fmi2False { 1.0 } else { 0.0 }
+);
+// There are no String variables: every value reference is refused (with its real type when
+// it exists); no value is ever converted.
+accessors!(
+    fmi2GetString,
+    fmi2SetString,
+    fmi2String,
+    ValueType::none(Api::Fmi2, "String"),
+    masks::SET_OTHER,
+    |_| std::ptr::null(),
+    |_| f64::NAN
+);

@@ -9,8 +9,9 @@ use crate::exports::lifecycle::{
 };
 use crate::exports::model_exchange::enter_event_mode;
 use crate::fmi3_types::*;
-use crate::instance::{Api, Interface, Stage, masks3};
+use crate::instance::{Interface, Stage, masks3};
 use crate::log::Sink;
+use crate::table::Api;
 use std::ffi::c_char;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 

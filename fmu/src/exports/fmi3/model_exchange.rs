@@ -196,7 +196,7 @@ fn count(
     instance: fmi3Instance,
     function: &'static str,
     out: *mut usize,
-    of: fn(&crate::model::ModelExchangeTable) -> usize,
+    of: fn(&crate::table::ModelExchangeTable) -> usize,
 ) -> fmi3Status {
     with_instance3(instance, function, masks3::ANY, |instance| {
         let n = instance.sim.table().model_exchange.as_ref().map_or(0, of);
