@@ -73,17 +73,27 @@ pub enum Interface {
     ModelExchange,
 }
 
-/// The stages a function may be called in.
+/// The stages a function may be called in, and whether it is a Model Exchange function.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Mask {
     bits: u16,
     /// For the "Illegal call sequence" message.
     pub names: &'static str,
+    /// Refused on a Co-Simulation instance (Model Exchange shares InitializationMode and
+    /// Terminated with Co-Simulation, so the stage alone does not tell).
+    model_exchange: bool,
 }
 
 impl Mask {
     pub fn allows(self, stage: Stage) -> bool {
         self.bits & stage as u16 != 0
+    }
+
+    const fn model_exchange(self) -> Mask {
+        Mask {
+            model_exchange: true,
+            ..self
+        }
     }
 }
 
@@ -92,6 +102,7 @@ macro_rules! mask {
         Mask {
             bits: Stage::$first as u16 $(| Stage::$rest as u16)*,
             names: concat!(stringify!($first) $(, ", ", stringify!($rest))*),
+            model_exchange: false,
         }
     };
 }
@@ -162,18 +173,20 @@ pub mod masks {
     pub const CANCEL_STEP: Mask = mask!(StepInProgress);
     pub const GET_STATUS: Mask = mask!(StepComplete | StepInProgress | StepFailed | Terminated);
     // Model Exchange.
-    pub const ENTER_EVENT_MODE: Mask = mask!(EventMode | ContinuousTimeMode);
-    pub const NEW_DISCRETE_STATES: Mask = mask!(EventMode);
-    pub const ENTER_CONTINUOUS_TIME_MODE: Mask = mask!(EventMode);
-    pub const COMPLETED_INTEGRATOR_STEP: Mask = mask!(ContinuousTimeMode);
-    pub const SET_TIME: Mask = mask!(EventMode | ContinuousTimeMode);
-    pub const SET_CONTINUOUS_STATES: Mask = mask!(ContinuousTimeMode);
+    pub const ENTER_EVENT_MODE: Mask = mask!(EventMode | ContinuousTimeMode).model_exchange();
+    pub const NEW_DISCRETE_STATES: Mask = mask!(EventMode).model_exchange();
+    pub const ENTER_CONTINUOUS_TIME_MODE: Mask = mask!(EventMode).model_exchange();
+    pub const COMPLETED_INTEGRATOR_STEP: Mask = mask!(ContinuousTimeMode).model_exchange();
+    pub const SET_TIME: Mask = mask!(EventMode | ContinuousTimeMode).model_exchange();
+    pub const SET_CONTINUOUS_STATES: Mask = mask!(ContinuousTimeMode).model_exchange();
     pub const GET_EVENT_INDICATORS: Mask =
-        mask!(InitializationMode | EventMode | ContinuousTimeMode | Terminated | Error);
+        mask!(InitializationMode | EventMode | ContinuousTimeMode | Terminated | Error)
+            .model_exchange();
     pub const GET_CONTINUOUS_STATES: Mask = GET_EVENT_INDICATORS;
-    pub const GET_DERIVATIVES: Mask = mask!(EventMode | ContinuousTimeMode | Terminated | Error);
+    pub const GET_DERIVATIVES: Mask =
+        mask!(EventMode | ContinuousTimeMode | Terminated | Error).model_exchange();
     pub const GET_NOMINALS: Mask =
-        mask!(Instantiated | EventMode | ContinuousTimeMode | Terminated | Error);
+        mask!(Instantiated | EventMode | ContinuousTimeMode | Terminated | Error).model_exchange();
 }
 
 /// Per-function masks of FMI 3.0 (Reference-FMUs' fmi3Functions.c), in the stages of
@@ -200,7 +213,7 @@ pub mod masks3 {
     pub const SET_OTHER: Mask = super::masks::SET_OTHER;
     pub const ENTER_STEP_MODE: Mask = mask!(InitializationMode | EventMode);
     pub const GET_OUTPUT_DERIVATIVES: Mask = mask!(StepComplete | StepFailed | Terminated);
-    pub const UPDATE_DISCRETE_STATES: Mask = mask!(EventMode);
+    pub const UPDATE_DISCRETE_STATES: Mask = mask!(EventMode).model_exchange();
     /// FMI 3.0 allows derivatives in initialization mode too: the event indicators' stages.
     pub const GET_DERIVATIVES: Mask = super::masks::GET_EVENT_INDICATORS;
     /// Functions that ask nothing of the stage (counts, unsupported capabilities): every
@@ -258,6 +271,11 @@ impl Instance {
         }
     }
 
+    /// Whether the instance is past initialization mode (fixed parameters are fixed now).
+    pub fn initialised(&self) -> bool {
+        !matches!(self.stage, Stage::Instantiated | Stage::InitializationMode)
+    }
+
     /// Logs `message` if its category is on.
     pub fn log(&self, status: fmi2Status, message: &str) {
         let category = category_of(status);
@@ -284,16 +302,28 @@ impl Instance {
         status
     }
 
-    /// Fails with "Illegal call sequence" unless `mask` allows the current stage.
+    /// Fails with "Illegal call sequence" unless `mask` allows the current stage, and for a
+    /// Model Exchange function on a Co-Simulation instance.
     pub fn check_stage(&self, mask: Mask) -> Result<(), FmuError> {
-        if mask.allows(self.stage) {
-            Ok(())
-        } else {
-            Err(FmuError::IllegalCall {
+        if !mask.allows(self.stage) {
+            return Err(FmuError::IllegalCall {
                 stage: self.api.stage_name(&format!("{:?}", self.stage)),
                 allowed: self.api.stage_name(mask.names),
-            })
+            });
         }
+        if mask.model_exchange && self.interface == Interface::CoSimulation {
+            return Err(FmuError::NotSupported(match self.api {
+                Api::Fmi2 => {
+                    "Model Exchange functions on a Co-Simulation instance (instantiate with \
+                     fmuType fmi2ModelExchange)"
+                }
+                Api::Fmi3 => {
+                    "Model Exchange functions on a Co-Simulation instance (instantiate with \
+                     fmi3InstantiateModelExchange)"
+                }
+            }));
+        }
+        Ok(())
     }
 
     /// Fails unless this is a Co-Simulation instance.
@@ -303,24 +333,6 @@ impl Instance {
             Interface::ModelExchange => Err(FmuError::NotSupported(
                 "Co-Simulation functions on a Model Exchange instance",
             )),
-        }
-    }
-
-    /// Fails unless this is a Model Exchange instance (the Model Exchange masks share
-    /// InitializationMode and Terminated with Co-Simulation).
-    pub fn check_model_exchange(&self) -> Result<(), FmuError> {
-        match self.interface {
-            Interface::ModelExchange => Ok(()),
-            Interface::CoSimulation => Err(FmuError::NotSupported(match self.api {
-                Api::Fmi2 => {
-                    "Model Exchange functions on a Co-Simulation instance (instantiate with \
-                     fmuType fmi2ModelExchange)"
-                }
-                Api::Fmi3 => {
-                    "Model Exchange functions on a Co-Simulation instance (instantiate with \
-                     fmi3InstantiateModelExchange)"
-                }
-            })),
         }
     }
 

@@ -6,6 +6,7 @@ use crate::error::FmuError;
 use crate::fmi2_types::{fmi2Component, fmi2Status};
 use crate::instance::{Instance, Mask, Stage};
 use std::any::Any;
+use std::ffi::{CStr, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// Runs `body` for the instance behind `c` if `mask` allows its stage.
@@ -119,6 +120,15 @@ fn check_length<T>(n: usize, name: &'static str) -> Result<(), FmuError> {
         )));
     }
     Ok(())
+}
+
+/// A `&CStr` from a C string argument.
+///
+/// # Safety
+/// `s` must be NULL or NUL-terminated and valid for the call.
+pub(crate) unsafe fn c_str<'a>(s: *const c_char) -> Option<&'a CStr> {
+    // SAFETY: per the function's contract.
+    (!s.is_null()).then(|| unsafe { CStr::from_ptr(s) })
 }
 
 /// `*ptr = value` for an output pointer argument.

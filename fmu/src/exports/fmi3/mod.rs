@@ -4,14 +4,12 @@
 //! (arrays, `time`, event indicators; see [`crate::table::Fmi3View`]).
 
 mod cosimulation;
-mod fmu_state;
 mod lifecycle;
 mod model_exchange;
 mod unsupported;
-mod values;
+pub(crate) mod values;
 
 pub use cosimulation::*;
-pub use fmu_state::*;
 pub use lifecycle::*;
 pub use model_exchange::*;
 pub use unsupported::*;
@@ -21,7 +19,8 @@ use crate::error::FmuError;
 use crate::fmi3_types::{fmi3Instance, fmi3Status};
 use crate::instance::{Instance, Mask};
 
-/// [`super::guard::with_instance`] with an FMI 3.0 status.
+/// [`super::guard::with_instance`] for a body without a status of its own: OK, or the
+/// error's status, as an FMI 3.0 status.
 pub(crate) fn with_instance3(
     instance: fmi3Instance,
     function: &'static str,

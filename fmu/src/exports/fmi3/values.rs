@@ -130,7 +130,6 @@ macro_rules! accessors {
         ) -> fmi3Status {
             use $crate::exports::fmi3::values::{not_settable, resolve};
             use $crate::exports::guard::{c_slice, with_instance};
-            use $crate::exports::values::initialised;
             use $crate::table::Source;
             let function = stringify!($set);
             with_instance(instance, function, $mask, |instance| {
@@ -140,7 +139,7 @@ macro_rules! accessors {
                 let variables = resolve(&instance.sim.table().fmi3, vrs, nValues)?;
                 // SAFETY: per the function's contract.
                 let values = unsafe { c_slice(values, nValues, "values[]") }?;
-                let initialised = initialised(instance);
+                let initialised = instance.initialised();
                 let mut worst = $crate::fmi2_types::fmi2Status::fmi2OK;
                 let mut at = 0;
                 for v in variables {

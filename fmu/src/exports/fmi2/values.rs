@@ -2,18 +2,11 @@
 //! refused one is logged with its reason and the call returns the worst status, while the
 //! others still take effect (set) or are filled in (get).
 
-use super::guard::{c_slice, c_slice_mut, with_instance};
+use crate::exports::guard::{c_slice, c_slice_mut, with_instance};
 use crate::fmi2_types::*;
-use crate::instance::{Instance, Stage, masks};
+use crate::instance::masks;
 use crate::table::{Api, ValueType};
 use flyloop_core::params::ValueKind;
-
-pub(crate) fn initialised(instance: &Instance) -> bool {
-    !matches!(
-        instance.stage,
-        Stage::Instantiated | Stage::InitializationMode
-    )
-}
 
 /// Defines fmi2Get<T> and fmi2Set<T> for C type `$t` and value type `$ty`: the getter
 /// converts through `$to_c`, the setter (allowed in `$mask`) through `$from_c`. The body is
@@ -62,7 +55,7 @@ macro_rules! accessors {
                 let vrs = unsafe { c_slice(vr, nvr, "vr[]") }?;
                 // SAFETY: per the function's contract.
                 let values = unsafe { c_slice(value, nvr, "value[]") }?;
-                let initialised = initialised(instance);
+                let initialised = instance.initialised();
                 let table = instance.sim.table();
                 let mut worst = fmi2Status::fmi2OK;
                 for (&vr, &v) in vrs.iter().zip(values) {

@@ -7,7 +7,8 @@ use crate::instance::{Instance, Interface};
 use crate::log::{Category, Logger, Sink};
 use crate::models;
 use crate::table::Api;
-use std::ffi::CStr;
+use std::ffi::{CStr, c_void};
+use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// An instantiation request, its C arguments already read.
 pub(crate) struct Request<'a> {
@@ -86,4 +87,14 @@ pub(crate) fn create_instance(request: &Request<'_>) -> Option<*mut Instance> {
         instance.interface
     ));
     Some(Box::into_raw(Box::new(instance)))
+}
+
+/// The instance `build` asks for, or NULL (`build` gives `None` when there is no logger to
+/// tell why; a panic, caught here, gives NULL too).
+pub(crate) fn instantiate<'a>(build: impl FnOnce() -> Option<Request<'a>>) -> *mut c_void {
+    let outcome = catch_unwind(AssertUnwindSafe(|| create_instance(&build()?)));
+    match outcome {
+        Ok(Some(instance)) => instance.cast(),
+        _ => std::ptr::null_mut(),
+    }
 }
