@@ -81,19 +81,10 @@ impl Clock {
 }
 
 /// What fmi2SetupExperiment said.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Experiment {
     pub start: f64,
     pub stop: Option<f64>,
-}
-
-impl Default for Experiment {
-    fn default() -> Self {
-        Experiment {
-            start: 0.0,
-            stop: None,
-        }
-    }
 }
 
 /// The instance's simulation as the FMI functions drive it.
@@ -192,11 +183,6 @@ impl<M: FmuModel> Engine<M> {
             clock: Clock::at(0.0),
             event_time: 0.0,
         })
-    }
-
-    /// The model (for tests and benchmarks that compare with the core).
-    pub fn model(&self) -> &M {
-        &self.model
     }
 
     /// Rebuilds the model from the start values, keeping the inputs set so far.

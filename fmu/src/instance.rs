@@ -351,12 +351,25 @@ impl Instance {
         Ok(stage)
     }
 
-    /// Keeps `state` and returns its address for the importer.
-    pub fn adopt_state(&mut self, state: SavedState) -> *mut SavedState {
-        let mut boxed = Box::new(state);
+    /// Keeps `bytes` as a new state (`existing` 0) or in the live state at `existing`;
+    /// returns the state's address for the importer.
+    pub fn keep_state(
+        &mut self,
+        existing: usize,
+        bytes: Vec<u8>,
+    ) -> Result<*mut SavedState, FmuError> {
+        if existing != 0 {
+            let state = self
+                .states
+                .get_mut(&existing)
+                .ok_or(FmuError::UnknownState)?;
+            state.bytes = bytes;
+            return Ok(&mut **state);
+        }
+        let mut boxed = Box::new(SavedState { bytes });
         let address: *mut SavedState = &mut *boxed;
         self.states.insert(address as usize, boxed);
-        address
+        Ok(address)
     }
 
     /// The live state at `address`.
@@ -367,25 +380,12 @@ impl Instance {
             .ok_or(FmuError::UnknownState)
     }
 
-    /// The live state at `address`, to overwrite.
-    pub fn state_mut(&mut self, address: usize) -> Result<&mut SavedState, FmuError> {
-        self.states
-            .get_mut(&address)
-            .map(|b| &mut **b)
-            .ok_or(FmuError::UnknownState)
-    }
-
     /// Frees the live state at `address`.
     pub fn release_state(&mut self, address: usize) -> Result<(), FmuError> {
         self.states
             .remove(&address)
             .map(drop)
             .ok_or(FmuError::UnknownState)
-    }
-
-    /// How many FMU states are live.
-    pub fn live_states(&self) -> usize {
-        self.states.len()
     }
 }
 

@@ -146,6 +146,31 @@ pub(crate) fn categories_and_experiment(out: &mut String, info: &ModelInfo) {
     );
 }
 
+/// The unit (Real variables only), range (not for Booleans) and start attributes (every
+/// element's, for an FMI 3.0 array).
+pub(crate) fn value_attributes(
+    out: &mut String,
+    kind: ValueKind,
+    unit: &str,
+    [min, max]: [Option<f64>; 2],
+    start: &[f64],
+) {
+    if kind == ValueKind::Real && !unit.is_empty() {
+        let _ = write!(out, " unit=\"{}\"", escape(unit));
+    }
+    if kind != ValueKind::Boolean {
+        for (name, bound) in [("min", min), ("max", max)] {
+            if let Some(b) = bound {
+                let _ = write!(out, " {name}=\"{}\"", value_text(kind, b));
+            }
+        }
+    }
+    if !start.is_empty() {
+        let starts: Vec<String> = start.iter().map(|&s| value_text(kind, s)).collect();
+        let _ = write!(out, " start=\"{}\"", starts.join(" "));
+    }
+}
+
 /// `derivative` is the 1-based index of the state a derivative variable belongs to.
 fn scalar_variable(out: &mut String, v: &Variable, derivative: Option<usize>) {
     let _ = writeln!(
@@ -159,20 +184,8 @@ fn scalar_variable(out: &mut String, v: &Variable, derivative: Option<usize>) {
         variability(v.variability)
     );
     let _ = write!(out, "      <{}", Api::Fmi2.type_name(v.kind));
-    // FMI 2.0 gives units to Real variables only.
-    if v.kind == ValueKind::Real && !v.unit.is_empty() {
-        let _ = write!(out, " unit=\"{}\"", escape(v.unit));
-    }
-    if v.kind != ValueKind::Boolean {
-        for (name, bound) in [("min", v.min), ("max", v.max)] {
-            if let Some(b) = bound {
-                let _ = write!(out, " {name}=\"{}\"", value_text(v.kind, b));
-            }
-        }
-    }
-    if let Some(start) = v.start {
-        let _ = write!(out, " start=\"{}\"", value_text(v.kind, start));
-    }
+    let range = [v.min, v.max];
+    value_attributes(out, v.kind, v.unit, range, v.start.as_slice());
     if let Some(state) = derivative {
         let _ = write!(out, " derivative=\"{state}\"");
     }

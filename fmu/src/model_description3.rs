@@ -4,8 +4,8 @@
 //! 2.0 description, with arrays, `time` and the event-indicator variables. Deterministic.
 
 use crate::model_description::{
-    UnknownUnit, categories_and_experiment, escape, output_dependencies, value_text, variability,
-    write_units,
+    UnknownUnit, categories_and_experiment, escape, output_dependencies, value_attributes,
+    variability, write_units,
 };
 use crate::table::{Api, Causality3, Fmi3View, ModelTable, Source, Variable3};
 use flyloop_core::params::ValueKind;
@@ -36,20 +36,7 @@ fn variable(out: &mut String, table: &ModelTable, v: &Variable3) {
         v.causality.name(),
         variability(v.variability)
     );
-    if v.kind == ValueKind::Real && !v.unit.is_empty() {
-        let _ = write!(out, " unit=\"{}\"", escape(v.unit));
-    }
-    if v.kind != ValueKind::Boolean {
-        for (name, bound) in [("min", v.min), ("max", v.max)] {
-            if let Some(b) = bound {
-                let _ = write!(out, " {name}=\"{}\"", value_text(v.kind, b));
-            }
-        }
-    }
-    if !v.start.is_empty() {
-        let starts: Vec<String> = v.start.iter().map(|&s| value_text(v.kind, s)).collect();
-        let _ = write!(out, " start=\"{}\"", starts.join(" "));
-    }
+    value_attributes(out, v.kind, v.unit, [v.min, v.max], &v.start);
     if let Some(state) = state_of_derivative(table, v) {
         let _ = write!(out, " derivative=\"{state}\"");
     }

@@ -89,18 +89,19 @@ exports! {
         reset(c, "fmi2Reset")
     }
 
-    /// Copies the current state (see [`get_state`]).
+    /// Copies the current state. `*FMUstate` NULL gets a new state; a state of this instance
+    /// is overwritten in place.
     fn fmi2GetFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate) -> fmi2Status {
         get_state(c, "fmi2GetFMUstate", FMUstate)
     }
 
-    /// Restores a state of this instance (see [`set_state`]); `FMUstate` is looked up, never
-    /// dereferenced.
+    /// Restores a state of this instance (stage, time and everything else included);
+    /// `FMUstate` is looked up, never dereferenced.
     fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
         set_state(c, "fmi2SetFMUstate", FMUstate)
     }
 
-    /// Frees a state (see [`free_state`]).
+    /// Frees a state and sets `*FMUstate` to NULL; a second free is an error.
     fn fmi2FreeFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate) -> fmi2Status {
         free_state(c, "fmi2FreeFMUstate", FMUstate)
     }
@@ -109,12 +110,13 @@ exports! {
         serialized_size(c, "fmi2SerializedFMUstateSize", FMUstate, size)
     }
 
-    /// Copies a state's bytes (see [`serialize`]).
+    /// Copies a state's bytes; `size` must be what fmi2SerializedFMUstateSize said.
     fn fmi2SerializeFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate, serializedState: *mut fmi2Byte, size: usize) -> fmi2Status {
         serialize(c, "fmi2SerializeFMUstate", FMUstate, serializedState.cast(), size)
     }
 
-    /// Makes a state from serialized bytes (see [`deserialize`]).
+    /// Makes a state from serialized bytes after checking them completely (format,
+    /// checksum, model, a restorable model snapshot); bytes that fail change nothing.
     fn fmi2DeSerializeFMUstate(c: fmi2Component, serializedState: *const fmi2Byte, size: usize, FMUstate: *mut fmi2FMUstate) -> fmi2Status {
         deserialize(c, "fmi2DeSerializeFMUstate", serializedState.cast(), size, FMUstate)
     }

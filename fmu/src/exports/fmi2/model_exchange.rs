@@ -1,5 +1,4 @@
-//! FMI 2.0 Model Exchange, for an instance made with fmuType fmi2ModelExchange (the bodies
-//! both versions share are in [`crate::exports::shared::model_exchange`]).
+//! FMI 2.0 Model Exchange, for an instance made with fmuType fmi2ModelExchange.
 
 use crate::error::FmuError;
 use crate::exports::guard::{c_slice, c_slice_mut, with_instance, write_out};

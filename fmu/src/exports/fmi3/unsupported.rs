@@ -12,89 +12,25 @@ use crate::fmi3_types::*;
 use crate::instance::{Mask, masks3};
 use crate::table::{Api, ValueType};
 
-// Types no variable has: every value reference is refused, naming the variable's real type
-// when it exists; no value is ever converted.
-accessors!(
-    fmi3GetFloat32,
-    fmi3SetFloat32,
-    fmi3Float32,
-    ValueType::none(Api::Fmi3, "Float32"),
-    masks3::SET_OTHER,
-    |_| 0.0,
-    |_| f64::NAN
-);
-accessors!(
-    fmi3GetInt8,
-    fmi3SetInt8,
-    fmi3Int8,
-    ValueType::none(Api::Fmi3, "Int8"),
-    masks3::SET_OTHER,
-    |_| 0,
-    |_| f64::NAN
-);
-accessors!(
-    fmi3GetUInt8,
-    fmi3SetUInt8,
-    fmi3UInt8,
-    ValueType::none(Api::Fmi3, "UInt8"),
-    masks3::SET_OTHER,
-    |_| 0,
-    |_| f64::NAN
-);
-accessors!(
-    fmi3GetInt16,
-    fmi3SetInt16,
-    fmi3Int16,
-    ValueType::none(Api::Fmi3, "Int16"),
-    masks3::SET_OTHER,
-    |_| 0,
-    |_| f64::NAN
-);
-accessors!(
-    fmi3GetUInt16,
-    fmi3SetUInt16,
-    fmi3UInt16,
-    ValueType::none(Api::Fmi3, "UInt16"),
-    masks3::SET_OTHER,
-    |_| 0,
-    |_| f64::NAN
-);
-accessors!(
-    fmi3GetUInt32,
-    fmi3SetUInt32,
-    fmi3UInt32,
-    ValueType::none(Api::Fmi3, "UInt32"),
-    masks3::SET_OTHER,
-    |_| 0,
-    |_| f64::NAN
-);
-accessors!(
-    fmi3GetInt64,
-    fmi3SetInt64,
-    fmi3Int64,
-    ValueType::none(Api::Fmi3, "Int64"),
-    masks3::SET_OTHER,
-    |_| 0,
-    |_| f64::NAN
-);
-accessors!(
-    fmi3GetUInt64,
-    fmi3SetUInt64,
-    fmi3UInt64,
-    ValueType::none(Api::Fmi3, "UInt64"),
-    masks3::SET_OTHER,
-    |_| 0,
-    |_| f64::NAN
-);
-accessors!(
-    fmi3GetString,
-    fmi3SetString,
-    fmi3String,
-    ValueType::none(Api::Fmi3, "String"),
-    masks3::SET_OTHER,
-    |_| std::ptr::null(),
-    |_| f64::NAN
-);
+/// Defines fmi3Get<T> and fmi3Set<T> for types no variable has: every value reference is
+/// refused, naming the variable's real type when it exists; no value is ever converted.
+macro_rules! no_variables {
+    ($($get:ident $set:ident $t:ty, $name:literal = $zero:expr;)*) => {$(
+        accessors!($get, $set, $t, ValueType::none(Api::Fmi3, $name), masks3::SET_OTHER, |_| $zero, |_| f64::NAN);
+    )*};
+}
+
+no_variables! {
+    fmi3GetFloat32 fmi3SetFloat32 fmi3Float32, "Float32" = 0.0;
+    fmi3GetInt8 fmi3SetInt8 fmi3Int8, "Int8" = 0;
+    fmi3GetUInt8 fmi3SetUInt8 fmi3UInt8, "UInt8" = 0;
+    fmi3GetInt16 fmi3SetInt16 fmi3Int16, "Int16" = 0;
+    fmi3GetUInt16 fmi3SetUInt16 fmi3UInt16, "UInt16" = 0;
+    fmi3GetUInt32 fmi3SetUInt32 fmi3UInt32, "UInt32" = 0;
+    fmi3GetInt64 fmi3SetInt64 fmi3Int64, "Int64" = 0;
+    fmi3GetUInt64 fmi3SetUInt64 fmi3UInt64, "UInt64" = 0;
+    fmi3GetString fmi3SetString fmi3String, "String" = std::ptr::null();
+}
 
 /// The body of fmi3GetBinary and fmi3SetBinary: after the checks every fmi3Get*/fmi3Set*
 /// makes (known value references, `nValues`, `values` not NULL), every variable is refused

@@ -8,7 +8,7 @@
 use crate::error::FmuError;
 use crate::exports::guard::{c_slice, c_slice_mut, with_instance, write_out};
 use crate::fmi2_types::*;
-use crate::instance::{SavedState, masks};
+use crate::instance::masks;
 use flyloop_core::number::Compact;
 use std::ffi::c_void;
 
@@ -32,13 +32,9 @@ pub(crate) unsafe fn get_state(
         // SAFETY: non-NULL and readable per the contract.
         let existing = unsafe { FMUstate.read() };
         let bytes = instance.sim.save(instance.stage.code())?;
-        if existing.is_null() {
-            let address = instance.adopt_state(SavedState { bytes });
-            // SAFETY: non-NULL and writable per the contract.
-            unsafe { FMUstate.write(address.cast()) };
-        } else {
-            instance.state_mut(existing as usize)?.bytes = bytes;
-        }
+        let address = instance.keep_state(existing as usize, bytes)?;
+        // SAFETY: non-NULL and writable per the contract.
+        unsafe { FMUstate.write(address.cast()) };
         instance.event(&format!(
             "{function}: state saved at t = {}",
             Compact(instance.sim.time())
@@ -167,15 +163,9 @@ pub(crate) unsafe fn deserialize(
         instance.stage_from_code(instance.sim.check_saved(bytes)?)?;
         // SAFETY: non-NULL and readable per the contract.
         let existing = unsafe { FMUstate.read() };
-        if existing.is_null() {
-            let address = instance.adopt_state(SavedState {
-                bytes: bytes.to_vec(),
-            });
-            // SAFETY: non-NULL and writable per the contract.
-            unsafe { FMUstate.write(address.cast()) };
-        } else {
-            instance.state_mut(existing as usize)?.bytes = bytes.to_vec();
-        }
+        let address = instance.keep_state(existing as usize, bytes.to_vec())?;
+        // SAFETY: non-NULL and writable per the contract.
+        unsafe { FMUstate.write(address.cast()) };
         Ok(fmi2Status::fmi2OK)
     })
 }
