@@ -107,86 +107,57 @@ macro_rules! mask {
     };
 }
 
+/// A table of masks, one a line (rustfmt leaves it as a table).
+macro_rules! masks {
+    ($($(#[doc = $doc:literal])* $name:ident = $mask:expr;)*) => {$(
+        $(#[doc = $doc])*
+        pub const $name: Mask = $mask;
+    )*};
+}
+
 /// Per-function masks, as in Reference-FMUs' fmi2Functions.c.
 pub mod masks {
     use super::{Mask, Stage};
 
-    pub const SET_DEBUG_LOGGING: Mask = mask!(
-        Instantiated
-            | InitializationMode
-            | EventMode
-            | ContinuousTimeMode
-            | StepComplete
-            | StepInProgress
-            | StepFailed
-            | StepCanceled
-            | Terminated
-            | Error
-    );
-    pub const FREE_INSTANCE: Mask = mask!(
-        Instantiated
-            | InitializationMode
-            | EventMode
-            | ContinuousTimeMode
-            | StepComplete
-            | StepFailed
-            | StepCanceled
-            | Terminated
-            | Error
-            | Fatal
-    );
-    pub const SETUP_EXPERIMENT: Mask = mask!(Instantiated);
-    pub const ENTER_INITIALIZATION_MODE: Mask = mask!(Instantiated);
-    pub const EXIT_INITIALIZATION_MODE: Mask = mask!(InitializationMode);
-    pub const TERMINATE: Mask = mask!(EventMode | ContinuousTimeMode | StepComplete | StepFailed);
-    pub const RESET: Mask = mask!(
-        Instantiated
-            | InitializationMode
-            | EventMode
-            | ContinuousTimeMode
-            | StepComplete
-            | StepFailed
-            | StepCanceled
-            | Terminated
-            | Error
-    );
-    pub const GET_VALUE: Mask = mask!(
-        InitializationMode
-            | EventMode
-            | ContinuousTimeMode
-            | StepComplete
-            | StepFailed
-            | StepCanceled
-            | Terminated
-            | Error
-    );
-    pub const SET_REAL: Mask =
-        mask!(Instantiated | InitializationMode | EventMode | ContinuousTimeMode | StepComplete);
-    pub const SET_OTHER: Mask = mask!(Instantiated | InitializationMode | EventMode | StepComplete);
-    pub const FMU_STATE: Mask = RESET;
-    pub const DIRECTIONAL_DERIVATIVE: Mask = GET_VALUE;
-    pub const SET_REAL_INPUT_DERIVATIVES: Mask =
-        mask!(Instantiated | InitializationMode | StepComplete);
-    pub const GET_REAL_OUTPUT_DERIVATIVES: Mask =
-        mask!(StepComplete | StepFailed | StepCanceled | Terminated | Error);
-    pub const DO_STEP: Mask = mask!(StepComplete);
-    pub const CANCEL_STEP: Mask = mask!(StepInProgress);
-    pub const GET_STATUS: Mask = mask!(StepComplete | StepInProgress | StepFailed | Terminated);
-    // Model Exchange.
-    pub const ENTER_EVENT_MODE: Mask = mask!(EventMode | ContinuousTimeMode).model_exchange();
-    pub const NEW_DISCRETE_STATES: Mask = mask!(EventMode).model_exchange();
-    pub const ENTER_CONTINUOUS_TIME_MODE: Mask = mask!(EventMode).model_exchange();
-    pub const COMPLETED_INTEGRATOR_STEP: Mask = mask!(ContinuousTimeMode).model_exchange();
-    pub const SET_TIME: Mask = mask!(EventMode | ContinuousTimeMode).model_exchange();
-    pub const SET_CONTINUOUS_STATES: Mask = mask!(ContinuousTimeMode).model_exchange();
-    pub const GET_EVENT_INDICATORS: Mask =
-        mask!(InitializationMode | EventMode | ContinuousTimeMode | Terminated | Error)
+    masks! {
+        SET_DEBUG_LOGGING = mask!(Instantiated | InitializationMode | EventMode | ContinuousTimeMode
+            | StepComplete | StepInProgress | StepFailed | StepCanceled | Terminated | Error);
+        FREE_INSTANCE = mask!(Instantiated | InitializationMode | EventMode | ContinuousTimeMode
+            | StepComplete | StepFailed | StepCanceled | Terminated | Error | Fatal);
+        SETUP_EXPERIMENT = mask!(Instantiated);
+        ENTER_INITIALIZATION_MODE = mask!(Instantiated);
+        EXIT_INITIALIZATION_MODE = mask!(InitializationMode);
+        TERMINATE = mask!(EventMode | ContinuousTimeMode | StepComplete | StepFailed);
+        RESET = mask!(Instantiated | InitializationMode | EventMode | ContinuousTimeMode
+            | StepComplete | StepFailed | StepCanceled | Terminated | Error);
+        GET_VALUE = mask!(InitializationMode | EventMode | ContinuousTimeMode | StepComplete
+            | StepFailed | StepCanceled | Terminated | Error);
+        SET_REAL = mask!(Instantiated | InitializationMode | EventMode | ContinuousTimeMode
+            | StepComplete);
+        SET_OTHER = mask!(Instantiated | InitializationMode | EventMode | StepComplete);
+        FMU_STATE = RESET;
+        DIRECTIONAL_DERIVATIVE = GET_VALUE;
+        SET_REAL_INPUT_DERIVATIVES = mask!(Instantiated | InitializationMode | StepComplete);
+        GET_REAL_OUTPUT_DERIVATIVES = mask!(StepComplete | StepFailed | StepCanceled | Terminated
+            | Error);
+        DO_STEP = mask!(StepComplete);
+        CANCEL_STEP = mask!(StepInProgress);
+        GET_STATUS = mask!(StepComplete | StepInProgress | StepFailed | Terminated);
+        // Model Exchange.
+        ENTER_EVENT_MODE = mask!(EventMode | ContinuousTimeMode).model_exchange();
+        NEW_DISCRETE_STATES = mask!(EventMode).model_exchange();
+        ENTER_CONTINUOUS_TIME_MODE = mask!(EventMode).model_exchange();
+        COMPLETED_INTEGRATOR_STEP = mask!(ContinuousTimeMode).model_exchange();
+        SET_TIME = mask!(EventMode | ContinuousTimeMode).model_exchange();
+        SET_CONTINUOUS_STATES = mask!(ContinuousTimeMode).model_exchange();
+        GET_EVENT_INDICATORS = mask!(InitializationMode | EventMode | ContinuousTimeMode
+            | Terminated | Error).model_exchange();
+        GET_CONTINUOUS_STATES = GET_EVENT_INDICATORS;
+        GET_DERIVATIVES = mask!(EventMode | ContinuousTimeMode | Terminated | Error)
             .model_exchange();
-    pub const GET_CONTINUOUS_STATES: Mask = GET_EVENT_INDICATORS;
-    pub const GET_DERIVATIVES: Mask =
-        mask!(EventMode | ContinuousTimeMode | Terminated | Error).model_exchange();
-    pub const GET_NOMINALS: Mask =
-        mask!(Instantiated | EventMode | ContinuousTimeMode | Terminated | Error).model_exchange();
+        GET_NOMINALS = mask!(Instantiated | EventMode | ContinuousTimeMode | Terminated | Error)
+            .model_exchange();
+    }
 }
 
 /// Per-function masks of FMI 3.0 (Reference-FMUs' fmi3Functions.c), in the stages of
@@ -195,30 +166,23 @@ pub mod masks {
 pub mod masks3 {
     use super::{Mask, Stage};
 
-    pub const ENTER_INITIALIZATION_MODE: Mask = mask!(Instantiated);
-    /// FMI 3.0 allows reading in every stage but the step in progress.
-    pub const GET_VALUE: Mask = mask!(
-        Instantiated
-            | InitializationMode
-            | EventMode
-            | ContinuousTimeMode
-            | StepComplete
-            | StepFailed
-            | StepCanceled
-            | Terminated
-            | Error
-    );
-    /// The same stages as FMI 2.0's fmi2SetReal and the other setters.
-    pub const SET_FLOAT64: Mask = super::masks::SET_REAL;
-    pub const SET_OTHER: Mask = super::masks::SET_OTHER;
-    pub const ENTER_STEP_MODE: Mask = mask!(InitializationMode | EventMode);
-    pub const GET_OUTPUT_DERIVATIVES: Mask = mask!(StepComplete | StepFailed | Terminated);
-    pub const UPDATE_DISCRETE_STATES: Mask = mask!(EventMode).model_exchange();
-    /// FMI 3.0 allows derivatives in initialization mode too: the event indicators' stages.
-    pub const GET_DERIVATIVES: Mask = super::masks::GET_EVENT_INDICATORS;
-    /// Functions that ask nothing of the stage (counts, unsupported capabilities): every
-    /// stage but Fatal, as for fmi2SetDebugLogging.
-    pub const ANY: Mask = super::masks::SET_DEBUG_LOGGING;
+    masks! {
+        ENTER_INITIALIZATION_MODE = mask!(Instantiated);
+        /// FMI 3.0 allows reading in every stage but the step in progress.
+        GET_VALUE = mask!(Instantiated | InitializationMode | EventMode | ContinuousTimeMode
+            | StepComplete | StepFailed | StepCanceled | Terminated | Error);
+        /// The same stages as FMI 2.0's fmi2SetReal and the other setters.
+        SET_FLOAT64 = super::masks::SET_REAL;
+        SET_OTHER = super::masks::SET_OTHER;
+        ENTER_STEP_MODE = mask!(InitializationMode | EventMode);
+        GET_OUTPUT_DERIVATIVES = mask!(StepComplete | StepFailed | Terminated);
+        UPDATE_DISCRETE_STATES = mask!(EventMode).model_exchange();
+        /// FMI 3.0 allows derivatives in initialization mode too: the event indicators' stages.
+        GET_DERIVATIVES = super::masks::GET_EVENT_INDICATORS;
+        /// Functions that ask nothing of the stage (counts, unsupported capabilities): every
+        /// stage but Fatal, as for fmi2SetDebugLogging.
+        ANY = super::masks::SET_DEBUG_LOGGING;
+    }
 }
 
 /// A saved FMU state: the bytes of [`Simulation::save`]. Boxed; the box's address is the

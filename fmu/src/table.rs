@@ -17,6 +17,8 @@ pub enum Api {
 }
 
 impl Api {
+    pub const ALL: [Api; 2] = [Api::Fmi2, Api::Fmi3];
+
     /// Stage names as this version's standard calls them (FMI 3.0: Step Mode).
     pub fn stage_name(self, names: &str) -> String {
         match self {

@@ -88,7 +88,11 @@ pub(crate) unsafe fn c_slice<'a, T>(
     if ptr.is_null() {
         return Err(FmuError::NullArgument(name));
     }
-    check_length::<T>(n, name)?;
+    if n > isize::MAX as usize / std::mem::size_of::<T>().max(1) {
+        return Err(FmuError::InvalidArgument(format!(
+            "array `{name}` claims {n} elements, more than memory can hold"
+        )));
+    }
     // SAFETY: non-NULL, length checked against isize::MAX bytes, validity per the contract.
     Ok(unsafe { std::slice::from_raw_parts(ptr, n) })
 }
@@ -102,24 +106,10 @@ pub(crate) unsafe fn c_slice_mut<'a, T>(
     n: usize,
     name: &'static str,
 ) -> Result<&'a mut [T], FmuError> {
-    if n == 0 {
-        return Ok(&mut []);
-    }
-    if ptr.is_null() {
-        return Err(FmuError::NullArgument(name));
-    }
-    check_length::<T>(n, name)?;
-    // SAFETY: as in c_slice, and the importer does not alias its output arrays.
-    Ok(unsafe { std::slice::from_raw_parts_mut(ptr, n) })
-}
-
-fn check_length<T>(n: usize, name: &'static str) -> Result<(), FmuError> {
-    if n > isize::MAX as usize / std::mem::size_of::<T>().max(1) {
-        return Err(FmuError::InvalidArgument(format!(
-            "array `{name}` claims {n} elements, more than memory can hold"
-        )));
-    }
-    Ok(())
+    // SAFETY: the checks of c_slice, the importer's contract, and the importer does not alias
+    // its output arrays.
+    let checked = unsafe { c_slice(ptr.cast_const(), n, name) }?;
+    Ok(unsafe { std::slice::from_raw_parts_mut(checked.as_ptr().cast_mut(), n) })
 }
 
 /// A `&CStr` from a C string argument.

@@ -145,7 +145,10 @@ fn table() -> Table<Quadrotor> {
             let read: fn(&Quadrotor, usize) -> f64 = |q, at| q.continuous_state()[at];
             (
                 local(name, vr, "m", text),
-                Access::Local { read, at: 17 + i },
+                Access::Local {
+                    read,
+                    at: BODY_STATE_OUTPUTS.len() + i,
+                },
             )
         });
     let derivatives =

@@ -24,69 +24,55 @@ pub(crate) struct Request<'a> {
     pub logging_on: bool,
 }
 
-/// The new instance, or `None` after logging the reason.
+/// The new instance, or `None` after logging why not.
 pub(crate) fn create_instance(request: &Request<'_>) -> Option<*mut Instance> {
-    let fail = |message: &str| {
-        let shown = request.name.map(CStr::to_owned).unwrap_or_default();
-        // SAFETY: the sink's callback and environment come together from the importer.
-        unsafe {
-            request.sink.send(
-                &shown,
-                fmi2Status::fmi2Error,
-                Category::Error,
-                &format!("{}: {message}", request.function),
-            );
+    match new_instance(request) {
+        Ok(instance) => Some(Box::into_raw(Box::new(instance))),
+        Err(message) => {
+            let shown = request.name.map(CStr::to_owned).unwrap_or_default();
+            let message = format!("{}: {message}", request.function);
+            // SAFETY: the sink's callback and environment come together from the importer.
+            unsafe {
+                (request.sink).send(&shown, fmi2Status::fmi2Error, Category::Error, &message)
+            };
+            None
         }
-        None
-    };
-    let Some(name) = request.name.filter(|n| !n.is_empty()) else {
-        return fail("instanceName is NULL or empty");
-    };
-    let interface = match &request.interface {
-        Ok(interface) => *interface,
-        Err(why) => return fail(why),
-    };
+    }
+}
+
+/// The instance `request` asks for, or why there is none.
+fn new_instance(request: &Request<'_>) -> Result<Instance, String> {
+    let name = (request.name.filter(|n| !n.is_empty())).ok_or("instanceName is NULL or empty")?;
+    let interface = request.interface.clone()?;
     let token_name = request.api.token_name();
-    let Some(token) = request.token else {
-        return fail(&format!("{token_name} is NULL"));
-    };
+    let token = request.token.ok_or(format!("{token_name} is NULL"))?;
     let token = token.to_string_lossy();
     let Some(sim) = models::simulation_for(request.api, &token) else {
         let known: Vec<String> = models::tables()
             .iter()
             .map(|t| format!("{} {}", t.info.identifier, t.token(request.api)))
             .collect();
-        return fail(&format!(
+        return Err(format!(
             "{token_name} {token} is not one of this library's models ({}); the \
              modelDescription.xml and the binary do not belong together",
             known.join(", ")
         ));
     };
-    let sim = match sim {
-        Ok(sim) => sim,
-        Err(e) => return fail(&format!("the model does not start: {e}")),
-    };
+    let sim = sim.map_err(|e| format!("the model does not start: {e}"))?;
+    let identifier = sim.table().info.identifier;
     if interface == Interface::ModelExchange && sim.table().model_exchange.is_none() {
-        return fail(&format!(
-            "{} is Co-Simulation only (its physics engine steps internally); \
-             instantiate it for Co-Simulation",
-            sim.table().info.identifier
+        return Err(format!(
+            "{identifier} is Co-Simulation only (its physics engine steps internally); \
+             instantiate it for Co-Simulation"
         ));
     }
-    let instance = Instance::new(
-        request.api,
-        interface,
-        Logger::new(request.sink, name.to_owned()),
-        request.logging_on,
-        sim,
-    );
+    let logger = Logger::new(request.sink, name.to_owned());
+    let instance = Instance::new(request.api, interface, logger, request.logging_on, sim);
+    let function = request.function;
     instance.event(&format!(
-        "{}: {} {:?} instance ({token}) created",
-        request.function,
-        instance.sim.table().info.identifier,
-        instance.interface
+        "{function}: {identifier} {interface:?} instance ({token}) created"
     ));
-    Some(Box::into_raw(Box::new(instance)))
+    Ok(instance)
 }
 
 /// The instance `build` asks for, or NULL (`build` gives `None` when there is no logger to
