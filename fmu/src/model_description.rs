@@ -5,7 +5,7 @@
 //! date), so the checked-in copies under modelDescription/ can be compared byte for byte.
 
 use crate::log::CATEGORIES;
-use crate::table::{Api, ModelInfo, ModelTable};
+use crate::table::{Api, Causality3, ModelInfo, ModelTable};
 use crate::units::{self, BASE_UNITS};
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::{Causality, Variability, Variable};
@@ -53,15 +53,6 @@ pub(crate) fn value_text(kind: ValueKind, value: f64) -> String {
         ValueKind::Real => real(value),
         ValueKind::Integer => format!("{}", value as i64),
         ValueKind::Boolean => (value != 0.0).to_string(),
-    }
-}
-
-fn causality(c: Causality) -> &'static str {
-    match c {
-        Causality::Parameter => "parameter",
-        Causality::Input => "input",
-        Causality::Output => "output",
-        Causality::Local => "local",
     }
 }
 
@@ -180,7 +171,7 @@ fn scalar_variable(out: &mut String, v: &Variable, derivative: Option<usize>) {
         escape(v.name),
         v.value_reference,
         escape(v.description),
-        causality(v.causality),
+        Causality3::Model(v.causality).name(),
         variability(v.variability)
     );
     let _ = write!(out, "      <{}", Api::Fmi2.type_name(v.kind));
@@ -194,11 +185,7 @@ fn scalar_variable(out: &mut String, v: &Variable, derivative: Option<usize>) {
 
 /// 1-based position (ModelVariables order) of value reference `vr`.
 fn index_of(table: &ModelTable, vr: u32) -> Option<usize> {
-    table
-        .variables
-        .iter()
-        .position(|v| v.value_reference == vr)
-        .map(|i| i + 1)
+    table.index(vr).map(|i| i + 1)
 }
 
 /// The value references `output` depends on: its direct-feedthrough inputs and, under Model

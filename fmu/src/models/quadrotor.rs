@@ -137,30 +137,19 @@ fn local(name: &'static str, vr: u32, unit: &'static str, description: &'static 
 
 /// The core's variables, then the bristle states and the derivatives.
 fn table() -> Table<Quadrotor> {
-    let bristles = BRISTLES
-        .iter()
-        .zip(BRISTLE_VR..)
-        .enumerate()
-        .map(|(i, (&(name, text), vr))| {
-            let read: fn(&Quadrotor, usize) -> f64 = |q, at| q.continuous_state()[at];
-            (
-                local(name, vr, "m", text),
-                Access::Local {
-                    read,
-                    at: BODY_STATE_OUTPUTS.len() + i,
-                },
-            )
-        });
-    let derivatives =
-        DERIVATIVES
-            .iter()
-            .zip(DERIVATIVE_VR..)
-            .enumerate()
-            .map(|(i, (&(name, unit), vr))| {
-                let read: fn(&Quadrotor, usize) -> f64 = |q, at| q.state_derivative()[at];
-                let text = "Time derivative of the state";
-                (local(name, vr, unit, text), Access::Local { read, at: i })
-            });
+    let bristle = |at| Access::Local {
+        read: |q: &Quadrotor, at| q.continuous_state()[at],
+        at: BODY_STATE_OUTPUTS.len() + at,
+    };
+    let derivative = |at| Access::Local {
+        read: |q: &Quadrotor, at| q.state_derivative()[at],
+        at,
+    };
+    let text = "Time derivative of the state";
+    let bristles = (BRISTLES.iter().zip(BRISTLE_VR..).enumerate())
+        .map(|(i, (&(name, text), vr))| (local(name, vr, "m", text), bristle(i)));
+    let derivatives = (DERIVATIVES.iter().zip(DERIVATIVE_VR..).enumerate())
+        .map(|(i, (&(name, unit), vr))| (local(name, vr, unit, text), derivative(i)));
     let locals: Vec<_> = bristles.chain(derivatives).collect();
     let core = variables::variables::<Quadrotor>();
     let vr_of = |name: &str| {
