@@ -9,17 +9,18 @@ use std::any::Any;
 use std::ffi::{CStr, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-/// Runs `body` for the instance behind `c` if `mask` allows its stage.
+/// Runs `body` for the instance behind `c` if `mask` allows its stage, and answers its status
+/// (`()` is OK) in the caller's FMI version (`S`: fmi2Status or fmi3Status).
 ///
 /// A NULL `c` gives fmi2Error (there is no logger to tell). An `Err` from the body is logged
 /// as "`function`: reason" and gives its status. A panic puts the instance in the Fatal
 /// stage and gives fmi2Fatal.
-pub(crate) fn with_instance(
+pub(crate) fn with_instance<R: Into<fmi2Status>, S: From<fmi2Status>>(
     c: fmi2Component,
     function: &'static str,
     mask: Mask,
-    body: impl FnOnce(&mut Instance) -> Result<fmi2Status, FmuError>,
-) -> fmi2Status {
+    body: impl FnOnce(&mut Instance) -> Result<R, FmuError>,
+) -> S {
     let outcome = catch_unwind(AssertUnwindSafe(|| {
         // SAFETY: a non-NULL fmi2Component is a pointer fmi2Instantiate returned and
         // fmi2FreeInstance has not freed (the importer's side of the contract).
@@ -28,11 +29,11 @@ pub(crate) fn with_instance(
         };
         let result = instance.check_stage(mask).and_then(|()| body(instance));
         match result {
-            Ok(status) => status,
+            Ok(status) => status.into(),
             Err(error) => instance.report(function, &error),
         }
     }));
-    outcome.unwrap_or_else(|payload| {
+    S::from(outcome.unwrap_or_else(|payload| {
         let message = panic_message(payload);
         // SAFETY: as above; the borrow inside the closure ended with the unwind.
         if let Some(instance) = unsafe { c.cast::<Instance>().as_mut() } {
@@ -48,7 +49,14 @@ pub(crate) fn with_instance(
             }));
         }
         fmi2Status::fmi2Fatal
-    })
+    }))
+}
+
+/// A body without a status of its own answers OK.
+impl From<()> for fmi2Status {
+    fn from((): ()) -> Self {
+        fmi2Status::fmi2OK
+    }
 }
 
 /// Runs `body` (an export without an instance) and returns `fallback` if it panics.
@@ -169,9 +177,14 @@ mod tests {
             )
         };
         assert!(!c.is_null());
-        let status = with_instance(c, "fmi2Probe", masks::SET_REAL, |_| {
-            panic!("100% broken");
-        });
+        let status: fmi2Status = with_instance(
+            c,
+            "fmi2Probe",
+            masks::SET_REAL,
+            |_| -> Result<(), FmuError> {
+                panic!("100% broken");
+            },
+        );
         assert_eq!(status, fmi2Status::fmi2Fatal);
         let last = recorder.last().unwrap();
         assert_eq!(

@@ -32,7 +32,9 @@ fn status_kind(
 /// The body of a function this FMU does not offer: refuses with `why` (after the NULL and
 /// stage checks).
 fn refuse(c: fmi2Component, function: &'static str, mask: Mask, why: &'static str) -> fmi2Status {
-    with_instance(c, function, mask, |_| Err(FmuError::NotSupported(why)))
+    with_instance(c, function, mask, |_| {
+        Err::<(), _>(FmuError::NotSupported(why))
+    })
 }
 
 exports! {

@@ -2,9 +2,8 @@
 //! (so both give the same outputs bit for bit), and the step-mode functions this FMU does not
 //! need.
 
-use super::with_instance3;
 use crate::error::FmuError;
-use crate::exports::guard::write_out;
+use crate::exports::guard::{with_instance, write_out};
 use crate::fmi3_types::*;
 use crate::instance::{masks, masks3};
 
@@ -14,7 +13,7 @@ exports! {
     /// never terminates, never returns early; `*lastSuccessfulTime` is the time after the
     /// step. The four output pointers must not be NULL.
     fn fmi3DoStep(instance: fmi3Instance, currentCommunicationPoint: fmi3Float64, communicationStepSize: fmi3Float64, _noSetFMUStatePriorToCurrentPoint: fmi3Boolean, eventHandlingNeeded: *mut fmi3Boolean, terminateSimulation: *mut fmi3Boolean, earlyReturn: *mut fmi3Boolean, lastSuccessfulTime: *mut fmi3Float64) -> fmi3Status {
-        with_instance3(instance, "fmi3DoStep", masks::DO_STEP, |instance| {
+        with_instance(instance, "fmi3DoStep", masks::DO_STEP, |instance| {
             instance.check_co_simulation()?;
             let flags = [
                 (eventHandlingNeeded, "eventHandlingNeeded"),
@@ -39,16 +38,16 @@ exports! {
     /// Not needed: without event mode (hasEventMode="false") fmi3ExitInitializationMode
     /// already enters step mode.
     fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status {
-        with_instance3(instance, "fmi3EnterStepMode", masks3::ENTER_STEP_MODE, |instance| {
+        with_instance(instance, "fmi3EnterStepMode", masks3::ENTER_STEP_MODE, |instance| {
             instance.check_co_simulation()?;
-            Err(FmuError::NotSupported("event mode is not used (hasEventMode=\"false\"): fmi3ExitInitializationMode enters step mode"))
+            Err::<(), _>(FmuError::NotSupported("event mode is not used (hasEventMode=\"false\"): fmi3ExitInitializationMode enters step mode"))
         })
     }
 
     /// maxOutputDerivativeOrder="0".
     fn fmi3GetOutputDerivatives(instance: fmi3Instance, _valueReferences: *const fmi3ValueReference, _nValueReferences: usize, _orders: *const fmi3Int32, _values: *mut fmi3Float64, _nValues: usize) -> fmi3Status {
-        with_instance3(instance, "fmi3GetOutputDerivatives", masks3::GET_OUTPUT_DERIVATIVES, |_| {
-            Err(FmuError::NotSupported("output derivatives (maxOutputDerivativeOrder=\"0\")"))
+        with_instance(instance, "fmi3GetOutputDerivatives", masks3::GET_OUTPUT_DERIVATIVES, |_| {
+            Err::<(), _>(FmuError::NotSupported("output derivatives (maxOutputDerivativeOrder=\"0\")"))
         })
     }
 }

@@ -1,8 +1,7 @@
 //! Creating, initialising, terminating, resetting and freeing an FMI 3.0 instance, and its
 //! FMU states (the same states as FMI 2.0's, under FMI 3.0's names).
 
-use super::with_instance3;
-use crate::exports::guard::{c_str, guarded};
+use crate::exports::guard::{c_str, guarded, with_instance};
 use crate::exports::shared::fmu_state::*;
 use crate::exports::shared::instantiate::{Request, instantiate};
 use crate::exports::shared::lifecycle::*;
@@ -90,7 +89,7 @@ exports! {
     /// initialization mode.
     fn fmi3EnterInitializationMode(instance: fmi3Instance, _toleranceDefined: fmi3Boolean, _tolerance: fmi3Float64, startTime: fmi3Float64, stopTimeDefined: fmi3Boolean, stopTime: fmi3Float64) -> fmi3Status {
         let function = "fmi3EnterInitializationMode";
-        with_instance3(instance, function, masks3::ENTER_INITIALIZATION_MODE, |instance| {
+        with_instance(instance, function, masks3::ENTER_INITIALIZATION_MODE, |instance| {
             let stop = (stopTimeDefined != fmi3False).then_some(stopTime);
             setup_experiment(instance, function, startTime, stop)?;
             instance.stage = Stage::InitializationMode;

@@ -14,22 +14,3 @@ pub use lifecycle::*;
 pub use model_exchange::*;
 pub use unsupported::*;
 pub use values::*;
-
-use crate::error::FmuError;
-use crate::fmi3_types::{fmi3Instance, fmi3Status};
-use crate::instance::{Instance, Mask};
-
-/// [`super::guard::with_instance`] for a body without a status of its own: OK, or the
-/// error's status, as an FMI 3.0 status.
-pub(crate) fn with_instance3(
-    instance: fmi3Instance,
-    function: &'static str,
-    mask: Mask,
-    body: impl FnOnce(&mut Instance) -> Result<(), FmuError>,
-) -> fmi3Status {
-    super::guard::with_instance(instance, function, mask, |instance| {
-        body(instance)?;
-        Ok(crate::fmi2_types::fmi2Status::fmi2OK)
-    })
-    .into()
-}

@@ -1,7 +1,6 @@
 //! Model Exchange through FMI 3.0, for an instance from fmi3InstantiateModelExchange: the
 //! same states, derivatives, event indicators and events as FMI 2.0's Model Exchange.
 
-use super::with_instance3;
 use crate::error::FmuError;
 use crate::exports::guard::{c_slice, c_slice_mut, with_instance, write_out};
 use crate::exports::shared::model_exchange::*;
@@ -20,7 +19,7 @@ unsafe fn count(
     out: *mut usize,
     of: fn(&ModelExchangeTable) -> usize,
 ) -> fmi3Status {
-    with_instance3(instance, function, masks3::ANY, |instance| {
+    with_instance(instance, function, masks3::ANY, |instance| {
         let n = instance.sim.table().model_exchange.as_ref().map_or(0, of);
         // SAFETY: per the function's contract.
         unsafe { write_out(out, n, "the count") }
@@ -42,7 +41,7 @@ exports! {
     /// bristles) and the next time event. Every output pointer must be writable.
     fn fmi3UpdateDiscreteStates(instance: fmi3Instance, discreteStatesNeedUpdate: *mut fmi3Boolean, terminateSimulation: *mut fmi3Boolean, nominalsOfContinuousStatesChanged: *mut fmi3Boolean, valuesOfContinuousStatesChanged: *mut fmi3Boolean, nextEventTimeDefined: *mut fmi3Boolean, nextEventTime: *mut fmi3Float64) -> fmi3Status {
         let function = "fmi3UpdateDiscreteStates";
-        with_instance3(instance, function, masks3::UPDATE_DISCRETE_STATES, |instance| {
+        with_instance(instance, function, masks3::UPDATE_DISCRETE_STATES, |instance| {
             let flags = [
                 (discreteStatesNeedUpdate, "discreteStatesNeedUpdate"),
                 (terminateSimulation, "terminateSimulation"),
@@ -73,32 +72,32 @@ exports! {
 
     /// A finite time not before the last event.
     fn fmi3SetTime(instance: fmi3Instance, time: fmi3Float64) -> fmi3Status {
-        with_instance3(instance, "fmi3SetTime", masks::SET_TIME, |instance| instance.sim.set_time(time))
+        with_instance(instance, "fmi3SetTime", masks::SET_TIME, |instance| instance.sim.set_time(time))
     }
 
     /// Sets the states; nothing changes when a value is not finite.
     fn fmi3SetContinuousStates(instance: fmi3Instance, continuousStates: *const fmi3Float64, nContinuousStates: usize) -> fmi3Status {
-        with_instance3(instance, "fmi3SetContinuousStates", masks::SET_CONTINUOUS_STATES, |instance| {
+        with_instance(instance, "fmi3SetContinuousStates", masks::SET_CONTINUOUS_STATES, |instance| {
             instance.sim.set_continuous_states(c_slice(continuousStates, nContinuousStates, "continuous states")?)
         })
     }
 
     /// The derivatives of the continuous states: the core's right-hand side, bit for bit.
     fn fmi3GetContinuousStateDerivatives(instance: fmi3Instance, derivatives: *mut fmi3Float64, nContinuousStates: usize) -> fmi3Status {
-        with_instance3(instance, "fmi3GetContinuousStateDerivatives", masks3::GET_DERIVATIVES, |instance| {
+        with_instance(instance, "fmi3GetContinuousStateDerivatives", masks3::GET_DERIVATIVES, |instance| {
             instance.sim.derivatives(c_slice_mut(derivatives, nContinuousStates, "derivatives")?)
         })
     }
 
     /// The foot heights (m): a sign change is a touch-down or a lift-off.
     fn fmi3GetEventIndicators(instance: fmi3Instance, eventIndicators: *mut fmi3Float64, nEventIndicators: usize) -> fmi3Status {
-        with_instance3(instance, "fmi3GetEventIndicators", masks::GET_EVENT_INDICATORS, |instance| {
+        with_instance(instance, "fmi3GetEventIndicators", masks::GET_EVENT_INDICATORS, |instance| {
             instance.sim.event_indicators(c_slice_mut(eventIndicators, nEventIndicators, "eventIndicators")?)
         })
     }
 
     fn fmi3GetContinuousStates(instance: fmi3Instance, continuousStates: *mut fmi3Float64, nContinuousStates: usize) -> fmi3Status {
-        with_instance3(instance, "fmi3GetContinuousStates", masks::GET_CONTINUOUS_STATES, |instance| {
+        with_instance(instance, "fmi3GetContinuousStates", masks::GET_CONTINUOUS_STATES, |instance| {
             instance.sim.continuous_states(c_slice_mut(continuousStates, nContinuousStates, "continuousStates")?)
         })
     }
@@ -108,7 +107,7 @@ exports! {
         with_instance(instance, "fmi3GetNominalsOfContinuousStates", masks::GET_NOMINALS, |instance| {
             instance.sim.nominals(c_slice_mut(nominals, nContinuousStates, "nominals")?)?;
             Ok(crate::fmi2_types::fmi2Status::fmi2OK)
-        }).into()
+        })
     }
 
     /// The number of event indicators (0 for a Co-Simulation-only model).

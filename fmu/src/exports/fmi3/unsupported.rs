@@ -4,7 +4,6 @@
 //! (importers bind every function) and answers fmi3Error with the reason in the log.
 
 use super::values::{accessors, resolve};
-use super::with_instance3;
 use crate::error::FmuError;
 use crate::exports::guard::{c_slice, with_instance};
 use crate::fmi2_types::fmi2Status;
@@ -61,7 +60,6 @@ unsafe fn no_binary(
         }
         Ok(worst)
     })
-    .into()
 }
 
 /// No Binary variables: every value reference is refused.
@@ -125,8 +123,8 @@ fn refuse(
     mask: Mask,
     why: &'static str,
 ) -> fmi3Status {
-    with_instance3(instance, function, mask, |_| {
-        Err(FmuError::NotSupported(why))
+    with_instance(instance, function, mask, |_| {
+        Err::<(), _>(FmuError::NotSupported(why))
     })
 }
 

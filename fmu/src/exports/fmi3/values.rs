@@ -113,7 +113,6 @@ macro_rules! accessors {
                 }
                 Ok(worst)
             })
-            .into()
         }
 
         /// Writes `values` to the variables (arrays element by element).
@@ -167,7 +166,6 @@ macro_rules! accessors {
                 }
                 Ok(worst)
             })
-            .into()
         }
     };
 }

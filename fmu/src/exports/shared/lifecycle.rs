@@ -11,7 +11,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// Frees the instance behind `c` (the body of fmi2FreeInstance and fmi3FreeInstance).
 pub(crate) fn free_instance(c: fmi2Component, function: &'static str) {
-    let status = with_instance(c, function, masks::FREE_INSTANCE, |instance| {
+    let status: fmi2Status = with_instance(c, function, masks::FREE_INSTANCE, |instance| {
         instance.event(&format!("{function}: freeing the instance"));
         Ok(fmi2Status::fmi2OK)
     });
