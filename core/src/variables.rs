@@ -173,15 +173,25 @@ pub trait VariableTable: Sized + 'static {
     fn set_parameter(&mut self, name: &'static str, value: f64) -> Result<(), ParamError>;
 }
 
-/// Which row a value reference points at.
-enum Row<'a, M: VariableTable> {
-    Input(&'a InputRow<M>),
-    Output(&'a OutputRow<M>),
+/// The row a value reference points at: what reads and writes the variable in the model.
+#[derive(Debug)]
+pub enum Row<M: VariableTable> {
+    Input(&'static InputRow<M>),
+    Output(&'static OutputRow<M>),
     Parameter(&'static ParamSpec<M::Params>),
     Initial(&'static ParamSpec<M::Initial>),
 }
 
-fn row<M: VariableTable>(vr: u32) -> Result<Row<'static, M>, ParamError> {
+impl<M: VariableTable> Clone for Row<M> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<M: VariableTable> Copy for Row<M> {}
+
+/// The row of value reference `vr` of `M`.
+pub fn row<M: VariableTable>(vr: u32) -> Result<Row<M>, ParamError> {
     let unknown = ParamError::UnknownValueReference(vr);
     let index = |first: u32| (vr - first) as usize;
     Ok(if vr >= vr_block::INITIAL {
@@ -193,6 +203,47 @@ fn row<M: VariableTable>(vr: u32) -> Result<Row<'static, M>, ParamError> {
     } else {
         Row::Input(M::INPUTS.get(index(vr_block::INPUT)).ok_or(unknown)?)
     })
+}
+
+impl<M: VariableTable> Row<M> {
+    /// The variable's value in `model` (start values from `initial`).
+    pub fn get(self, model: &M, initial: &M::Initial) -> f64 {
+        match self {
+            Row::Input(r) => (r.get)(model),
+            Row::Output(r) => (r.get)(model),
+            Row::Parameter(spec) => (spec.get)(model.params()),
+            Row::Initial(spec) => (spec.get)(initial),
+        }
+    }
+
+    /// Writes the variable; the value is checked against its range and nothing changes when
+    /// it is refused. Outputs cannot be set.
+    pub fn set(
+        self,
+        model: &mut M,
+        initial: &mut M::Initial,
+        value: f64,
+    ) -> Result<(), ParamError> {
+        match self {
+            Row::Input(r) => {
+                let out_of_range = ParamError::OutOfRange {
+                    role: Role::Input,
+                    name: r.name,
+                    value,
+                    min: r.min,
+                    max: r.max,
+                    unit: r.unit,
+                };
+                if !(value >= r.min && value <= r.max) {
+                    return Err(out_of_range);
+                }
+                (r.set)(model, value).map_err(|_| out_of_range)
+            }
+            Row::Output(r) => Err(ParamError::NotSettable(r.name)),
+            Row::Parameter(spec) => model.set_parameter(spec.name, value),
+            Row::Initial(spec) => initial.set(spec.name, value),
+        }
+    }
 }
 
 /// Every variable of `M`, in value-reference order.
@@ -246,41 +297,17 @@ pub fn variables<M: VariableTable>() -> Vec<Variable> {
 
 /// Reads variable `vr` of `model` (start values from `initial`).
 pub fn get<M: VariableTable>(model: &M, initial: &M::Initial, vr: u32) -> Result<f64, ParamError> {
-    Ok(match row::<M>(vr)? {
-        Row::Input(r) => (r.get)(model),
-        Row::Output(r) => (r.get)(model),
-        Row::Parameter(spec) => (spec.get)(model.params()),
-        Row::Initial(spec) => (spec.get)(initial),
-    })
+    Ok(row::<M>(vr)?.get(model, initial))
 }
 
-/// Writes variable `vr`; the value is checked against the variable's range and nothing
-/// changes when it is refused. Outputs cannot be set.
+/// Writes variable `vr` (see [`Row::set`]).
 pub fn set<M: VariableTable>(
     model: &mut M,
     initial: &mut M::Initial,
     vr: u32,
     value: f64,
 ) -> Result<(), ParamError> {
-    match row::<M>(vr)? {
-        Row::Input(r) => {
-            let out_of_range = ParamError::OutOfRange {
-                role: Role::Input,
-                name: r.name,
-                value,
-                min: r.min,
-                max: r.max,
-                unit: r.unit,
-            };
-            if !(value >= r.min && value <= r.max) {
-                return Err(out_of_range);
-            }
-            (r.set)(model, value).map_err(|_| out_of_range)
-        }
-        Row::Output(r) => Err(ParamError::NotSettable(r.name)),
-        Row::Parameter(spec) => model.set_parameter(spec.name, value),
-        Row::Initial(spec) => initial.set(spec.name, value),
-    }
+    row::<M>(vr)?.set(model, initial, value)
 }
 
 /// Looks up the parameter row behind `vr` in a block that starts at `first_vr`.

@@ -12,9 +12,12 @@ use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial, QuadrotorParams};
 use flyloop_fmu::exports::*;
 use flyloop_fmu::fmi2_types::*;
 use flyloop_fmu::fmi3_types::{fmi3Instance, fmi3Status};
-use flyloop_fmu::importer_logger;
 use flyloop_fmu::models::tables;
 use std::hint::black_box;
+
+#[allow(dead_code)]
+#[path = "../tests/support/importer_logger.rs"]
+mod importer_logger;
 
 fn instance(hover: f64) -> fmi2Component {
     let callbacks = Box::leak(Box::new(importer_logger::callbacks(

@@ -2,10 +2,11 @@
 //! Co-Simulation and Model Exchange: the stage it is in and, per function, the stages it may
 //! be called in (the masks of modelica/Reference-FMUs' fmi2Functions.c).
 
+use crate::engine::Simulation;
 use crate::error::FmuError;
 use crate::fmi2_types::fmi2Status;
 use crate::log::{Category, LogFilter, Logger, category_of};
-use crate::simulation::Simulation;
+use crate::table::Api;
 use std::collections::HashMap;
 
 /// The stages of an instance: EventMode and ContinuousTimeMode for Model Exchange, the Step*
@@ -65,31 +66,6 @@ impl Stage {
     }
 }
 
-/// The FMI version an instance was created through.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Api {
-    Fmi2,
-    Fmi3,
-}
-
-impl Api {
-    /// Stage names as this version's standard calls them (FMI 3.0: Step Mode).
-    pub fn stage_name(self, names: &str) -> String {
-        match self {
-            Api::Fmi2 => names.to_string(),
-            Api::Fmi3 => names.replace("StepComplete", "StepMode"),
-        }
-    }
-
-    /// What the modelDescription calls the string that ties it to the binary.
-    pub fn token_name(self) -> &'static str {
-        match self {
-            Api::Fmi2 => "fmuGUID",
-            Api::Fmi3 => "instantiationToken",
-        }
-    }
-}
-
 /// The interface an instance was created for (fmi2Instantiate's fmuType).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Interface {
@@ -97,17 +73,27 @@ pub enum Interface {
     ModelExchange,
 }
 
-/// The stages a function may be called in.
+/// The stages a function may be called in, and whether it is a Model Exchange function.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Mask {
     bits: u16,
     /// For the "Illegal call sequence" message.
     pub names: &'static str,
+    /// Refused on a Co-Simulation instance (Model Exchange shares InitializationMode and
+    /// Terminated with Co-Simulation, so the stage alone does not tell).
+    model_exchange: bool,
 }
 
 impl Mask {
     pub fn allows(self, stage: Stage) -> bool {
         self.bits & stage as u16 != 0
+    }
+
+    const fn model_exchange(self) -> Mask {
+        Mask {
+            model_exchange: true,
+            ..self
+        }
     }
 }
 
@@ -116,88 +102,62 @@ macro_rules! mask {
         Mask {
             bits: Stage::$first as u16 $(| Stage::$rest as u16)*,
             names: concat!(stringify!($first) $(, ", ", stringify!($rest))*),
+            model_exchange: false,
         }
     };
+}
+
+/// A table of masks, one a line (rustfmt leaves it as a table).
+macro_rules! masks {
+    ($($(#[doc = $doc:literal])* $name:ident = $mask:expr;)*) => {$(
+        $(#[doc = $doc])*
+        pub const $name: Mask = $mask;
+    )*};
 }
 
 /// Per-function masks, as in Reference-FMUs' fmi2Functions.c.
 pub mod masks {
     use super::{Mask, Stage};
 
-    pub const SET_DEBUG_LOGGING: Mask = mask!(
-        Instantiated
-            | InitializationMode
-            | EventMode
-            | ContinuousTimeMode
-            | StepComplete
-            | StepInProgress
-            | StepFailed
-            | StepCanceled
-            | Terminated
-            | Error
-    );
-    pub const FREE_INSTANCE: Mask = mask!(
-        Instantiated
-            | InitializationMode
-            | EventMode
-            | ContinuousTimeMode
-            | StepComplete
-            | StepFailed
-            | StepCanceled
-            | Terminated
-            | Error
-            | Fatal
-    );
-    pub const SETUP_EXPERIMENT: Mask = mask!(Instantiated);
-    pub const ENTER_INITIALIZATION_MODE: Mask = mask!(Instantiated);
-    pub const EXIT_INITIALIZATION_MODE: Mask = mask!(InitializationMode);
-    pub const TERMINATE: Mask = mask!(EventMode | ContinuousTimeMode | StepComplete | StepFailed);
-    pub const RESET: Mask = mask!(
-        Instantiated
-            | InitializationMode
-            | EventMode
-            | ContinuousTimeMode
-            | StepComplete
-            | StepFailed
-            | StepCanceled
-            | Terminated
-            | Error
-    );
-    pub const GET_VALUE: Mask = mask!(
-        InitializationMode
-            | EventMode
-            | ContinuousTimeMode
-            | StepComplete
-            | StepFailed
-            | StepCanceled
-            | Terminated
-            | Error
-    );
-    pub const SET_REAL: Mask =
-        mask!(Instantiated | InitializationMode | EventMode | ContinuousTimeMode | StepComplete);
-    pub const SET_OTHER: Mask = mask!(Instantiated | InitializationMode | EventMode | StepComplete);
-    pub const FMU_STATE: Mask = RESET;
-    pub const DIRECTIONAL_DERIVATIVE: Mask = GET_VALUE;
-    pub const SET_REAL_INPUT_DERIVATIVES: Mask =
-        mask!(Instantiated | InitializationMode | StepComplete);
-    pub const GET_REAL_OUTPUT_DERIVATIVES: Mask =
-        mask!(StepComplete | StepFailed | StepCanceled | Terminated | Error);
-    pub const DO_STEP: Mask = mask!(StepComplete);
-    pub const CANCEL_STEP: Mask = mask!(StepInProgress);
-    pub const GET_STATUS: Mask = mask!(StepComplete | StepInProgress | StepFailed | Terminated);
-    // Model Exchange.
-    pub const ENTER_EVENT_MODE: Mask = mask!(EventMode | ContinuousTimeMode);
-    pub const NEW_DISCRETE_STATES: Mask = mask!(EventMode);
-    pub const ENTER_CONTINUOUS_TIME_MODE: Mask = mask!(EventMode);
-    pub const COMPLETED_INTEGRATOR_STEP: Mask = mask!(ContinuousTimeMode);
-    pub const SET_TIME: Mask = mask!(EventMode | ContinuousTimeMode);
-    pub const SET_CONTINUOUS_STATES: Mask = mask!(ContinuousTimeMode);
-    pub const GET_EVENT_INDICATORS: Mask =
-        mask!(InitializationMode | EventMode | ContinuousTimeMode | Terminated | Error);
-    pub const GET_CONTINUOUS_STATES: Mask = GET_EVENT_INDICATORS;
-    pub const GET_DERIVATIVES: Mask = mask!(EventMode | ContinuousTimeMode | Terminated | Error);
-    pub const GET_NOMINALS: Mask =
-        mask!(Instantiated | EventMode | ContinuousTimeMode | Terminated | Error);
+    masks! {
+        SET_DEBUG_LOGGING = mask!(Instantiated | InitializationMode | EventMode | ContinuousTimeMode
+            | StepComplete | StepInProgress | StepFailed | StepCanceled | Terminated | Error);
+        FREE_INSTANCE = mask!(Instantiated | InitializationMode | EventMode | ContinuousTimeMode
+            | StepComplete | StepFailed | StepCanceled | Terminated | Error | Fatal);
+        SETUP_EXPERIMENT = mask!(Instantiated);
+        ENTER_INITIALIZATION_MODE = mask!(Instantiated);
+        EXIT_INITIALIZATION_MODE = mask!(InitializationMode);
+        TERMINATE = mask!(EventMode | ContinuousTimeMode | StepComplete | StepFailed);
+        RESET = mask!(Instantiated | InitializationMode | EventMode | ContinuousTimeMode
+            | StepComplete | StepFailed | StepCanceled | Terminated | Error);
+        GET_VALUE = mask!(InitializationMode | EventMode | ContinuousTimeMode | StepComplete
+            | StepFailed | StepCanceled | Terminated | Error);
+        SET_REAL = mask!(Instantiated | InitializationMode | EventMode | ContinuousTimeMode
+            | StepComplete);
+        SET_OTHER = mask!(Instantiated | InitializationMode | EventMode | StepComplete);
+        FMU_STATE = RESET;
+        DIRECTIONAL_DERIVATIVE = GET_VALUE;
+        SET_REAL_INPUT_DERIVATIVES = mask!(Instantiated | InitializationMode | StepComplete);
+        GET_REAL_OUTPUT_DERIVATIVES = mask!(StepComplete | StepFailed | StepCanceled | Terminated
+            | Error);
+        DO_STEP = mask!(StepComplete);
+        CANCEL_STEP = mask!(StepInProgress);
+        GET_STATUS = mask!(StepComplete | StepInProgress | StepFailed | Terminated);
+        // Model Exchange.
+        ENTER_EVENT_MODE = mask!(EventMode | ContinuousTimeMode).model_exchange();
+        NEW_DISCRETE_STATES = mask!(EventMode).model_exchange();
+        ENTER_CONTINUOUS_TIME_MODE = mask!(EventMode).model_exchange();
+        COMPLETED_INTEGRATOR_STEP = mask!(ContinuousTimeMode).model_exchange();
+        SET_TIME = mask!(EventMode | ContinuousTimeMode).model_exchange();
+        SET_CONTINUOUS_STATES = mask!(ContinuousTimeMode).model_exchange();
+        GET_EVENT_INDICATORS = mask!(InitializationMode | EventMode | ContinuousTimeMode
+            | Terminated | Error).model_exchange();
+        GET_CONTINUOUS_STATES = GET_EVENT_INDICATORS;
+        GET_DERIVATIVES = mask!(EventMode | ContinuousTimeMode | Terminated | Error)
+            .model_exchange();
+        GET_NOMINALS = mask!(Instantiated | EventMode | ContinuousTimeMode | Terminated | Error)
+            .model_exchange();
+    }
 }
 
 /// Per-function masks of FMI 3.0 (Reference-FMUs' fmi3Functions.c), in the stages of
@@ -206,30 +166,23 @@ pub mod masks {
 pub mod masks3 {
     use super::{Mask, Stage};
 
-    pub const ENTER_INITIALIZATION_MODE: Mask = mask!(Instantiated);
-    /// FMI 3.0 allows reading in every stage but the step in progress.
-    pub const GET_VALUE: Mask = mask!(
-        Instantiated
-            | InitializationMode
-            | EventMode
-            | ContinuousTimeMode
-            | StepComplete
-            | StepFailed
-            | StepCanceled
-            | Terminated
-            | Error
-    );
-    /// The same stages as FMI 2.0's fmi2SetReal and the other setters.
-    pub const SET_FLOAT64: Mask = super::masks::SET_REAL;
-    pub const SET_OTHER: Mask = super::masks::SET_OTHER;
-    pub const ENTER_STEP_MODE: Mask = mask!(InitializationMode | EventMode);
-    pub const GET_OUTPUT_DERIVATIVES: Mask = mask!(StepComplete | StepFailed | Terminated);
-    pub const UPDATE_DISCRETE_STATES: Mask = mask!(EventMode);
-    /// FMI 3.0 allows derivatives in initialization mode too: the event indicators' stages.
-    pub const GET_DERIVATIVES: Mask = super::masks::GET_EVENT_INDICATORS;
-    /// Functions that ask nothing of the stage (counts, unsupported capabilities): every
-    /// stage but Fatal, as for fmi2SetDebugLogging.
-    pub const ANY: Mask = super::masks::SET_DEBUG_LOGGING;
+    masks! {
+        ENTER_INITIALIZATION_MODE = mask!(Instantiated);
+        /// FMI 3.0 allows reading in every stage but the step in progress.
+        GET_VALUE = mask!(Instantiated | InitializationMode | EventMode | ContinuousTimeMode
+            | StepComplete | StepFailed | StepCanceled | Terminated | Error);
+        /// The same stages as FMI 2.0's fmi2SetReal and the other setters.
+        SET_FLOAT64 = super::masks::SET_REAL;
+        SET_OTHER = super::masks::SET_OTHER;
+        ENTER_STEP_MODE = mask!(InitializationMode | EventMode);
+        GET_OUTPUT_DERIVATIVES = mask!(StepComplete | StepFailed | Terminated);
+        UPDATE_DISCRETE_STATES = mask!(EventMode).model_exchange();
+        /// FMI 3.0 allows derivatives in initialization mode too: the event indicators' stages.
+        GET_DERIVATIVES = super::masks::GET_EVENT_INDICATORS;
+        /// Functions that ask nothing of the stage (counts, unsupported capabilities): every
+        /// stage but Fatal, as for fmi2SetDebugLogging.
+        ANY = super::masks::SET_DEBUG_LOGGING;
+    }
 }
 
 /// A saved FMU state: the bytes of [`Simulation::save`]. Boxed; the box's address is the
@@ -282,6 +235,11 @@ impl Instance {
         }
     }
 
+    /// Whether the instance is past initialization mode (fixed parameters are fixed now).
+    pub fn initialised(&self) -> bool {
+        !matches!(self.stage, Stage::Instantiated | Stage::InitializationMode)
+    }
+
     /// Logs `message` if its category is on.
     pub fn log(&self, status: fmi2Status, message: &str) {
         let category = category_of(status);
@@ -308,16 +266,28 @@ impl Instance {
         status
     }
 
-    /// Fails with "Illegal call sequence" unless `mask` allows the current stage.
+    /// Fails with "Illegal call sequence" unless `mask` allows the current stage, and for a
+    /// Model Exchange function on a Co-Simulation instance.
     pub fn check_stage(&self, mask: Mask) -> Result<(), FmuError> {
-        if mask.allows(self.stage) {
-            Ok(())
-        } else {
-            Err(FmuError::IllegalCall {
+        if !mask.allows(self.stage) {
+            return Err(FmuError::IllegalCall {
                 stage: self.api.stage_name(&format!("{:?}", self.stage)),
                 allowed: self.api.stage_name(mask.names),
-            })
+            });
         }
+        if mask.model_exchange && self.interface == Interface::CoSimulation {
+            return Err(FmuError::NotSupported(match self.api {
+                Api::Fmi2 => {
+                    "Model Exchange functions on a Co-Simulation instance (instantiate with \
+                     fmuType fmi2ModelExchange)"
+                }
+                Api::Fmi3 => {
+                    "Model Exchange functions on a Co-Simulation instance (instantiate with \
+                     fmi3InstantiateModelExchange)"
+                }
+            }));
+        }
+        Ok(())
     }
 
     /// Fails unless this is a Co-Simulation instance.
@@ -327,24 +297,6 @@ impl Instance {
             Interface::ModelExchange => Err(FmuError::NotSupported(
                 "Co-Simulation functions on a Model Exchange instance",
             )),
-        }
-    }
-
-    /// Fails unless this is a Model Exchange instance (the Model Exchange masks share
-    /// InitializationMode and Terminated with Co-Simulation).
-    pub fn check_model_exchange(&self) -> Result<(), FmuError> {
-        match self.interface {
-            Interface::ModelExchange => Ok(()),
-            Interface::CoSimulation => Err(FmuError::NotSupported(match self.api {
-                Api::Fmi2 => {
-                    "Model Exchange functions on a Co-Simulation instance (instantiate with \
-                     fmuType fmi2ModelExchange)"
-                }
-                Api::Fmi3 => {
-                    "Model Exchange functions on a Co-Simulation instance (instantiate with \
-                     fmi3InstantiateModelExchange)"
-                }
-            })),
         }
     }
 
@@ -363,12 +315,25 @@ impl Instance {
         Ok(stage)
     }
 
-    /// Keeps `state` and returns its address for the importer.
-    pub fn adopt_state(&mut self, state: SavedState) -> *mut SavedState {
-        let mut boxed = Box::new(state);
+    /// Keeps `bytes` as a new state (`existing` 0) or in the live state at `existing`;
+    /// returns the state's address for the importer.
+    pub fn keep_state(
+        &mut self,
+        existing: usize,
+        bytes: Vec<u8>,
+    ) -> Result<*mut SavedState, FmuError> {
+        if existing != 0 {
+            let state = self
+                .states
+                .get_mut(&existing)
+                .ok_or(FmuError::UnknownState)?;
+            state.bytes = bytes;
+            return Ok(&mut **state);
+        }
+        let mut boxed = Box::new(SavedState { bytes });
         let address: *mut SavedState = &mut *boxed;
         self.states.insert(address as usize, boxed);
-        address
+        Ok(address)
     }
 
     /// The live state at `address`.
@@ -379,25 +344,12 @@ impl Instance {
             .ok_or(FmuError::UnknownState)
     }
 
-    /// The live state at `address`, to overwrite.
-    pub fn state_mut(&mut self, address: usize) -> Result<&mut SavedState, FmuError> {
-        self.states
-            .get_mut(&address)
-            .map(|b| &mut **b)
-            .ok_or(FmuError::UnknownState)
-    }
-
     /// Frees the live state at `address`.
     pub fn release_state(&mut self, address: usize) -> Result<(), FmuError> {
         self.states
             .remove(&address)
             .map(drop)
             .ok_or(FmuError::UnknownState)
-    }
-
-    /// How many FMU states are live.
-    pub fn live_states(&self) -> usize {
-        self.states.len()
     }
 }
 

@@ -3,27 +3,26 @@
 //! `Lander2D-fmi3.fmu`, all from one cdylib that exports both APIs.
 //!
 //! Layers, from the C boundary down:
-//! - [`exports`]: every `fmi2*` function, each inside `catch_unwind` (a panic becomes
+//! - [`exports`]: every `fmi2*` and `fmi3*` function ([`exports::fmi2`], [`exports::fmi3`], the
+//!   bodies they share in `exports::shared`), each inside `catch_unwind` (a panic becomes
 //!   fmi2Fatal, never an abort of the importer), with NULL checks and the stage check.
 //! - [`instance`]: the state machine (stages and the allowed-stage mask of each function, as
 //!   in modelica/Reference-FMUs), logging by category, the FMU states handed out.
-//! - [`simulation`]: start values, experiment, the time grid t0 + n·h, typed variable access,
-//!   doStep checks, FMU state bytes — for any [`model::FmuModel`].
-//! - [`exchange`]: Model Exchange on top of the engine (time, states, events).
+//! - [`engine`]: start values, experiment, the time grid t0 + n·h, variable access, doStep
+//!   checks, FMU state bytes and Model Exchange — for any [`model::FmuModel`].
 //! - [`models`]: the quadrotor and the lander behind `FmuModel`; the GUID picks one.
 //!
-//! [`model_description`] and [`model_description3`] write each modelDescription.xml from the
-//! core's variable tables ([`fmi3_variables`]: the FMI 3.0 view, with arrays);
-//! [`pack`] zips the FMUs (binary `flyloop-fmu-pack`).
+//! [`table`] holds each model's variables as the FMI layer looks them up (with the FMI 3.0
+//! view: arrays, `time`, event indicators); [`model_description`] and [`model_description3`]
+//! write each modelDescription.xml from it; [`pack`] zips the FMUs (binary
+//! `flyloop-fmu-pack`).
 
+pub mod engine;
 pub mod error;
-pub mod exchange;
 pub mod exports;
 pub mod fmi2_types;
 pub mod fmi3_types;
-pub mod fmi3_variables;
 pub mod guid;
-pub mod importer_logger;
 pub mod instance;
 pub mod log;
 pub mod model;
@@ -31,8 +30,12 @@ pub mod model_description;
 pub mod model_description3;
 pub mod models;
 pub mod pack;
-pub mod simulation;
 pub mod state_record;
+pub mod table;
 pub mod units;
 
 pub use error::FmuError;
+
+// The importer's test logger (tests/support) names the crate by its name, also in unit tests.
+#[cfg(test)]
+extern crate self as flyloop_fmu;

@@ -8,7 +8,7 @@
 //! categories it names (all of them when it names none), errors included.
 
 use crate::fmi2_types::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status};
-use crate::fmi3_types::{fmi3InstanceEnvironment, fmi3LogMessageCallback, fmi3Status};
+use crate::fmi3_types::{fmi3InstanceEnvironment, fmi3LogMessageCallback};
 use std::ffi::{CStr, CString};
 
 /// A log category.
@@ -118,8 +118,7 @@ impl Logger {
         &self.instance_name
     }
 
-    /// Sends `message` (FMI 2.0: always through a "%s" format so that a '%' in it is
-    /// printed, never interpreted).
+    /// Sends `message` (see [`Sink::send`]).
     pub fn log(&self, status: fmi2Status, category: Category, message: &str) {
         // SAFETY: callback and environment came together from the importer, which keeps
         // them valid while the instance lives.
@@ -131,7 +130,8 @@ impl Logger {
 }
 
 impl Sink {
-    /// Calls the callback once with `message`.
+    /// Calls the callback once with `message` (NUL bytes in it become U+FFFD; FMI 2.0:
+    /// always through a "%s" format so that a '%' in it is printed, never interpreted).
     ///
     /// # Safety
     /// The callback and environment must be the importer's, valid for the call.
@@ -142,68 +142,33 @@ impl Sink {
         category: Category,
         message: &str,
     ) {
+        let text = CString::new(message.replace('\0', "\u{fffd}")).unwrap_or_default();
+        let category = category.c_name().as_ptr();
         match *self {
-            // SAFETY: the caller's contract.
+            // SAFETY: the caller's contract; every string is NUL-terminated and outlives the
+            // call; the format consumes exactly one string argument.
             Sink::Fmi2 {
                 callback,
                 environment,
             } => unsafe {
-                send(
-                    callback,
+                let name = instance_name.as_ptr();
+                callback(
                     environment,
-                    instance_name,
+                    name,
                     status,
                     category,
-                    message,
-                )
+                    c"%s".as_ptr(),
+                    text.as_ptr(),
+                );
             },
-            Sink::Fmi3 { callback: None, .. } => {}
+            // FMI 3.0's logger has no instance name: the environment tells instances apart.
+            // SAFETY: as above.
             Sink::Fmi3 {
                 callback: Some(callback),
                 environment,
-            } => {
-                // FMI 3.0's logger has no instance name: the environment tells instances
-                // apart.
-                let text = CString::new(message.replace('\0', "\u{fffd}")).unwrap_or_default();
-                // SAFETY: the caller's contract; both strings outlive the call.
-                unsafe {
-                    callback(
-                        environment,
-                        fmi3Status::from(status),
-                        category.c_name().as_ptr(),
-                        text.as_ptr(),
-                    );
-                }
-            }
+            } => unsafe { callback(environment, status.into(), category, text.as_ptr()) },
+            Sink::Fmi3 { callback: None, .. } => {}
         }
-    }
-}
-
-/// Calls `callback` once with `message` (NUL bytes in it become U+FFFD).
-///
-/// # Safety
-/// `callback` must be the importer's logger and `environment` the componentEnvironment it
-/// gave with it.
-pub unsafe fn send(
-    callback: fmi2CallbackLogger,
-    environment: fmi2ComponentEnvironment,
-    instance_name: &CStr,
-    status: fmi2Status,
-    category: Category,
-    message: &str,
-) {
-    let text = CString::new(message.replace('\0', "\u{fffd}")).unwrap_or_default();
-    // SAFETY: the caller's contract for callback and environment; every string is
-    // NUL-terminated and outlives the call; the format consumes exactly one string argument.
-    unsafe {
-        callback(
-            environment,
-            instance_name.as_ptr(),
-            status,
-            category.c_name().as_ptr(),
-            c"%s".as_ptr(),
-            text.as_ptr(),
-        );
     }
 }
 

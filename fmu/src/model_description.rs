@@ -5,7 +5,7 @@
 //! date), so the checked-in copies under modelDescription/ can be compared byte for byte.
 
 use crate::log::CATEGORIES;
-use crate::model::{ModelInfo, ModelTable, type_name};
+use crate::table::{Api, Causality3, ModelInfo, ModelTable};
 use crate::units::{self, BASE_UNITS};
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::{Causality, Variability, Variable};
@@ -53,15 +53,6 @@ pub(crate) fn value_text(kind: ValueKind, value: f64) -> String {
         ValueKind::Real => real(value),
         ValueKind::Integer => format!("{}", value as i64),
         ValueKind::Boolean => (value != 0.0).to_string(),
-    }
-}
-
-fn causality(c: Causality) -> &'static str {
-    match c {
-        Causality::Parameter => "parameter",
-        Causality::Input => "input",
-        Causality::Output => "output",
-        Causality::Local => "local",
     }
 }
 
@@ -146,6 +137,31 @@ pub(crate) fn categories_and_experiment(out: &mut String, info: &ModelInfo) {
     );
 }
 
+/// The unit (Real variables only), range (not for Booleans) and start attributes (every
+/// element's, for an FMI 3.0 array).
+pub(crate) fn value_attributes(
+    out: &mut String,
+    kind: ValueKind,
+    unit: &str,
+    [min, max]: [Option<f64>; 2],
+    start: &[f64],
+) {
+    if kind == ValueKind::Real && !unit.is_empty() {
+        let _ = write!(out, " unit=\"{}\"", escape(unit));
+    }
+    if kind != ValueKind::Boolean {
+        for (name, bound) in [("min", min), ("max", max)] {
+            if let Some(b) = bound {
+                let _ = write!(out, " {name}=\"{}\"", value_text(kind, b));
+            }
+        }
+    }
+    if !start.is_empty() {
+        let starts: Vec<String> = start.iter().map(|&s| value_text(kind, s)).collect();
+        let _ = write!(out, " start=\"{}\"", starts.join(" "));
+    }
+}
+
 /// `derivative` is the 1-based index of the state a derivative variable belongs to.
 fn scalar_variable(out: &mut String, v: &Variable, derivative: Option<usize>) {
     let _ = writeln!(
@@ -155,24 +171,12 @@ fn scalar_variable(out: &mut String, v: &Variable, derivative: Option<usize>) {
         escape(v.name),
         v.value_reference,
         escape(v.description),
-        causality(v.causality),
+        Causality3::Model(v.causality).name(),
         variability(v.variability)
     );
-    let _ = write!(out, "      <{}", type_name(v.kind));
-    // FMI 2.0 gives units to Real variables only.
-    if v.kind == ValueKind::Real && !v.unit.is_empty() {
-        let _ = write!(out, " unit=\"{}\"", escape(v.unit));
-    }
-    if v.kind != ValueKind::Boolean {
-        for (name, bound) in [("min", v.min), ("max", v.max)] {
-            if let Some(b) = bound {
-                let _ = write!(out, " {name}=\"{}\"", value_text(v.kind, b));
-            }
-        }
-    }
-    if let Some(start) = v.start {
-        let _ = write!(out, " start=\"{}\"", value_text(v.kind, start));
-    }
+    let _ = write!(out, "      <{}", Api::Fmi2.type_name(v.kind));
+    let range = [v.min, v.max];
+    value_attributes(out, v.kind, v.unit, range, v.start.as_slice());
     if let Some(state) = derivative {
         let _ = write!(out, " derivative=\"{state}\"");
     }
@@ -181,11 +185,7 @@ fn scalar_variable(out: &mut String, v: &Variable, derivative: Option<usize>) {
 
 /// 1-based position (ModelVariables order) of value reference `vr`.
 fn index_of(table: &ModelTable, vr: u32) -> Option<usize> {
-    table
-        .variables
-        .iter()
-        .position(|v| v.value_reference == vr)
-        .map(|i| i + 1)
+    table.index(vr).map(|i| i + 1)
 }
 
 /// The value references `output` depends on: its direct-feedthrough inputs and, under Model

@@ -1,25 +1,16 @@
 //! Writes a model's FMI 3.0 modelDescription.xml from its table's FMI 3.0 view
-//! ([`crate::fmi3_variables`]): Co-Simulation for every model, Model Exchange for one that
+//! ([`crate::table::Fmi3View`]): Co-Simulation for every model, Model Exchange for one that
 //! offers it; the same units, log categories, default experiment and dependencies as the FMI
 //! 2.0 description, with arrays, `time` and the event-indicator variables. Deterministic.
 
-use crate::fmi3_variables::{Causality3, Layout3, Source, Variable3};
-use crate::model::ModelTable;
 use crate::model_description::{
-    UnknownUnit, categories_and_experiment, escape, output_dependencies, value_text, variability,
-    write_units,
+    UnknownUnit, categories_and_experiment, escape, output_dependencies, value_attributes,
+    variability, write_units,
 };
+use crate::table::{Api, Causality3, Fmi3View, ModelTable, Source, Variable3};
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::Causality;
 use std::fmt::Write;
-
-fn type_element(kind: ValueKind) -> &'static str {
-    match kind {
-        ValueKind::Real => "Float64",
-        ValueKind::Integer => "Int32",
-        ValueKind::Boolean => "Boolean",
-    }
-}
 
 /// The FMI 3.0 value reference of model variable `vr`'s derivative, when it is a state
 /// derivative (the `derivative` attribute names the state's value reference).
@@ -28,12 +19,13 @@ fn state_of_derivative(table: &ModelTable, v: &Variable3) -> Option<u32> {
     let Source::Model(elements) = &v.source else {
         return None;
     };
-    let k = me.derivatives.iter().position(|&d| d == elements[0])?;
+    let vr = table.variables[elements[0]].value_reference;
+    let k = me.derivatives.iter().position(|&d| d == vr)?;
     table.fmi3.element(me.states[k]).map(|(vr, _)| vr)
 }
 
 fn variable(out: &mut String, table: &ModelTable, v: &Variable3) {
-    let element = type_element(v.kind);
+    let element = Api::Fmi3.type_name(v.kind);
     let _ = write!(
         out,
         "    <{element} name=\"{}\" valueReference=\"{}\" description=\"{}\" causality=\"{}\" \
@@ -44,20 +36,7 @@ fn variable(out: &mut String, table: &ModelTable, v: &Variable3) {
         v.causality.name(),
         variability(v.variability)
     );
-    if v.kind == ValueKind::Real && !v.unit.is_empty() {
-        let _ = write!(out, " unit=\"{}\"", escape(v.unit));
-    }
-    if v.kind != ValueKind::Boolean {
-        for (name, bound) in [("min", v.min), ("max", v.max)] {
-            if let Some(b) = bound {
-                let _ = write!(out, " {name}=\"{}\"", value_text(v.kind, b));
-            }
-        }
-    }
-    if !v.start.is_empty() {
-        let starts: Vec<String> = v.start.iter().map(|&s| value_text(v.kind, s)).collect();
-        let _ = write!(out, " start=\"{}\"", starts.join(" "));
-    }
+    value_attributes(out, v.kind, v.unit, [v.min, v.max], &v.start);
     if let Some(state) = state_of_derivative(table, v) {
         let _ = write!(out, " derivative=\"{state}\"");
     }
@@ -79,9 +58,7 @@ fn dependencies(table: &ModelTable, v: &Variable3) -> String {
     };
     let mut model_vrs = Vec::new();
     for &element in elements {
-        if let Some(variable) = table.variable(element) {
-            model_vrs.extend(output_dependencies(table, variable));
-        }
+        model_vrs.extend(output_dependencies(table, &table.variables[element]));
     }
     let vrs: Vec<String> = table
         .fmi3
@@ -93,7 +70,7 @@ fn dependencies(table: &ModelTable, v: &Variable3) -> String {
 }
 
 fn model_structure(out: &mut String, table: &ModelTable) {
-    let layout: &Layout3 = &table.fmi3;
+    let layout: &Fmi3View = &table.fmi3;
     out.push_str("  <ModelStructure>\n");
     let outputs: Vec<&Variable3> = layout
         .variables

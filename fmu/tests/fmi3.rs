@@ -11,7 +11,7 @@ use flyloop_fmu::exports::*;
 use flyloop_fmu::fmi2_types::{fmi2LastSuccessfulTime, fmi2Status};
 use flyloop_fmu::fmi3_types::fmi3Status::{fmi3Error, fmi3OK};
 use flyloop_fmu::fmi3_types::*;
-use flyloop_fmu::fmi3_variables::{EVENT_INDICATOR_VR, TIME_VR};
+use flyloop_fmu::table::{EVENT_INDICATOR_VR, TIME_VR};
 use std::ffi::CString;
 use support::{Fmu, Model, Recorder};
 
@@ -175,10 +175,9 @@ fn fmi2_outputs(model: Model) -> Vec<u32> {
     let layout = &model.table().fmi3;
     let mut vrs = Vec::new();
     for (vr, _) in fmi3_outputs(model) {
-        if let flyloop_fmu::fmi3_variables::Source::Model(elements) =
-            &layout.variable(vr).unwrap().source
-        {
-            vrs.extend(elements);
+        if let flyloop_fmu::table::Source::Model(elements) = &layout.variable(vr).unwrap().source {
+            let table = &model.table().variables;
+            vrs.extend(elements.iter().map(|&i| table[i].value_reference));
         }
     }
     vrs

@@ -12,7 +12,8 @@ mod support;
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::Causality;
 use flyloop_fmu::fmi2_types::fmi2Status::fmi2OK;
-use flyloop_fmu::pack::{Version, model_description_path, write_model_description};
+use flyloop_fmu::pack::{model_description, model_description_path, write_model_description};
+use flyloop_fmu::table::Api;
 use std::path::{Path, PathBuf};
 use support::{Fmu, Model};
 
@@ -26,7 +27,7 @@ fn checked_in_model_descriptions_match_the_generated_ones() {
     let update = std::env::var_os("UPDATE_MODEL_DESCRIPTION").is_some_and(|v| v == "1");
     for (model, version) in [Model::Quadrotor, Model::Lander2D]
         .into_iter()
-        .flat_map(|m| Version::ALL.map(|v| (m, v)))
+        .flat_map(|m| Api::ALL.map(|v| (m, v)))
     {
         let table = model.table();
         if update {
@@ -34,7 +35,7 @@ fn checked_in_model_descriptions_match_the_generated_ones() {
         }
         let path = model_description_path(&dir, table, version);
         let checked_in = std::fs::read_to_string(&path).unwrap_or_default();
-        let generated = version.model_description(table).unwrap();
+        let generated = model_description(table, version).unwrap();
         assert!(
             checked_in == generated,
             "{} is out of date with the variable tables; regenerate it with\n    \
@@ -43,8 +44,8 @@ fn checked_in_model_descriptions_match_the_generated_ones() {
             path.display()
         );
         let token = match version {
-            Version::Fmi2 => format!("guid=\"{}\"", table.guid),
-            Version::Fmi3 => format!("instantiationToken=\"{}\"", table.token3),
+            Api::Fmi2 => format!("guid=\"{}\"", table.guid),
+            Api::Fmi3 => format!("instantiationToken=\"{}\"", table.token3),
         };
         assert!(generated.contains(&token), "{token}");
     }

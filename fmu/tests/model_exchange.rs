@@ -270,7 +270,7 @@ fn misuse_is_an_error_with_a_log_line_never_a_crash() {
 
 #[test]
 fn lander2d_refuses_model_exchange_with_the_reason() {
-    let recorder = Box::<flyloop_fmu::importer_logger::Recorder>::default();
+    let recorder = Box::<support::Recorder>::default();
     let callbacks = support::callbacks_for(&recorder);
     // SAFETY: valid strings and callbacks.
     let c = unsafe {

@@ -28,7 +28,7 @@ def fmus() -> dict[str, Path]:
 
 @pytest.fixture(scope="session")
 def core_trajectory(fmus):
-    """Runs the core model from Rust (fmu/src/bin/core_trajectory.rs) for a spec."""
+    """Runs the core model from Rust (fmu/tests/tools/core_trajectory.rs) for a spec."""
     target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
     if not target.is_absolute():
         target = ROOT / target

@@ -9,7 +9,8 @@
 //! scripts/pack-fmus.sh builds the library and runs the first form into dist/fmu.
 
 use flyloop_fmu::models::tables;
-use flyloop_fmu::pack::{Version, write_fmu, write_model_description};
+use flyloop_fmu::pack::{write_fmu, write_model_description};
+use flyloop_fmu::table::Api;
 use std::path::Path;
 use std::process::ExitCode;
 
@@ -20,12 +21,12 @@ fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let result = match args.as_slice() {
-        ["fmus", library, out] => Version::ALL
+        ["fmus", library, out] => Api::ALL
             .into_iter()
             .flat_map(|v| tables().map(|t| (t, v)))
             .map(|(t, v)| write_fmu(t, v, Path::new(library), Path::new(out)))
             .collect::<Result<Vec<_>, _>>(),
-        ["model-descriptions", dir] => Version::ALL
+        ["model-descriptions", dir] => Api::ALL
             .into_iter()
             .flat_map(|v| tables().map(|t| (t, v)))
             .map(|(t, v)| write_model_description(t, v, Path::new(dir)))

@@ -6,19 +6,21 @@ use crate::error::FmuError;
 use crate::fmi2_types::{fmi2Component, fmi2Status};
 use crate::instance::{Instance, Mask, Stage};
 use std::any::Any;
+use std::ffi::{CStr, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-/// Runs `body` for the instance behind `c` if `mask` allows its stage.
+/// Runs `body` for the instance behind `c` if `mask` allows its stage, and answers its status
+/// (`()` is OK) in the caller's FMI version (`S`: fmi2Status or fmi3Status).
 ///
 /// A NULL `c` gives fmi2Error (there is no logger to tell). An `Err` from the body is logged
 /// as "`function`: reason" and gives its status. A panic puts the instance in the Fatal
 /// stage and gives fmi2Fatal.
-pub(crate) fn with_instance(
+pub(crate) fn with_instance<R: Into<fmi2Status>, S: From<fmi2Status>>(
     c: fmi2Component,
     function: &'static str,
     mask: Mask,
-    body: impl FnOnce(&mut Instance) -> Result<fmi2Status, FmuError>,
-) -> fmi2Status {
+    body: impl FnOnce(&mut Instance) -> Result<R, FmuError>,
+) -> S {
     let outcome = catch_unwind(AssertUnwindSafe(|| {
         // SAFETY: a non-NULL fmi2Component is a pointer fmi2Instantiate returned and
         // fmi2FreeInstance has not freed (the importer's side of the contract).
@@ -27,11 +29,11 @@ pub(crate) fn with_instance(
         };
         let result = instance.check_stage(mask).and_then(|()| body(instance));
         match result {
-            Ok(status) => status,
+            Ok(status) => status.into(),
             Err(error) => instance.report(function, &error),
         }
     }));
-    outcome.unwrap_or_else(|payload| {
+    S::from(outcome.unwrap_or_else(|payload| {
         let message = panic_message(payload);
         // SAFETY: as above; the borrow inside the closure ended with the unwind.
         if let Some(instance) = unsafe { c.cast::<Instance>().as_mut() } {
@@ -47,7 +49,14 @@ pub(crate) fn with_instance(
             }));
         }
         fmi2Status::fmi2Fatal
-    })
+    }))
+}
+
+/// A body without a status of its own answers OK.
+impl From<()> for fmi2Status {
+    fn from((): ()) -> Self {
+        fmi2Status::fmi2OK
+    }
 }
 
 /// Runs `body` (an export without an instance) and returns `fallback` if it panics.
@@ -87,7 +96,11 @@ pub(crate) unsafe fn c_slice<'a, T>(
     if ptr.is_null() {
         return Err(FmuError::NullArgument(name));
     }
-    check_length::<T>(n, name)?;
+    if n > isize::MAX as usize / std::mem::size_of::<T>().max(1) {
+        return Err(FmuError::InvalidArgument(format!(
+            "array `{name}` claims {n} elements, more than memory can hold"
+        )));
+    }
     // SAFETY: non-NULL, length checked against isize::MAX bytes, validity per the contract.
     Ok(unsafe { std::slice::from_raw_parts(ptr, n) })
 }
@@ -101,24 +114,19 @@ pub(crate) unsafe fn c_slice_mut<'a, T>(
     n: usize,
     name: &'static str,
 ) -> Result<&'a mut [T], FmuError> {
-    if n == 0 {
-        return Ok(&mut []);
-    }
-    if ptr.is_null() {
-        return Err(FmuError::NullArgument(name));
-    }
-    check_length::<T>(n, name)?;
-    // SAFETY: as in c_slice, and the importer does not alias its output arrays.
-    Ok(unsafe { std::slice::from_raw_parts_mut(ptr, n) })
+    // SAFETY: the checks of c_slice, the importer's contract, and the importer does not alias
+    // its output arrays.
+    let checked = unsafe { c_slice(ptr.cast_const(), n, name) }?;
+    Ok(unsafe { std::slice::from_raw_parts_mut(checked.as_ptr().cast_mut(), n) })
 }
 
-fn check_length<T>(n: usize, name: &'static str) -> Result<(), FmuError> {
-    if n > isize::MAX as usize / std::mem::size_of::<T>().max(1) {
-        return Err(FmuError::InvalidArgument(format!(
-            "array `{name}` claims {n} elements, more than memory can hold"
-        )));
-    }
-    Ok(())
+/// A `&CStr` from a C string argument.
+///
+/// # Safety
+/// `s` must be NULL or NUL-terminated and valid for the call.
+pub(crate) unsafe fn c_str<'a>(s: *const c_char) -> Option<&'a CStr> {
+    // SAFETY: per the function's contract.
+    (!s.is_null()).then(|| unsafe { CStr::from_ptr(s) })
 }
 
 /// `*ptr = value` for an output pointer argument.
@@ -139,7 +147,13 @@ pub(crate) unsafe fn write_out<T>(
 }
 
 #[cfg(test)]
+#[allow(dead_code)]
+#[path = "../../tests/support/importer_logger.rs"]
+mod importer_logger;
+
+#[cfg(test)]
 mod tests {
+    use super::importer_logger;
     use super::*;
     use crate::exports::{fmi2DoStep, fmi2FreeInstance, fmi2GetReal, fmi2Instantiate};
     use crate::fmi2_types::*;
@@ -147,7 +161,7 @@ mod tests {
 
     #[test]
     fn a_panic_becomes_fatal_with_a_message_and_only_free_instance_remains() {
-        let recorder = crate::importer_logger::Recorder::default();
+        let recorder = importer_logger::Recorder::default();
         let callbacks = recorder.callbacks();
         let guid = crate::models::tables()[0].guid_c.clone();
         // SAFETY: valid strings and callbacks.
@@ -163,9 +177,14 @@ mod tests {
             )
         };
         assert!(!c.is_null());
-        let status = with_instance(c, "fmi2Probe", masks::SET_REAL, |_| {
-            panic!("100% broken");
-        });
+        let status: fmi2Status = with_instance(
+            c,
+            "fmi2Probe",
+            masks::SET_REAL,
+            |_| -> Result<(), FmuError> {
+                panic!("100% broken");
+            },
+        );
         assert_eq!(status, fmi2Status::fmi2Fatal);
         let last = recorder.last().unwrap();
         assert_eq!(

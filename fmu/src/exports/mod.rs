@@ -1,20 +1,31 @@
-//! Every FMI 2.0 and FMI 3.0 function, exported unmangled from the library (`extern "C"`). Tests call
-//! them directly through the rlib; importers load them from the .so.
+//! Every FMI 2.0 and FMI 3.0 function, exported unmangled from the library (`extern "C"`):
+//! [`fmi2`] and [`fmi3`] hold the C signatures, [`shared`] the bodies both versions run, and
+//! [`guard`] what every export does around its body. Tests call them directly through the
+//! rlib; importers load them from the .so.
 // Function and parameter names are the standard's.
 #![allow(non_snake_case, non_upper_case_globals)]
 
-mod cosimulation;
-mod fmi3;
-pub(crate) mod fmu_state;
-mod guard;
-mod instantiate;
-mod lifecycle;
-pub(crate) mod model_exchange;
-pub(crate) mod values;
+/// Defines exported C functions, each a C signature and a body.
+macro_rules! exports {
+    ($($(#[doc = $doc:literal])* fn $name:ident($($arg:ident: $t:ty),* $(,)?) $(-> $ret:ty)? $body:block)*) => {$(
+        $(#[doc = $doc])*
+        ///
+        /// # Safety
+        /// Every pointer argument must be NULL or valid as the FMI standard says; an instance
+        /// must be one this library made and has not freed.
+        #[unsafe(no_mangle)]
+        pub unsafe extern "C" fn $name($($arg: $t),*) $(-> $ret)? {
+            // SAFETY: the caller's contract above, which each body forwards.
+            #[allow(unused_unsafe)]
+            unsafe { $body }
+        }
+    )*};
+}
 
-pub use cosimulation::*;
+pub mod fmi2;
+pub mod fmi3;
+mod guard;
+pub(crate) mod shared;
+
+pub use fmi2::*;
 pub use fmi3::*;
-pub use fmu_state::*;
-pub use lifecycle::*;
-pub use model_exchange::*;
-pub use values::*;

@@ -4,9 +4,9 @@
 //! shortened rapier step when t falls inside a grid step; so every communication step size
 //! that is a multiple of `physics_step` gives the same bits at the shared times.
 
-use crate::model::{FmuModel, ModelInfo, ModelTable, StepRequest};
+use crate::model::{FmuModel, StepRequest, Table};
+use crate::table::ModelInfo;
 use flyloop_core::lander2d::{Lander2d, Lander2dInitial};
-use flyloop_core::variables;
 use flyloop_core::{ParamError, SnapshotError};
 use std::sync::OnceLock;
 
@@ -28,29 +28,14 @@ static INFO: ModelInfo = ModelInfo {
 };
 
 impl FmuModel for Lander2d {
-    type Initial = Lander2dInitial;
-
-    fn table() -> &'static ModelTable {
-        static TABLE: OnceLock<ModelTable> = OnceLock::new();
-        TABLE.get_or_init(|| ModelTable::new(&INFO, variables::variables::<Lander2d>()))
+    fn table() -> &'static Table<Self> {
+        static TABLE: OnceLock<Table<Lander2d>> = OnceLock::new();
+        TABLE.get_or_init(|| Table::new(&INFO, Vec::new(), None))
     }
 
     fn build(previous: Option<&Self>, initial: &Lander2dInitial) -> Result<Self, ParamError> {
         let params = previous.map(|l| l.params().clone()).unwrap_or_default();
         Lander2d::from_initial(params, initial)
-    }
-
-    fn get(&self, initial: &Lander2dInitial, vr: u32) -> Result<f64, ParamError> {
-        variables::get(self, initial, vr)
-    }
-
-    fn set(
-        &mut self,
-        initial: &mut Lander2dInitial,
-        vr: u32,
-        value: f64,
-    ) -> Result<(), ParamError> {
-        variables::set(self, initial, vr, value)
     }
 
     fn internal_steps(&self, step: &StepRequest) -> f64 {

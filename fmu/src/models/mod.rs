@@ -3,16 +3,16 @@
 mod lander2d;
 mod quadrotor;
 
+use crate::engine::{Engine, Simulation};
 use crate::error::FmuError;
-use crate::instance::Api;
-use crate::model::{FmuModel, ModelTable};
-use crate::simulation::{Engine, Simulation};
+use crate::model::FmuModel;
+use crate::table::{Api, ModelTable};
 use flyloop_core::lander2d::Lander2d;
 use flyloop_core::quadrotor::Quadrotor;
 
 /// The tables of every model, Quadrotor first.
 pub fn tables() -> [&'static ModelTable; 2] {
-    [Quadrotor::table(), Lander2d::table()]
+    [&Quadrotor::table().table, &Lander2d::table().table]
 }
 
 /// A fresh simulation of the model whose GUID (FMI 2.0) or instantiation token (FMI 3.0) is

@@ -10,7 +10,8 @@
 //! indicators and the turbulence samples as time events.
 
 use crate::error::FmuError;
-use crate::model::{FmuModel, Hybrid, ModelExchangeTable, ModelInfo, ModelTable, StepRequest};
+use crate::model::{Access, FmuModel, Hybrid, StepRequest, Table};
+use crate::table::{Array, ModelExchangeTable, ModelInfo};
 use flyloop_core::number::Compact;
 use flyloop_core::params::ValueKind;
 use flyloop_core::quadrotor::continuous::{BODY_STATE_OUTPUTS, BRISTLES, EVENT_INDICATORS};
@@ -40,15 +41,27 @@ static INFO: ModelInfo = ModelInfo {
     // The wind is the episode wind plus the input: turbulence is a discrete state.
     state_free_outputs: &["wind_x", "wind_y", "wind_z"],
     arrays: &[
-        (
-            "motor_command",
-            "Commands of the four motors, 0 .. 1 each: front-right (CCW), rear-left (CCW), \
-             front-left (CW), rear-right (CW)",
-        ),
-        (
-            "motor_state",
-            "Lagged states of the four motors (order of motor_command)",
-        ),
+        Array {
+            name: "motor_command",
+            description: Some(
+                "Commands of the four motors, 0 .. 1 each: front-right (CCW), rear-left (CCW), \
+                 front-left (CW), rear-right (CW)",
+            ),
+            first: "motor_command_0",
+            len: 4,
+        },
+        Array {
+            name: "motor_state",
+            description: Some("Lagged states of the four motors (order of motor_command)"),
+            first: "motor_state_0",
+            len: 4,
+        },
+        Array {
+            name: "der(motor_state)",
+            description: None,
+            first: "der(motor_state_0)",
+            len: 4,
+        },
     ],
     event_indicators: &[
         (
@@ -123,22 +136,25 @@ fn local(name: &'static str, vr: u32, unit: &'static str, description: &'static 
 }
 
 /// The core's variables, then the bristle states and the derivatives.
-fn table() -> ModelTable {
-    let mut vars = variables::variables::<Quadrotor>();
-    vars.extend(
-        BRISTLES
-            .iter()
-            .zip(BRISTLE_VR..)
-            .map(|(&(name, text), vr)| local(name, vr, "m", text)),
-    );
-    vars.extend(
-        DERIVATIVES
-            .iter()
-            .zip(DERIVATIVE_VR..)
-            .map(|(&(name, unit), vr)| local(name, vr, unit, "Time derivative of the state")),
-    );
+fn table() -> Table<Quadrotor> {
+    let bristle = |at| Access::Local {
+        read: |q: &Quadrotor, at| q.continuous_state()[at],
+        at: BODY_STATE_OUTPUTS.len() + at,
+    };
+    let derivative = |at| Access::Local {
+        read: |q: &Quadrotor, at| q.state_derivative()[at],
+        at,
+    };
+    let text = "Time derivative of the state";
+    let bristles = (BRISTLES.iter().zip(BRISTLE_VR..).enumerate())
+        .map(|(i, (&(name, text), vr))| (local(name, vr, "m", text), bristle(i)));
+    let derivatives = (DERIVATIVES.iter().zip(DERIVATIVE_VR..).enumerate())
+        .map(|(i, (&(name, unit), vr))| (local(name, vr, unit, text), derivative(i)));
+    let locals: Vec<_> = bristles.chain(derivatives).collect();
+    let core = variables::variables::<Quadrotor>();
     let vr_of = |name: &str| {
-        vars.iter()
+        core.iter()
+            .chain(locals.iter().map(|(v, _)| v))
             .find(|v| v.name == name)
             .map(|v| v.value_reference)
     };
@@ -153,44 +169,18 @@ fn table() -> ModelTable {
         derivatives: (DERIVATIVE_VR..).take(STATE_LEN).collect(),
         event_indicators: EVENT_INDICATORS,
     };
-    ModelTable::with_model_exchange(&INFO, vars, Some(me))
+    Table::new(&INFO, locals, Some(me))
 }
 
 impl FmuModel for Quadrotor {
-    type Initial = QuadrotorInitial;
-
-    fn table() -> &'static ModelTable {
-        static TABLE: OnceLock<ModelTable> = OnceLock::new();
+    fn table() -> &'static Table<Self> {
+        static TABLE: OnceLock<Table<Quadrotor>> = OnceLock::new();
         TABLE.get_or_init(table)
     }
 
     fn build(previous: Option<&Self>, initial: &QuadrotorInitial) -> Result<Self, ParamError> {
         let params = previous.map(|q| q.params.clone()).unwrap_or_default();
         Quadrotor::from_initial(params, initial)
-    }
-
-    fn get(&self, initial: &QuadrotorInitial, vr: u32) -> Result<f64, ParamError> {
-        let local = |first: u32, values: [f64; STATE_LEN], offset: usize| {
-            let at = (vr - first) as usize + offset;
-            values
-                .get(at)
-                .copied()
-                .ok_or(ParamError::UnknownValueReference(vr))
-        };
-        match vr {
-            DERIVATIVE_VR.. => local(DERIVATIVE_VR, self.state_derivative(), 0),
-            BRISTLE_VR.. => local(BRISTLE_VR, self.continuous_state(), 17),
-            _ => variables::get(self, initial, vr),
-        }
-    }
-
-    fn set(
-        &mut self,
-        initial: &mut QuadrotorInitial,
-        vr: u32,
-        value: f64,
-    ) -> Result<(), ParamError> {
-        variables::set(self, initial, vr, value)
     }
 
     fn internal_steps(&self, step: &StepRequest) -> f64 {

@@ -4,7 +4,6 @@
 
 use flyloop_fmu::exports::*;
 use flyloop_fmu::fmi2_types::*;
-use flyloop_fmu::importer_logger;
 use flyloop_fmu::models::tables;
 use std::ffi::CString;
 
@@ -16,7 +15,7 @@ pub enum Model {
 }
 
 impl Model {
-    pub fn table(self) -> &'static flyloop_fmu::model::ModelTable {
+    pub fn table(self) -> &'static flyloop_fmu::table::ModelTable {
         match self {
             Model::Quadrotor => tables()[0],
             Model::Lander2D => tables()[1],
@@ -32,7 +31,9 @@ impl Model {
     }
 }
 
-pub use flyloop_fmu::importer_logger::{Entry, Recorder};
+pub mod importer_logger;
+
+pub use importer_logger::{Entry, Recorder};
 
 /// The recording logger as the variadic callback type.
 pub fn recording_logger() -> fmi2CallbackLogger {

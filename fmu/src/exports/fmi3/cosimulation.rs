@@ -2,104 +2,52 @@
 //! (so both give the same outputs bit for bit), and the step-mode functions this FMU does not
 //! need.
 
-use super::with_instance3;
 use crate::error::FmuError;
-use crate::exports::guard::write_out;
+use crate::exports::guard::{with_instance, write_out};
 use crate::fmi3_types::*;
 use crate::instance::{masks, masks3};
 
-/// Advances from `currentCommunicationPoint` (the instance's time) by
-/// `communicationStepSize`, exactly as fmi2DoStep does. Never asks for event handling, never
-/// terminates, never returns early; `*lastSuccessfulTime` is the time after the step. The four
-/// output pointers must not be NULL.
-///
-/// # Safety
-/// `instance` must be NULL or live; the output pointers NULL or writable.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3DoStep(
-    instance: fmi3Instance,
-    currentCommunicationPoint: fmi3Float64,
-    communicationStepSize: fmi3Float64,
-    _noSetFMUStatePriorToCurrentPoint: fmi3Boolean,
-    eventHandlingNeeded: *mut fmi3Boolean,
-    terminateSimulation: *mut fmi3Boolean,
-    earlyReturn: *mut fmi3Boolean,
-    lastSuccessfulTime: *mut fmi3Float64,
-) -> fmi3Status {
-    with_instance3(instance, "fmi3DoStep", masks::DO_STEP, |instance| {
-        instance.check_co_simulation()?;
-        for (pointer, name) in [
-            (eventHandlingNeeded, "eventHandlingNeeded"),
-            (terminateSimulation, "terminateSimulation"),
-            (earlyReturn, "earlyReturn"),
-        ] {
-            if pointer.is_null() {
+exports! {
+    /// Advances from `currentCommunicationPoint` (the instance's time) by
+    /// `communicationStepSize`, exactly as fmi2DoStep does. Never asks for event handling,
+    /// never terminates, never returns early; `*lastSuccessfulTime` is the time after the
+    /// step. The four output pointers must not be NULL.
+    fn fmi3DoStep(instance: fmi3Instance, currentCommunicationPoint: fmi3Float64, communicationStepSize: fmi3Float64, _noSetFMUStatePriorToCurrentPoint: fmi3Boolean, eventHandlingNeeded: *mut fmi3Boolean, terminateSimulation: *mut fmi3Boolean, earlyReturn: *mut fmi3Boolean, lastSuccessfulTime: *mut fmi3Float64) -> fmi3Status {
+        with_instance(instance, "fmi3DoStep", masks::DO_STEP, |instance| {
+            instance.check_co_simulation()?;
+            let flags = [
+                (eventHandlingNeeded, "eventHandlingNeeded"),
+                (terminateSimulation, "terminateSimulation"),
+                (earlyReturn, "earlyReturn"),
+            ];
+            if let Some((_, name)) = flags.iter().find(|(p, _)| p.is_null()) {
                 return Err(FmuError::NullArgument(name));
             }
-        }
-        if lastSuccessfulTime.is_null() {
-            return Err(FmuError::NullArgument("lastSuccessfulTime"));
-        }
-        let result = instance
-            .sim
-            .do_step(currentCommunicationPoint, communicationStepSize);
-        // SAFETY: all four checked non-NULL above, writable per the contract.
-        unsafe {
-            write_out(eventHandlingNeeded, fmi3False, "eventHandlingNeeded")?;
-            write_out(terminateSimulation, fmi3False, "terminateSimulation")?;
-            write_out(earlyReturn, fmi3False, "earlyReturn")?;
-            write_out(
-                lastSuccessfulTime,
-                instance.sim.time(),
-                "lastSuccessfulTime",
-            )?;
-        }
-        result
-    })
-}
+            if lastSuccessfulTime.is_null() {
+                return Err(FmuError::NullArgument("lastSuccessfulTime"));
+            }
+            let result = instance.sim.do_step(currentCommunicationPoint, communicationStepSize);
+            for (pointer, name) in flags {
+                write_out(pointer, fmi3False, name)?;
+            }
+            write_out(lastSuccessfulTime, instance.sim.time(), "lastSuccessfulTime")?;
+            result
+        })
+    }
 
-/// Not needed: without event mode (hasEventMode="false") fmi3ExitInitializationMode already
-/// enters step mode.
-///
-/// # Safety
-/// `instance` must be NULL or live.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status {
-    with_instance3(
-        instance,
-        "fmi3EnterStepMode",
-        masks3::ENTER_STEP_MODE,
-        |instance| {
+    /// Not needed: without event mode (hasEventMode="false") fmi3ExitInitializationMode
+    /// already enters step mode.
+    fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status {
+        with_instance(instance, "fmi3EnterStepMode", masks3::ENTER_STEP_MODE, |instance| {
             instance.check_co_simulation()?;
-            Err(FmuError::NotSupported(
-                "event mode is not used (hasEventMode=\"false\"): fmi3ExitInitializationMode \
-             enters step mode",
-            ))
-        },
-    )
-}
+            Err::<(), _>(FmuError::NotSupported("event mode is not used (hasEventMode=\"false\"): fmi3ExitInitializationMode enters step mode"))
+        })
+    }
 
-/// maxOutputDerivativeOrder="0".
-///
-/// # Safety
-/// `instance` must be NULL or live.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3GetOutputDerivatives(
-    instance: fmi3Instance,
-    _valueReferences: *const fmi3ValueReference,
-    _nValueReferences: usize,
-    _orders: *const fmi3Int32,
-    _values: *mut fmi3Float64,
-    _nValues: usize,
-) -> fmi3Status {
-    with_instance3(
-        instance,
-        "fmi3GetOutputDerivatives",
-        masks3::GET_OUTPUT_DERIVATIVES,
-        |_| {
-            Err(FmuError::NotSupported(
-                "output derivatives (maxOutputDerivativeOrder=\"0\")",
-            ))
-        },
-    )
+    /// maxOutputDerivativeOrder="0".
+    fn fmi3GetOutputDerivatives(instance: fmi3Instance, _valueReferences: *const fmi3ValueReference, _nValueReferences: usize, _orders: *const fmi3Int32, _values: *mut fmi3Float64, _nValues: usize) -> fmi3Status {
+        with_instance(instance, "fmi3GetOutputDerivatives", masks3::GET_OUTPUT_DERIVATIVES, |_| {
+            Err::<(), _>(FmuError::NotSupported("output derivatives (maxOutputDerivativeOrder=\"0\")"))
+        })
+    }
 }

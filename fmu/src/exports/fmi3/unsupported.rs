@@ -3,101 +3,69 @@
 //! and adjoint derivatives, evaluateDiscreteStates and Scheduled Execution. Each is exported
 //! (importers bind every function) and answers fmi3Error with the reason in the log.
 
-use super::values::{Setter, accessors, get_values, set_values};
-use super::with_instance3;
+use super::values::{accessors, resolve};
 use crate::error::FmuError;
+use crate::exports::guard::{c_slice, with_instance};
+use crate::fmi2_types::fmi2Status;
 use crate::fmi3_types::*;
 use crate::instance::{Mask, masks3};
-use crate::simulation::FmiType;
+use crate::table::{Api, ValueType};
 
-// Types no variable has: every value reference is refused, naming the variable's real type
-// when it exists; no value is ever converted.
-accessors!(
-    fmi3GetFloat32,
-    fmi3SetFloat32,
-    fmi3Float32,
-    FmiType::Other3("Float32"),
-    masks3::SET_OTHER,
-    |_| 0.0,
-    |_| f64::NAN
-);
-accessors!(
-    fmi3GetInt8,
-    fmi3SetInt8,
-    fmi3Int8,
-    FmiType::Other3("Int8"),
-    masks3::SET_OTHER,
-    |_| 0,
-    |_| f64::NAN
-);
-accessors!(
-    fmi3GetUInt8,
-    fmi3SetUInt8,
-    fmi3UInt8,
-    FmiType::Other3("UInt8"),
-    masks3::SET_OTHER,
-    |_| 0,
-    |_| f64::NAN
-);
-accessors!(
-    fmi3GetInt16,
-    fmi3SetInt16,
-    fmi3Int16,
-    FmiType::Other3("Int16"),
-    masks3::SET_OTHER,
-    |_| 0,
-    |_| f64::NAN
-);
-accessors!(
-    fmi3GetUInt16,
-    fmi3SetUInt16,
-    fmi3UInt16,
-    FmiType::Other3("UInt16"),
-    masks3::SET_OTHER,
-    |_| 0,
-    |_| f64::NAN
-);
-accessors!(
-    fmi3GetUInt32,
-    fmi3SetUInt32,
-    fmi3UInt32,
-    FmiType::Other3("UInt32"),
-    masks3::SET_OTHER,
-    |_| 0,
-    |_| f64::NAN
-);
-accessors!(
-    fmi3GetInt64,
-    fmi3SetInt64,
-    fmi3Int64,
-    FmiType::Other3("Int64"),
-    masks3::SET_OTHER,
-    |_| 0,
-    |_| f64::NAN
-);
-accessors!(
-    fmi3GetUInt64,
-    fmi3SetUInt64,
-    fmi3UInt64,
-    FmiType::Other3("UInt64"),
-    masks3::SET_OTHER,
-    |_| 0,
-    |_| f64::NAN
-);
-accessors!(
-    fmi3GetString,
-    fmi3SetString,
-    fmi3String,
-    FmiType::Other3("String"),
-    masks3::SET_OTHER,
-    |_| std::ptr::null(),
-    |_| f64::NAN
-);
+/// Defines fmi3Get<T> and fmi3Set<T> for types no variable has: every value reference is
+/// refused, naming the variable's real type when it exists; no value is ever converted.
+macro_rules! no_variables {
+    ($($get:ident $set:ident $t:ty, $name:literal = $zero:expr;)*) => {$(
+        accessors!($get, $set, $t, ValueType::none(Api::Fmi3, $name), masks3::SET_OTHER, |_| $zero, |_| f64::NAN);
+    )*};
+}
+
+no_variables! {
+    fmi3GetFloat32 fmi3SetFloat32 fmi3Float32, "Float32" = 0.0;
+    fmi3GetInt8 fmi3SetInt8 fmi3Int8, "Int8" = 0;
+    fmi3GetUInt8 fmi3SetUInt8 fmi3UInt8, "UInt8" = 0;
+    fmi3GetInt16 fmi3SetInt16 fmi3Int16, "Int16" = 0;
+    fmi3GetUInt16 fmi3SetUInt16 fmi3UInt16, "UInt16" = 0;
+    fmi3GetUInt32 fmi3SetUInt32 fmi3UInt32, "UInt32" = 0;
+    fmi3GetInt64 fmi3SetInt64 fmi3Int64, "Int64" = 0;
+    fmi3GetUInt64 fmi3SetUInt64 fmi3UInt64, "UInt64" = 0;
+    fmi3GetString fmi3SetString fmi3String, "String" = std::ptr::null();
+}
+
+/// The body of fmi3GetBinary and fmi3SetBinary: after the checks every fmi3Get*/fmi3Set*
+/// makes (known value references, `nValues`, `values` not NULL), every variable is refused
+/// with its real type.
+///
+/// # Safety
+/// `vr` must be NULL or hold `nvr` elements.
+unsafe fn no_binary(
+    instance: fmi3Instance,
+    function: &'static str,
+    mask: Mask,
+    (vr, nvr): (*const fmi3ValueReference, usize),
+    (values_null, n_values): (bool, usize),
+) -> fmi3Status {
+    with_instance(instance, function, mask, |instance| {
+        // SAFETY: per the function's contract.
+        let vrs = unsafe { c_slice(vr, nvr, "valueReferences[]") }?;
+        let variables = resolve(&instance.sim.table().fmi3, vrs, n_values)?;
+        if values_null && n_values > 0 {
+            return Err(FmuError::NullArgument("values[]"));
+        }
+        let mut worst = fmi2Status::fmi2OK;
+        for v in variables {
+            let binary = ValueType::none(Api::Fmi3, "Binary");
+            if let Err(e) = binary.check(&v.name, v.value_reference, v.kind) {
+                worst = worst.max(instance.report(function, &e));
+            }
+        }
+        Ok(worst)
+    })
+}
 
 /// No Binary variables: every value reference is refused.
 ///
 /// # Safety
-/// `valueReferences` NULL or `nValueReferences` elements; `values` NULL or `nValues`.
+/// `valueReferences` NULL or `nValueReferences` elements.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3GetBinary(
     instance: fmi3Instance,
@@ -108,15 +76,15 @@ pub unsafe extern "C" fn fmi3GetBinary(
     nValues: usize,
 ) -> fmi3Status {
     let vrs = (valueReferences, nValueReferences);
-    // SAFETY: forwarded contract; no value is ever converted.
+    let function = "fmi3GetBinary";
+    // SAFETY: forwarded contract; no value is ever read or written.
     unsafe {
-        get_values(
+        no_binary(
             instance,
-            "fmi3GetBinary",
-            FmiType::Other3("Binary"),
+            function,
+            masks3::GET_VALUE,
             vrs,
-            (values, nValues),
-            |_| std::ptr::null(),
+            (values.is_null(), nValues),
         )
     }
 }
@@ -124,7 +92,7 @@ pub unsafe extern "C" fn fmi3GetBinary(
 /// No Binary variables: every value reference is refused.
 ///
 /// # Safety
-/// `valueReferences` NULL or `nValueReferences` elements; `values` NULL or `nValues`.
+/// `valueReferences` NULL or `nValueReferences` elements.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3SetBinary(
     instance: fmi3Instance,
@@ -134,14 +102,18 @@ pub unsafe extern "C" fn fmi3SetBinary(
     values: *const fmi3Binary,
     nValues: usize,
 ) -> fmi3Status {
-    let setter = Setter {
-        function: "fmi3SetBinary",
-        mask: masks3::SET_OTHER,
-        ty: FmiType::Other3("Binary"),
-    };
     let vrs = (valueReferences, nValueReferences);
-    // SAFETY: forwarded contract; the values are never read.
-    unsafe { set_values(instance, setter, vrs, (values, nValues), |_| f64::NAN) }
+    let function = "fmi3SetBinary";
+    // SAFETY: forwarded contract; no value is ever read.
+    unsafe {
+        no_binary(
+            instance,
+            function,
+            masks3::SET_OTHER,
+            vrs,
+            (values.is_null(), nValues),
+        )
+    }
 }
 
 /// Refuses with `why` (after the NULL and stage checks).
@@ -151,8 +123,8 @@ fn refuse(
     mask: Mask,
     why: &'static str,
 ) -> fmi3Status {
-    with_instance3(instance, function, mask, |_| {
-        Err(FmuError::NotSupported(why))
+    with_instance(instance, function, mask, |_| {
+        Err::<(), _>(FmuError::NotSupported(why))
     })
 }
 

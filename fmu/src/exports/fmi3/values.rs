@@ -5,24 +5,22 @@
 //! FMI 2.0: a refused one is logged with its reason while the others still take effect.
 
 use crate::error::FmuError;
-use crate::exports::guard::{c_slice, c_slice_mut, with_instance};
-use crate::exports::values::initialised;
-use crate::fmi2_types::fmi2Status;
 use crate::fmi3_types::*;
-use crate::fmi3_variables::{Layout3, Source, Variable3};
-use crate::instance::{Instance, Mask, masks3};
-use crate::simulation::FmiType;
+use crate::instance::Instance;
+use crate::instance::masks3;
+use crate::table::{Api, Fmi3View, Source, ValueType, Variable3};
+use flyloop_core::params::ValueKind;
 
 /// The variables behind `vrs`, after checking that every one exists and that together they
 /// hold `n_values` values (no allocation: this runs on every get and set).
-fn resolve<'a>(
-    layout: &'static Layout3,
+pub(crate) fn resolve<'a>(
+    view: &'static Fmi3View,
     vrs: &'a [fmi3ValueReference],
     n_values: usize,
 ) -> Result<impl Iterator<Item = &'static Variable3> + use<'a>, FmuError> {
     let mut total = 0;
     for &vr in vrs {
-        total += layout
+        total += view
             .variable(vr)
             .ok_or(FmuError::UnknownValueReference(vr))?
             .len();
@@ -34,132 +32,38 @@ fn resolve<'a>(
             vrs.len()
         )));
     }
-    Ok(vrs.iter().filter_map(|&vr| layout.variable(vr)))
+    Ok(vrs.iter().filter_map(|&vr| view.variable(vr)))
 }
 
-fn check_type(v: &'static Variable3, ty: FmiType) -> Result<(), FmuError> {
-    if ty.matches(v.kind) {
-        Ok(())
-    } else {
-        Err(ty.mismatch(&v.name, v.value_reference, v.kind))
-    }
-}
-
-/// Element `i` of `v`.
-fn read(instance: &Instance, v: &Variable3, i: usize, ty: FmiType) -> Result<f64, FmuError> {
-    match &v.source {
-        Source::Model(elements) => instance.sim.get(elements[i], ty),
-        Source::Time => Ok(instance.sim.time()),
+/// Element `i` of `v`, which is not a model variable.
+pub(crate) fn computed(instance: &Instance, v: &Variable3) -> Result<f64, FmuError> {
+    match v.source {
         Source::EventIndicator(k) => {
-            let n = instance.sim.table().fmi3.event_indicators.len();
-            let mut z = vec![0.0; n];
+            let mut z = vec![0.0; instance.sim.table().fmi3.event_indicators.len()];
             instance.sim.event_indicators(&mut z)?;
-            Ok(z[*k])
+            Ok(z[k])
         }
+        _ => Ok(instance.sim.time()),
     }
 }
 
-/// One fmi3Get* call.
-///
-/// # Safety
-/// `vr` must be NULL or hold `nvr` elements, `values` NULL or `n_values`.
-pub(crate) unsafe fn get_values<T>(
-    instance: fmi3Instance,
-    function: &'static str,
-    ty: FmiType,
-    (vr, nvr): (*const fmi3ValueReference, usize),
-    (values, n_values): (*mut T, usize),
-    to_c: fn(f64) -> T,
-) -> fmi3Status {
-    with_instance(instance, function, masks3::GET_VALUE, |instance| {
-        // SAFETY: per the function's contract.
-        let vrs = unsafe { c_slice(vr, nvr, "valueReferences[]") }?;
-        let variables = resolve(&instance.sim.table().fmi3, vrs, n_values)?;
-        // SAFETY: per the function's contract.
-        let out = unsafe { c_slice_mut(values, n_values, "values[]") }?;
-        let mut worst = fmi2Status::fmi2OK;
-        let mut at = 0;
-        for v in variables {
-            let slots = &mut out[at..at + v.len()];
-            at += v.len();
-            let result = check_type(v, ty).and_then(|()| {
-                for (i, slot) in slots.iter_mut().enumerate() {
-                    *slot = to_c(read(instance, v, i, ty)?);
-                }
-                Ok(())
-            });
-            if let Err(e) = result {
-                worst = worst.max(instance.report(function, &e));
-            }
-        }
-        Ok(worst)
-    })
-    .into()
+/// Why `v`, which is not a model variable, cannot be set.
+pub(crate) fn not_settable(v: &Variable3) -> FmuError {
+    match v.source {
+        Source::Time => FmuError::NotSettable {
+            name: "time",
+            reason: "it is the independent variable (fmi3SetTime or fmi3DoStep moves it)",
+        },
+        _ => FmuError::NotSettable {
+            name: "event indicator",
+            reason: "it is calculated from the state",
+        },
+    }
 }
 
-/// One fmi3Set* function: its name, its allowed stages and its type.
-pub(crate) struct Setter {
-    pub function: &'static str,
-    pub mask: Mask,
-    pub ty: FmiType,
-}
-
-/// One fmi3Set* call.
-///
-/// # Safety
-/// `vr` must be NULL or hold `nvr` elements, `values` NULL or `n_values`.
-pub(crate) unsafe fn set_values<T: Copy>(
-    instance: fmi3Instance,
-    setter: Setter,
-    (vr, nvr): (*const fmi3ValueReference, usize),
-    (values, n_values): (*const T, usize),
-    from_c: fn(T) -> f64,
-) -> fmi3Status {
-    let Setter { function, mask, ty } = setter;
-    with_instance(instance, function, mask, |instance| {
-        // SAFETY: per the function's contract.
-        let vrs = unsafe { c_slice(vr, nvr, "valueReferences[]") }?;
-        let variables = resolve(&instance.sim.table().fmi3, vrs, n_values)?;
-        // SAFETY: per the function's contract.
-        let values = unsafe { c_slice(values, n_values, "values[]") }?;
-        let initialised = initialised(instance);
-        let mut worst = fmi2Status::fmi2OK;
-        let mut at = 0;
-        for v in variables {
-            let mine = &values[at..at + v.len()];
-            at += v.len();
-            let result = check_type(v, ty).and_then(|()| match &v.source {
-                Source::Model(elements) => {
-                    // Every element is tried; the first refusal is reported.
-                    let mut first = Ok(());
-                    for (&element, &value) in elements.iter().zip(mine) {
-                        let r = instance.sim.set(element, ty, from_c(value), initialised);
-                        if first.is_ok() {
-                            first = r;
-                        }
-                    }
-                    first
-                }
-                Source::Time => Err(FmuError::NotSettable {
-                    name: "time",
-                    reason: "it is the independent variable (fmi3SetTime or fmi3DoStep moves it)",
-                }),
-                Source::EventIndicator(_) => Err(FmuError::NotSettable {
-                    name: "event indicator",
-                    reason: "it is calculated from the state",
-                }),
-            });
-            if let Err(e) = result {
-                worst = worst.max(instance.report(function, &e));
-            }
-        }
-        Ok(worst)
-    })
-    .into()
-}
-
-/// Defines fmi3Get<T> and fmi3Set<T> for C type `$t`: the getter reads variables of
-/// `$ty` through `$to_c`, the setter (allowed in `$mask`) writes them through `$from_c`.
+/// Defines fmi3Get<T> and fmi3Set<T> for C type `$t` and value type `$ty`: the getter
+/// converts through `$to_c`, the setter (allowed in `$mask`) through `$from_c`. The body is
+/// here, not in a helper, so the model is two calls away: the guard, then the engine.
 macro_rules! accessors {
     ($get:ident, $set:ident, $t:ty, $ty:expr, $mask:expr, $to_c:expr, $from_c:expr) => {
         /// Reads the variables (arrays element by element) into `values`.
@@ -174,10 +78,41 @@ macro_rules! accessors {
             values: *mut $t,
             nValues: usize,
         ) -> fmi3Status {
-            let vrs = (valueReferences, nValueReferences);
+            use $crate::exports::fmi3::values::{computed, resolve};
+            use $crate::exports::guard::{c_slice, c_slice_mut, with_instance};
+            use $crate::table::Source;
             let function = stringify!($get);
-            // SAFETY: forwarded contract.
-            unsafe { get_values(instance, function, $ty, vrs, (values, nValues), $to_c) }
+            with_instance(instance, function, masks3::GET_VALUE, |instance| {
+                // SAFETY: per the function's contract.
+                let vrs =
+                    unsafe { c_slice(valueReferences, nValueReferences, "valueReferences[]") }?;
+                let variables = resolve(&instance.sim.table().fmi3, vrs, nValues)?;
+                // SAFETY: per the function's contract.
+                let out = unsafe { c_slice_mut(values, nValues, "values[]") }?;
+                let mut worst = $crate::fmi2_types::fmi2Status::fmi2OK;
+                let mut at = 0;
+                for v in variables {
+                    let slots = &mut out[at..at + v.len()];
+                    at += v.len();
+                    let result = $ty
+                        .check(&v.name, v.value_reference, v.kind)
+                        .and_then(|()| {
+                            match &v.source {
+                                Source::Model(elements) => {
+                                    for (slot, &index) in slots.iter_mut().zip(elements) {
+                                        *slot = $to_c(instance.sim.get(index));
+                                    }
+                                }
+                                _ => slots[0] = $to_c(computed(instance, v)?),
+                            }
+                            Ok(())
+                        });
+                    if let Err(e) = result {
+                        worst = worst.max(instance.report(function, &e));
+                    }
+                }
+                Ok(worst)
+            })
         }
 
         /// Writes `values` to the variables (arrays element by element).
@@ -192,14 +127,45 @@ macro_rules! accessors {
             values: *const $t,
             nValues: usize,
         ) -> fmi3Status {
-            let setter = Setter {
-                function: stringify!($set),
-                mask: $mask,
-                ty: $ty,
-            };
-            let vrs = (valueReferences, nValueReferences);
-            // SAFETY: forwarded contract.
-            unsafe { set_values(instance, setter, vrs, (values, nValues), $from_c) }
+            use $crate::exports::fmi3::values::{not_settable, resolve};
+            use $crate::exports::guard::{c_slice, with_instance};
+            use $crate::table::Source;
+            let function = stringify!($set);
+            with_instance(instance, function, $mask, |instance| {
+                // SAFETY: per the function's contract.
+                let vrs =
+                    unsafe { c_slice(valueReferences, nValueReferences, "valueReferences[]") }?;
+                let variables = resolve(&instance.sim.table().fmi3, vrs, nValues)?;
+                // SAFETY: per the function's contract.
+                let values = unsafe { c_slice(values, nValues, "values[]") }?;
+                let initialised = instance.initialised();
+                let mut worst = $crate::fmi2_types::fmi2Status::fmi2OK;
+                let mut at = 0;
+                for v in variables {
+                    let mine = &values[at..at + v.len()];
+                    at += v.len();
+                    let result = $ty
+                        .check(&v.name, v.value_reference, v.kind)
+                        .and_then(|()| {
+                            let Source::Model(elements) = &v.source else {
+                                return Err(not_settable(v));
+                            };
+                            // Every element is tried; the first refusal is reported.
+                            let mut first = Ok(());
+                            for (&index, &value) in elements.iter().zip(mine) {
+                                let r = instance.sim.set(index, $from_c(value), initialised);
+                                if first.is_ok() {
+                                    first = r;
+                                }
+                            }
+                            first
+                        });
+                    if let Err(e) = result {
+                        worst = worst.max(instance.report(function, &e));
+                    }
+                }
+                Ok(worst)
+            })
         }
     };
 }
@@ -209,7 +175,7 @@ accessors!(
     fmi3GetFloat64,
     fmi3SetFloat64,
     fmi3Float64,
-    FmiType::Float64,
+    ValueType::of(Api::Fmi3, ValueKind::Real),
     masks3::SET_FLOAT64,
     |v| v,
     |v| v
@@ -219,7 +185,7 @@ accessors!(
     fmi3GetInt32,
     fmi3SetInt32,
     fmi3Int32,
-    FmiType::Int32,
+    ValueType::of(Api::Fmi3, ValueKind::Integer),
     masks3::SET_OTHER,
     |v| v as i32,
     f64::from
@@ -228,7 +194,7 @@ accessors!(
     fmi3GetBoolean,
     fmi3SetBoolean,
     fmi3Boolean,
-    FmiType::Boolean3,
+    ValueType::of(Api::Fmi3, ValueKind::Boolean),
     masks3::SET_OTHER,
     |v| u8::from(v != 0.0),
     |v: u8| if v != 0 { 1.0 } else { 0.0 }

@@ -1,4 +1,5 @@
-//! A logger for Rust code that plays the importer (the crate's tests and benchmarks): the
+//! A logger for Rust code that plays the importer (the crate's tests and benchmarks; not part
+//! of the shipped library): the
 //! one place where a fixed-arity Rust function becomes the variadic `fmi2CallbackLogger`.
 //!
 //! The FMU always calls its logger with exactly one argument after the format ("%s",
@@ -6,10 +7,10 @@
 //! fixed-arity function with one more string parameter reads it. (Stable Rust cannot define
 //! a C-variadic function.)
 
-use crate::fmi2_types::{
+use flyloop_fmu::fmi2_types::{
     fmi2CallbackFunctions, fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status, fmi2String,
 };
-use crate::fmi3_types::{fmi3InstanceEnvironment, fmi3LogMessageCallback, fmi3Status};
+use flyloop_fmu::fmi3_types::{fmi3InstanceEnvironment, fmi3LogMessageCallback, fmi3Status};
 use std::ffi::{CStr, c_char, c_void};
 use std::sync::Mutex;
 

@@ -5,10 +5,10 @@
 //! The instance keeps every state it hands out; a pointer it does not know (freed already,
 //! foreign, garbage) is refused with fmi2Error instead of being dereferenced.
 
-use super::guard::{c_slice, c_slice_mut, with_instance, write_out};
 use crate::error::FmuError;
+use crate::exports::guard::{c_slice, c_slice_mut, with_instance, write_out};
 use crate::fmi2_types::*;
-use crate::instance::{SavedState, masks};
+use crate::instance::masks;
 use flyloop_core::number::Compact;
 use std::ffi::c_void;
 
@@ -32,13 +32,9 @@ pub(crate) unsafe fn get_state(
         // SAFETY: non-NULL and readable per the contract.
         let existing = unsafe { FMUstate.read() };
         let bytes = instance.sim.save(instance.stage.code())?;
-        if existing.is_null() {
-            let address = instance.adopt_state(SavedState { bytes });
-            // SAFETY: non-NULL and writable per the contract.
-            unsafe { FMUstate.write(address.cast()) };
-        } else {
-            instance.state_mut(existing as usize)?.bytes = bytes;
-        }
+        let address = instance.keep_state(existing as usize, bytes)?;
+        // SAFETY: non-NULL and writable per the contract.
+        unsafe { FMUstate.write(address.cast()) };
         instance.event(&format!(
             "{function}: state saved at t = {}",
             Compact(instance.sim.time())
@@ -167,96 +163,9 @@ pub(crate) unsafe fn deserialize(
         instance.stage_from_code(instance.sim.check_saved(bytes)?)?;
         // SAFETY: non-NULL and readable per the contract.
         let existing = unsafe { FMUstate.read() };
-        if existing.is_null() {
-            let address = instance.adopt_state(SavedState {
-                bytes: bytes.to_vec(),
-            });
-            // SAFETY: non-NULL and writable per the contract.
-            unsafe { FMUstate.write(address.cast()) };
-        } else {
-            instance.state_mut(existing as usize)?.bytes = bytes.to_vec();
-        }
+        let address = instance.keep_state(existing as usize, bytes.to_vec())?;
+        // SAFETY: non-NULL and writable per the contract.
+        unsafe { FMUstate.write(address.cast()) };
         Ok(fmi2Status::fmi2OK)
     })
-}
-
-/// See [`get_state`].
-///
-/// # Safety
-/// `FMUstate` must be NULL or valid for reads and writes of one pointer.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetFMUstate(
-    c: fmi2Component,
-    FMUstate: *mut fmi2FMUstate,
-) -> fmi2Status {
-    // SAFETY: forwarded contract.
-    unsafe { get_state(c, "fmi2GetFMUstate", FMUstate) }
-}
-
-/// See [`set_state`].
-///
-/// # Safety
-/// `c` must be NULL or a live instance.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
-    // SAFETY: forwarded contract.
-    unsafe { set_state(c, "fmi2SetFMUstate", FMUstate) }
-}
-
-/// See [`free_state`].
-///
-/// # Safety
-/// `FMUstate` must be NULL or valid for reads and writes of one pointer.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2FreeFMUstate(
-    c: fmi2Component,
-    FMUstate: *mut fmi2FMUstate,
-) -> fmi2Status {
-    // SAFETY: forwarded contract.
-    unsafe { free_state(c, "fmi2FreeFMUstate", FMUstate) }
-}
-
-/// # Safety
-/// `size` must be NULL or writable.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
-    c: fmi2Component,
-    FMUstate: fmi2FMUstate,
-    size: *mut usize,
-) -> fmi2Status {
-    // SAFETY: forwarded contract.
-    unsafe { serialized_size(c, "fmi2SerializedFMUstateSize", FMUstate, size) }
-}
-
-/// See [`serialize`].
-///
-/// # Safety
-/// `serializedState` must be NULL or writable for `size` bytes.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SerializeFMUstate(
-    c: fmi2Component,
-    FMUstate: fmi2FMUstate,
-    serializedState: *mut fmi2Byte,
-    size: usize,
-) -> fmi2Status {
-    let out = serializedState.cast::<u8>();
-    // SAFETY: forwarded contract.
-    unsafe { serialize(c, "fmi2SerializeFMUstate", FMUstate, out, size) }
-}
-
-/// See [`deserialize`].
-///
-/// # Safety
-/// `serializedState` must be NULL or readable for `size` bytes; `FMUstate` must be NULL or
-/// valid for reads and writes of one pointer.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
-    c: fmi2Component,
-    serializedState: *const fmi2Byte,
-    size: usize,
-    FMUstate: *mut fmi2FMUstate,
-) -> fmi2Status {
-    let bytes = serializedState.cast::<u8>();
-    // SAFETY: forwarded contract.
-    unsafe { deserialize(c, "fmi2DeSerializeFMUstate", bytes, size, FMUstate) }
 }

@@ -1,15 +1,18 @@
 //! The model-independent part of an FMU instance below the state machine: start values,
-//! the experiment, the time grid, variable access by type and causality, communication
-//! steps and FMU states. [`Engine`] does it for any [`FmuModel`]; the instance sees it
-//! through the object-safe [`Simulation`] so one library serves every model.
+//! the experiment, the time grid, variable access, communication steps, FMU states and Model
+//! Exchange (the importer's solver owns time and the continuous states; the engine checks
+//! array lengths and time, and keeps the time of the last event so the model's discrete
+//! changes happen at events only, never inside the solver's trial steps). [`Engine`] does it
+//! for any [`FmuModel`]; the instance sees it through the object-safe [`Simulation`] so one
+//! library serves every model.
 
 use crate::error::FmuError;
-use crate::model::{FmuModel, ModelTable, StepRequest, settable_after_initialisation};
+use crate::model::{Access, FmuModel, Hybrid, StepRequest};
 use crate::state_record;
+use crate::table::{ModelTable, settable_after_initialisation};
 use flyloop_core::SnapshotError;
 use flyloop_core::number::Compact;
-use flyloop_core::params::ValueKind;
-use flyloop_core::variables::Causality;
+use flyloop_core::variables::{self, Causality};
 use serde::{Deserialize, Serialize};
 
 /// A communication point matches the instance's time within this fraction of max(1 s, |t|)
@@ -23,68 +26,6 @@ pub const STEP_TOLERANCE: f64 = 1e-9;
 
 /// A single fmi2DoStep may run at most this many internal steps (≈ tens of seconds of CPU).
 pub const MAX_INTERNAL_STEPS: f64 = 1e8;
-
-/// The type an fmi2Get*/fmi2Set* or fmi3Get*/fmi3Set* function works with.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FmiType {
-    Real,
-    Integer,
-    Boolean,
-    String,
-    Float64,
-    Int32,
-    Boolean3,
-    /// An FMI 3.0 type no variable has (Float32, Int8, ..., String, Binary), by name.
-    Other3(&'static str),
-}
-
-impl FmiType {
-    fn name(self) -> &'static str {
-        match self {
-            FmiType::Real => "Real",
-            FmiType::Integer => "Integer",
-            FmiType::Boolean | FmiType::Boolean3 => "Boolean",
-            FmiType::String => "String",
-            FmiType::Float64 => "Float64",
-            FmiType::Int32 => "Int32",
-            FmiType::Other3(name) => name,
-        }
-    }
-
-    fn is_fmi3(self) -> bool {
-        matches!(
-            self,
-            FmiType::Float64 | FmiType::Int32 | FmiType::Boolean3 | FmiType::Other3(_)
-        )
-    }
-
-    /// The type of this FMI version that reads a variable of `kind`.
-    fn for_kind(self, kind: ValueKind) -> FmiType {
-        match (self.is_fmi3(), kind) {
-            (false, ValueKind::Real) => FmiType::Real,
-            (false, ValueKind::Integer) => FmiType::Integer,
-            (false, ValueKind::Boolean) => FmiType::Boolean,
-            (true, ValueKind::Real) => FmiType::Float64,
-            (true, ValueKind::Integer) => FmiType::Int32,
-            (true, ValueKind::Boolean) => FmiType::Boolean3,
-        }
-    }
-
-    pub(crate) fn matches(self, kind: ValueKind) -> bool {
-        self.for_kind(kind) == self
-    }
-
-    /// The error for a variable of another type than this function's.
-    pub fn mismatch(self, name: &'static str, vr: u32, kind: ValueKind) -> FmuError {
-        FmuError::WrongType {
-            name,
-            vr,
-            actual: self.for_kind(kind).name(),
-            requested: self.name(),
-            api: if self.is_fmi3() { "fmi3" } else { "fmi2" },
-        }
-    }
-}
 
 /// The time grid: t = base + n·h while the step size stays h, so time is never a running
 /// sum. A new step size starts a new segment at the current time.
@@ -140,19 +81,10 @@ impl Clock {
 }
 
 /// What fmi2SetupExperiment said.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Experiment {
     pub start: f64,
     pub stop: Option<f64>,
-}
-
-impl Default for Experiment {
-    fn default() -> Self {
-        Experiment {
-            start: 0.0,
-            stop: None,
-        }
-    }
 }
 
 /// The instance's simulation as the FMI functions drive it.
@@ -160,11 +92,11 @@ pub trait Simulation {
     fn table(&self) -> &'static ModelTable;
     /// fmi2SetupExperiment.
     fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> Result<(), FmuError>;
-    /// Reads `vr` through a function of type `ty`.
-    fn get(&self, vr: u32, ty: FmiType) -> Result<f64, FmuError>;
-    /// Writes `vr` through a function of type `ty`; `initialised` once past
+    /// Reads the variable at position `index` of the table.
+    fn get(&self, index: usize) -> f64;
+    /// Writes the variable at position `index` of the table; `initialised` once past
     /// fmi2ExitInitializationMode.
-    fn set(&mut self, vr: u32, ty: FmiType, value: f64, initialised: bool) -> Result<(), FmuError>;
+    fn set(&mut self, index: usize, value: f64, initialised: bool) -> Result<(), FmuError>;
     /// fmi2DoStep.
     fn do_step(&mut self, communication_point: f64, step_size: f64) -> Result<(), FmuError>;
     /// The instance's time, s.
@@ -179,7 +111,7 @@ pub trait Simulation {
     /// Applies state bytes; returns the stage code saved with them. Nothing changes on error.
     fn restore(&mut self, bytes: &[u8]) -> Result<u8, FmuError>;
 
-    // Model Exchange (see `crate::exchange`); each is an error for a Co-Simulation-only model.
+    // Model Exchange; each is an error for a Co-Simulation-only model.
     /// fmi2SetTime.
     fn set_time(&mut self, time: f64) -> Result<(), FmuError>;
     /// fmi2GetContinuousStates.
@@ -210,7 +142,11 @@ pub struct Engine<M: FmuModel> {
     experiment: Experiment,
     clock: Clock,
     /// Model Exchange: time of the last event (its discrete changes are done up to here).
-    pub(crate) event_time: f64,
+    event_time: f64,
+}
+
+fn co_simulation_only() -> FmuError {
+    FmuError::NotSupported("Model Exchange: this model is Co-Simulation only")
 }
 
 /// An FMU state: which model it belongs to (readable for any model, so that a state of
@@ -249,28 +185,38 @@ impl<M: FmuModel> Engine<M> {
         })
     }
 
-    /// The model (for tests and benchmarks that compare with the core).
-    pub fn model(&self) -> &M {
-        &self.model
-    }
-
-    pub(crate) fn model_mut(&mut self) -> &mut M {
-        &mut self.model
-    }
-
-    /// Model Exchange moves time by fmi2SetTime, not by steps.
-    pub(crate) fn set_clock(&mut self, time: f64) {
-        self.clock = Clock::at(time);
-    }
-
     /// Rebuilds the model from the start values, keeping the inputs set so far.
     fn rebuild(&mut self) -> Result<(), FmuError> {
         let mut model = M::build(Some(&self.model), &self.initial)?;
         for &(vr, value) in &self.early_inputs {
-            model.set(&mut self.initial, vr, value)?;
+            variables::set(&mut model, &mut self.initial, vr, value)?;
         }
         self.model = model;
         Ok(())
+    }
+
+    /// The model's hybrid view, after checking that the importer's array `name` of length
+    /// `len` has one entry per continuous state (`ni`: per event indicator).
+    fn hybrid(&self, len: usize, name: &str) -> Result<&dyn Hybrid, FmuError> {
+        let table = M::table();
+        let (Some(me), Some(hybrid)) = (&table.model_exchange, self.model.hybrid()) else {
+            return Err(co_simulation_only());
+        };
+        let (expected, what) = match name {
+            "ni" => (me.event_indicators, "event indicators"),
+            _ => (me.states.len(), "continuous states"),
+        };
+        if len != expected {
+            return Err(FmuError::InvalidArgument(format!(
+                "{name} = {len}, but {} has {expected} {what}",
+                table.info.identifier,
+            )));
+        }
+        Ok(hybrid)
+    }
+
+    fn hybrid_mut(&mut self) -> Result<&mut dyn Hybrid, FmuError> {
+        self.model.hybrid_mut().ok_or_else(co_simulation_only)
     }
 
     /// Decodes FMU state bytes completely: stage code, bookkeeping and a restored model.
@@ -292,7 +238,7 @@ impl<M: FmuModel> Engine<M> {
 
 impl<M: FmuModel> Simulation for Engine<M> {
     fn table(&self) -> &'static ModelTable {
-        M::table()
+        &M::table().table
     }
 
     fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> Result<(), FmuError> {
@@ -317,24 +263,17 @@ impl<M: FmuModel> Simulation for Engine<M> {
         Ok(())
     }
 
-    fn get(&self, vr: u32, ty: FmiType) -> Result<f64, FmuError> {
-        let variable = M::table()
-            .variable(vr)
-            .ok_or(FmuError::UnknownValueReference(vr))?;
-        if !ty.matches(variable.kind) {
-            return Err(ty.mismatch(variable.name, vr, variable.kind));
+    fn get(&self, index: usize) -> f64 {
+        match M::table().access[index] {
+            Access::Core(row) => row.get(&self.model, &self.initial),
+            Access::Local { read, at } => read(&self.model, at),
         }
-        Ok(self.model.get(&self.initial, vr)?)
     }
 
-    fn set(&mut self, vr: u32, ty: FmiType, value: f64, initialised: bool) -> Result<(), FmuError> {
-        let variable = M::table()
-            .variable(vr)
-            .ok_or(FmuError::UnknownValueReference(vr))?;
-        if !ty.matches(variable.kind) {
-            return Err(ty.mismatch(variable.name, vr, variable.kind));
-        }
-        let name = variable.name;
+    fn set(&mut self, index: usize, value: f64, initialised: bool) -> Result<(), FmuError> {
+        let table = M::table();
+        let variable = &table.variables[index];
+        let (name, vr) = (variable.name, variable.value_reference);
         match variable.causality {
             Causality::Output => {
                 return Err(FmuError::NotSettable {
@@ -353,7 +292,10 @@ impl<M: FmuModel> Simulation for Engine<M> {
             }
             _ => {}
         }
-        self.model.set(&mut self.initial, vr, value)?;
+        let Access::Core(row) = table.access[index] else {
+            return Err(FmuError::UnknownValueReference(vr));
+        };
+        row.set(&mut self.model, &mut self.initial, value)?;
         if !initialised {
             if variable.causality == Causality::Input {
                 self.early_inputs.retain(|&(v, _)| v != vr);
@@ -451,37 +393,67 @@ impl<M: FmuModel> Simulation for Engine<M> {
         Ok(stage)
     }
 
+    /// A finite time not before the last event (a solver may go back within a step it
+    /// rejects, never past an event it has handled).
     fn set_time(&mut self, time: f64) -> Result<(), FmuError> {
-        crate::exchange::set_time(self, time)
+        self.hybrid_mut()?;
+        let last = self.event_time;
+        if !time.is_finite() || time < last - TIME_TOLERANCE * last.abs().max(1.0) {
+            return Err(FmuError::InvalidArgument(format!(
+                "time {} is not a finite time at or after the last event ({})",
+                Compact(time),
+                Compact(last)
+            )));
+        }
+        self.clock = Clock::at(time);
+        Ok(())
     }
 
     fn continuous_states(&self, x: &mut [f64]) -> Result<(), FmuError> {
-        crate::exchange::hybrid(self, x.len(), "nx")?.states(x);
+        self.hybrid(x.len(), "nx")?.states(x);
         Ok(())
     }
 
     fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), FmuError> {
-        crate::exchange::hybrid(self, x.len(), "nx")?;
-        crate::exchange::hybrid_mut(self)?.set_states(x)
+        self.hybrid(x.len(), "nx")?;
+        self.hybrid_mut()?.set_states(x)
     }
 
     fn derivatives(&self, dx: &mut [f64]) -> Result<(), FmuError> {
-        crate::exchange::hybrid(self, dx.len(), "nx")?.derivatives(dx);
+        self.hybrid(dx.len(), "nx")?.derivatives(dx);
         Ok(())
     }
 
     fn event_indicators(&self, z: &mut [f64]) -> Result<(), FmuError> {
-        crate::exchange::event_indicators(self, z)
+        self.hybrid(z.len(), "ni")?.event_indicators(z);
+        Ok(())
     }
 
     fn nominals(&self, nominals: &mut [f64]) -> Result<(), FmuError> {
-        crate::exchange::hybrid(self, nominals.len(), "nx")?;
+        self.hybrid(nominals.len(), "nx")?;
         nominals.fill(1.0);
         Ok(())
     }
 
     fn new_discrete_states(&mut self) -> Result<(bool, Option<f64>), FmuError> {
-        crate::exchange::new_discrete_states(self)
+        let now = self.time();
+        let elapsed = (now - self.event_time).max(0.0);
+        let n = M::table()
+            .model_exchange
+            .as_ref()
+            .map_or(0, |me| me.states.len());
+        let (mut before, mut after) = (vec![0.0; n], vec![0.0; n]);
+        let hybrid = self.hybrid_mut()?;
+        hybrid.states(&mut before);
+        hybrid.event_update(elapsed);
+        hybrid.states(&mut after);
+        let next = hybrid.time_event_after().map(|dt| now + dt);
+        self.event_time = now;
+        let changed = before
+            .iter()
+            .zip(&after)
+            .any(|(a, b)| a.to_bits() != b.to_bits());
+        Ok((changed, next))
     }
 
     fn completed_integrator_step(&self) -> Result<(), FmuError> {

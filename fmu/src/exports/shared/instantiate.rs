@@ -1,0 +1,86 @@
+//! What fmi2Instantiate and FMI 3.0's fmi3Instantiate* share: checking the name, the
+//! interface and the GUID / instantiation token, creating the model, and saying why when any
+//! of it fails.
+
+use crate::fmi2_types::fmi2Status;
+use crate::instance::{Instance, Interface};
+use crate::log::{Category, Logger, Sink};
+use crate::models;
+use crate::table::Api;
+use std::ffi::{CStr, c_void};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
+/// An instantiation request, its C arguments already read.
+pub(crate) struct Request<'a> {
+    /// The C function's name, for messages.
+    pub function: &'static str,
+    pub api: Api,
+    pub name: Option<&'a CStr>,
+    /// The interface asked for, or why the argument does not name one.
+    pub interface: Result<Interface, String>,
+    /// FMI 2.0's GUID or FMI 3.0's instantiation token.
+    pub token: Option<&'a CStr>,
+    pub sink: Sink,
+    pub logging_on: bool,
+}
+
+/// The new instance, or `None` after logging why not.
+pub(crate) fn create_instance(request: &Request<'_>) -> Option<*mut Instance> {
+    match new_instance(request) {
+        Ok(instance) => Some(Box::into_raw(Box::new(instance))),
+        Err(message) => {
+            let shown = request.name.map(CStr::to_owned).unwrap_or_default();
+            let message = format!("{}: {message}", request.function);
+            // SAFETY: the sink's callback and environment come together from the importer.
+            unsafe {
+                (request.sink).send(&shown, fmi2Status::fmi2Error, Category::Error, &message)
+            };
+            None
+        }
+    }
+}
+
+/// The instance `request` asks for, or why there is none.
+fn new_instance(request: &Request<'_>) -> Result<Instance, String> {
+    let name = (request.name.filter(|n| !n.is_empty())).ok_or("instanceName is NULL or empty")?;
+    let interface = request.interface.clone()?;
+    let token_name = request.api.token_name();
+    let token = request.token.ok_or(format!("{token_name} is NULL"))?;
+    let token = token.to_string_lossy();
+    let Some(sim) = models::simulation_for(request.api, &token) else {
+        let known: Vec<String> = models::tables()
+            .iter()
+            .map(|t| format!("{} {}", t.info.identifier, t.token(request.api)))
+            .collect();
+        return Err(format!(
+            "{token_name} {token} is not one of this library's models ({}); the \
+             modelDescription.xml and the binary do not belong together",
+            known.join(", ")
+        ));
+    };
+    let sim = sim.map_err(|e| format!("the model does not start: {e}"))?;
+    let identifier = sim.table().info.identifier;
+    if interface == Interface::ModelExchange && sim.table().model_exchange.is_none() {
+        return Err(format!(
+            "{identifier} is Co-Simulation only (its physics engine steps internally); \
+             instantiate it for Co-Simulation"
+        ));
+    }
+    let logger = Logger::new(request.sink, name.to_owned());
+    let instance = Instance::new(request.api, interface, logger, request.logging_on, sim);
+    let function = request.function;
+    instance.event(&format!(
+        "{function}: {identifier} {interface:?} instance ({token}) created"
+    ));
+    Ok(instance)
+}
+
+/// The instance `build` asks for, or NULL (`build` gives `None` when there is no logger to
+/// tell why; a panic, caught here, gives NULL too).
+pub(crate) fn instantiate<'a>(build: impl FnOnce() -> Option<Request<'a>>) -> *mut c_void {
+    let outcome = catch_unwind(AssertUnwindSafe(|| create_instance(&build()?)));
+    match outcome {
+        Ok(Some(instance)) => instance.cast(),
+        _ => std::ptr::null_mut(),
+    }
+}

@@ -1,0 +1,69 @@
+//! The Model Exchange bodies of FMI 2.0 and FMI 3.0: the importer's solver sets time and
+//! continuous states, reads derivatives and event indicators, and calls the event functions.
+//! Each mask refuses a Co-Simulation instance; NULL pointers and wrong array lengths are
+//! refused with a log line, never a crash.
+
+use crate::error::FmuError;
+use crate::exports::guard::{with_instance, write_out};
+use crate::fmi2_types::*;
+use crate::instance::{Instance, Mask, Stage, masks};
+use flyloop_core::number::Compact;
+
+/// The body of a Model Exchange function that only moves the instance to `stage`.
+pub(crate) fn enter(
+    c: fmi2Component,
+    function: &'static str,
+    mask: Mask,
+    stage: Stage,
+) -> fmi2Status {
+    with_instance(c, function, mask, |instance| {
+        instance.stage = stage;
+        Ok(fmi2Status::fmi2OK)
+    })
+}
+
+/// The discrete changes of the event at the current time, logged as `function`'s event:
+/// whether the continuous states changed, and the next time event (the part of
+/// fmi2NewDiscreteStates and fmi3UpdateDiscreteStates that is not C arguments).
+pub(crate) fn discrete_update(
+    instance: &mut Instance,
+    function: &str,
+) -> Result<(bool, Option<f64>), FmuError> {
+    let (changed, next) = instance.sim.new_discrete_states()?;
+    instance.event(&format!(
+        "{function}: t = {}, next time event {}",
+        Compact(instance.sim.time()),
+        next.map_or("none".to_string(), |t| Compact(t).to_string())
+    ));
+    Ok((changed, next))
+}
+
+/// The body of fmi2CompletedIntegratorStep and fmi3CompletedIntegratorStep: no step event
+/// and no termination (`no` is the version's false); an error (Error stage) once the state is
+/// not finite.
+///
+/// # Safety
+/// The two flags must be NULL or writable.
+pub(crate) unsafe fn completed_integrator_step<B: Copy>(
+    c: fmi2Component,
+    function: &'static str,
+    enter_event_mode: *mut B,
+    terminate_simulation: *mut B,
+    no: B,
+) -> fmi2Status {
+    with_instance(c, function, masks::COMPLETED_INTEGRATOR_STEP, |instance| {
+        if enter_event_mode.is_null() {
+            return Err(FmuError::NullArgument("enterEventMode"));
+        }
+        if terminate_simulation.is_null() {
+            return Err(FmuError::NullArgument("terminateSimulation"));
+        }
+        instance.sim.completed_integrator_step()?;
+        // SAFETY: both non-NULL (checked above) and writable per the contract.
+        unsafe {
+            write_out(enter_event_mode, no, "enterEventMode")?;
+            write_out(terminate_simulation, no, "terminateSimulation")?;
+        }
+        Ok(fmi2Status::fmi2OK)
+    })
+}
