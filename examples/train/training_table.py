@@ -75,9 +75,10 @@ def main(argv: list[str] | None = None) -> int:
         walls = " / ".join(f"{r['wall_time_s']:.0f}" for r in runs)
         rates = " / ".join(f"{100 * r['evaluation']['success_rate']:.1f} %" for r in runs)
         episodes = runs[0]["evaluation"]["episodes"]
+        name = runs[0]["env_id"].split("/")[-1]
         lines.append(
-            f"| {runs[0]['env_id'].split('/')[-1]} (`{task}`) | {', '.join(f'{s:,}' for s in steps)}"
-            f" | {walls} | {rates} ({episodes}) | `fast_ppo.py --env {task} --seed S` |"
+            f"| {name} (`{task}`) | {', '.join(f'{s:,}' for s in steps)} | {walls} "
+            f"| {rates} ({episodes}) | `fast_ppo.py --env {task} --seed S` |"
         )
     table = "\n".join(lines)
     print(table)
