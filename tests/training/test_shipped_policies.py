@@ -14,13 +14,12 @@ POLICIES = REPO / "policies"
 HELD_BACK_SEEDS = 2_000_000
 
 
-# (policy, held-back episodes, landing rate required, held-out target). lander_static is a
-# fast_ppo.py run (policy.pt; its summary.json holds the held-out evaluation on seeds
-# 1,000,000..1,000,199: 200/200), measured 50/50 here; a policy meeting the 95 % target lands
-# >= 44 of 50 with probability 0.96. lander_moving is still the stable-baselines3 run (no
-# fast run met its target yet): 97 % on seeds 1,000,000.., 88 % on 2,000,000.. and 83 % on
-# 3,000,000.. (100 each), 42/50 here.
-SHIPPED = [("lander_static", 50, 0.88, 0.95), ("lander_moving", 50, 0.75, None)]
+# (policy, held-back episodes, landing rate required, held-out target). Both are fast_ppo.py
+# runs (policy.pt; their summary.json holds the held-out evaluation on seeds
+# 1,000,000..1,000,199), measured 50/50 here each. A policy meeting the target lands >= 44
+# of 50 with probability 0.99 (static, 95 %) and >= 41 of 50 with probability 0.98 (moving,
+# 90 %).
+SHIPPED = [("lander_static", 50, 0.88, 0.95), ("lander_moving", 50, 0.82, 0.90)]
 
 
 @pytest.mark.parametrize(("name", "episodes", "required", "target"), SHIPPED)
