@@ -3,7 +3,6 @@
 
 use crate::cli::{Args, GcsTarget, ListFormat};
 use crate::config::{self, ConfigError};
-use crate::model::{ModelKind, TaskConfig, TaskInstance, TaskKind};
 use crate::px4::config::Px4Config;
 use crate::px4::server::Pacing;
 use crate::px4::session::{Session, SessionOptions};
@@ -14,6 +13,7 @@ use crate::{ardupilot, px4};
 use crate::{param_table, starter_config, task_frame};
 use clap::Parser;
 use flyloop_core::ParamError;
+use flyloop_core::tasks::registry::{ModelKind, TaskConfig, TaskInstance, TaskKind};
 use std::io::IsTerminal;
 use std::net::SocketAddr;
 use std::time::Instant;

@@ -4,6 +4,7 @@
 
 use flyloop_core::lander2d::Lander2d;
 use flyloop_core::quadrotor::Quadrotor;
+use flyloop_core::tasks::registry::TaskInstance;
 use nalgebra::{UnitQuaternion, Vector3};
 
 /// Standard gravity for milli-g units (mG), m/s².
@@ -38,6 +39,15 @@ pub fn euler_ned(attitude_enu: &UnitQuaternion<f64>) -> (f64, f64, f64) {
 }
 
 impl Kinematics {
+    /// The state of `task`'s vehicle.
+    pub fn of_task(task: &TaskInstance) -> Self {
+        match task {
+            TaskInstance::Hover(t) => Kinematics::of_quadrotor(t.quadrotor()),
+            TaskInstance::Waypoints(t) => Kinematics::of_quadrotor(t.quadrotor()),
+            TaskInstance::Landing(t) => Kinematics::of_lander(t.lander()),
+        }
+    }
+
     /// The quadrotor's state, already in ENU/FLU.
     pub fn of_quadrotor(q: &Quadrotor) -> Self {
         let b = &q.body;

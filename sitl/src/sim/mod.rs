@@ -5,11 +5,11 @@
 
 use crate::gcs_streams::GcsStreams;
 use crate::kinematics::Home;
-use crate::model::{TaskConfig, TaskKind};
 use crate::stats::Stats;
 use crate::telemetry;
 use crate::vehicle::Vehicle;
 use crate::wire::{self, Encoder, Incoming};
+use flyloop_core::tasks::registry::{TaskConfig, TaskKind};
 
 use flyloop_core::ParamError;
 use mavlink::MavHeader;
