@@ -58,7 +58,7 @@ impl Kinematics {
             body_rates: b.body_rates,
             acceleration: q.accelerations().0,
             gravity: q.params.gravity,
-            air_velocity: b.velocity - q.wind_velocity(),
+            air_velocity: q.air_velocity(),
         }
     }
 
@@ -69,15 +69,15 @@ impl Kinematics {
     pub fn of_lander(l: &Lander2d) -> Self {
         let d = l.drone();
         let [ax, ay] = l.acceleration();
-        let velocity = Vector3::new(d.vx, 0.0, d.vy);
+        let [air_x, air_y] = l.air_velocity();
         Kinematics {
             position: Vector3::new(d.x, 0.0, d.y),
-            velocity,
+            velocity: Vector3::new(d.vx, 0.0, d.vy),
             attitude: UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -d.angle),
             body_rates: Vector3::new(0.0, -d.angular_velocity, 0.0),
             acceleration: Vector3::new(ax, 0.0, ay),
             gravity: l.params().gravity,
-            air_velocity: velocity,
+            air_velocity: Vector3::new(air_x, 0.0, air_y),
         }
     }
 
