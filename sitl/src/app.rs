@@ -175,16 +175,7 @@ fn start_px4(args: Args) -> Result<(), StartError> {
 /// The vehicle of the autopilot modes: `--config`, else the Iris preset.
 fn vehicle_config(args: &Args) -> Result<Px4Config, StartError> {
     Ok(match &args.config {
-        Some(path) => {
-            let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
-                path: path.clone(),
-                source,
-            })?;
-            Px4Config::parse(&text).map_err(|source| ConfigError::Invalid {
-                path: path.clone(),
-                source,
-            })?
-        }
+        Some(path) => config::read(path, Px4Config::parse)?,
         None => Px4Config::iris(),
     })
 }

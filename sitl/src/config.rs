@@ -83,12 +83,22 @@ pub(crate) fn toml_number(value: &toml::Value) -> Option<f64> {
     }
 }
 
+/// The parameter sets of `task` from the file at `path`.
 pub fn load(task: TaskKind, path: &Path) -> Result<TaskConfig, ConfigError> {
+    read(path, |text| parse(task, text))
+}
+
+/// Reads the parameter file at `path` with `parse`; the one loader of every mode, so a
+/// missing file and a bad value are reported the same way.
+pub fn read<T>(
+    path: &Path,
+    parse: impl FnOnce(&str) -> Result<T, ParamError>,
+) -> Result<T, ConfigError> {
     let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
         path: path.to_path_buf(),
         source,
     })?;
-    parse(task, &text).map_err(|source| ConfigError::Invalid {
+    parse(&text).map_err(|source| ConfigError::Invalid {
         path: path.to_path_buf(),
         source,
     })
