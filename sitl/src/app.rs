@@ -114,11 +114,7 @@ fn describe_frame(task: TaskKind, config: &TaskConfig) -> Result<String, ParamEr
 /// PX4 mode: the vehicle and sensor parameters, the TCP listener, then PX4 connections until
 /// a signal.
 fn start_px4(args: Args) -> Result<(), StartError> {
-    if args.model() != ModelKind::Quadrotor {
-        return Err(StartError::Options(
-            "--px4 flies the quadrotor only".to_string(),
-        ));
-    }
+    quadrotor_only(&args, "--px4")?;
     let mut config = vehicle_config(&args)?;
     config.sensors.home_latitude = args.home.latitude_deg;
     config.sensors.home_longitude = args.home.longitude_deg;
@@ -129,12 +125,7 @@ fn start_px4(args: Args) -> Result<(), StartError> {
         step_us,
         seed: args.seed,
     })?;
-    if let Some(path) = &args.track {
-        let track =
-            Track::create(path, args.track_interval_us).map_err(|source| StartError::Track {
-                path: path.clone(),
-                source,
-            })?;
+    if let Some(track) = track(&args)? {
         session.set_track(track);
     }
     let listener =
@@ -172,6 +163,29 @@ fn start_px4(args: Args) -> Result<(), StartError> {
     Ok(())
 }
 
+/// The autopilot modes fly the quadrotor only.
+fn quadrotor_only(args: &Args, mode_flag: &str) -> Result<(), StartError> {
+    if args.model() != ModelKind::Quadrotor {
+        return Err(StartError::Options(format!(
+            "{mode_flag} flies the quadrotor only"
+        )));
+    }
+    Ok(())
+}
+
+/// The ground-truth CSV of the autopilot modes (`--track`), if asked for.
+fn track(args: &Args) -> Result<Option<Track>, StartError> {
+    let Some(path) = &args.track else {
+        return Ok(None);
+    };
+    let track =
+        Track::create(path, args.track_interval_us).map_err(|source| StartError::Track {
+            path: path.clone(),
+            source,
+        })?;
+    Ok(Some(track))
+}
+
 /// The vehicle of the autopilot modes: `--config`, else the Iris preset.
 fn vehicle_config(args: &Args) -> Result<Px4Config, StartError> {
     Ok(match &args.config {
@@ -182,22 +196,13 @@ fn vehicle_config(args: &Args) -> Result<Px4Config, StartError> {
 
 /// ArduPilot mode: the vehicle, the UDP socket, then ArduPilot's frames until a signal.
 fn start_ardupilot(args: Args) -> Result<(), StartError> {
-    if args.model() != ModelKind::Quadrotor {
-        return Err(StartError::Options(
-            "--ardupilot flies the quadrotor only".to_string(),
-        ));
-    }
+    quadrotor_only(&args, "--ardupilot")?;
     let config = vehicle_config(&args)?;
     let mut session = ardupilot::session::Session::new(&ardupilot::session::SessionOptions {
         config,
         seed: args.seed,
     })?;
-    if let Some(path) = &args.track {
-        let track =
-            Track::create(path, args.track_interval_us).map_err(|source| StartError::Track {
-                path: path.clone(),
-                source,
-            })?;
+    if let Some(track) = track(&args)? {
         session.set_track(track);
     }
     let socket =
