@@ -141,9 +141,7 @@ fn start_px4(args: Args) -> Result<(), StartError> {
         "flyloop-sitl ready px4={listen} mode=px4 model=quadrotor step_us={step_us} speed_factor={speed} seed={}",
         args.seed
     );
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()?;
+    let runtime = single_thread_runtime()?;
     let session = runtime.block_on(async move {
         let shutdown = server::Shutdown::install()?;
         let listener = tokio::net::TcpListener::from_std(listener)?;
@@ -161,6 +159,13 @@ fn start_px4(args: Args) -> Result<(), StartError> {
     })?;
     tracing::info!("stopped: {}", session.stats);
     Ok(())
+}
+
+/// The tokio runtime every mode's sockets and signals run on.
+fn single_thread_runtime() -> std::io::Result<tokio::runtime::Runtime> {
+    tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
 }
 
 /// The autopilot modes fly the quadrotor only.
@@ -217,9 +222,7 @@ fn start_ardupilot(args: Args) -> Result<(), StartError> {
         "flyloop-sitl ready ardupilot={listen} mode=ardupilot model=quadrotor speed_factor={speed} seed={}",
         args.seed
     );
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()?;
+    let runtime = single_thread_runtime()?;
     let session = runtime.block_on(async move {
         let shutdown = server::Shutdown::install()?;
         println!("{ready}");
@@ -250,21 +253,30 @@ fn start(args: Args) -> Result<(), StartError> {
         Some(path) => config::load(task, path)?,
         None => TaskConfig::default(),
     };
-    match args.list_params {
-        Some(ListFormat::Table) => {
-            print!("{}", param_table::listing(task, &config));
-            return Ok(());
-        }
-        Some(ListFormat::Toml) => {
-            print!("{}", starter_config::starter_toml(task, &config));
-            return Ok(());
-        }
-        None => {}
-    }
-    if args.describe_frame {
-        print!("{}", describe_frame(task, &config)?);
+    if let Some(text) = printout(&args, task, &config)? {
+        print!("{text}");
         return Ok(());
     }
+    start_mavlink(args, task, config)
+}
+
+/// What `--list-params` or `--describe-frame` prints instead of running, if asked for.
+fn printout(
+    args: &Args,
+    task: TaskKind,
+    config: &TaskConfig,
+) -> Result<Option<String>, StartError> {
+    Ok(match args.list_params {
+        Some(ListFormat::Table) => Some(param_table::listing(task, config)),
+        Some(ListFormat::Toml) => Some(starter_config::starter_toml(task, config)),
+        None if args.describe_frame => Some(describe_frame(task, config)?),
+        None => None,
+    })
+}
+
+/// The MAVLink SITL (lockstep or real time): the vehicles, the sockets, then datagrams until
+/// a signal.
+fn start_mavlink(args: Args, task: TaskKind, config: TaskConfig) -> Result<(), StartError> {
     let mut options = SimOptions::new(task);
     options.vehicles = args.vehicles;
     options.seed = args.seed;
@@ -295,9 +307,7 @@ fn start(args: Args) -> Result<(), StartError> {
         args.seed
     );
 
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()?;
+    let runtime = single_thread_runtime()?;
     let stats = runtime.block_on(async move {
         let shutdown = server::Shutdown::install()?;
         let controller = tokio::net::UdpSocket::from_std(controller)?;
