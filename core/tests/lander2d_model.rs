@@ -513,3 +513,18 @@ fn a_finer_physics_step_refines_the_same_flight() {
     );
     assert_ne!(one, four);
 }
+
+#[test]
+fn the_air_velocity_is_the_drone_velocity_since_the_wind_is_a_force() {
+    let p = Lander2dParams::default();
+    let hover = p.command_for_thrust(p.hover_thrust()).unwrap();
+    let mut l = lander(p, at(25.0, 40.0));
+    l.set_external_wind_force([3.0, 0.0]).unwrap();
+    l.set_command([hover, hover]).unwrap();
+    for _ in 0..50 {
+        l.step();
+    }
+    let d = l.drone();
+    assert!(d.vx > 0.0, "the wind pushes it east: {d:?}");
+    assert_eq!(l.air_velocity(), [d.vx, d.vy]);
+}

@@ -247,3 +247,21 @@ fn a_dropped_vehicle_bounces_lower_each_time_and_comes_to_rest() {
         assert!((energy(&quad) - rest_energy).abs() < 1e-6);
     }
 }
+
+#[test]
+fn standing_starts_level_at_the_origin_facing_north_with_the_gear_carrying_it() {
+    for params in [still_air(), iris()] {
+        let q = Quadrotor::standing(params.clone(), 4).unwrap();
+        assert_eq!(
+            q.body.position,
+            Vector3::new(0.0, 0.0, rest_height(&params))
+        );
+        let (roll, pitch, yaw) = q.attitude().euler_angles();
+        assert!(roll.abs() < 1e-12 && pitch.abs() < 1e-12, "{roll} {pitch}");
+        assert!((yaw - std::f64::consts::FRAC_PI_2).abs() < 1e-12, "{yaw}");
+        let (linear, _) = q.accelerations();
+        assert!(linear.norm() < 1e-9, "the feet carry m·g: {linear}");
+    }
+    let windy = Quadrotor::standing(QuadrotorParams::default(), 4).unwrap();
+    assert_eq!(windy.air_velocity(), -windy.wind_velocity(), "at rest");
+}

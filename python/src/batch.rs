@@ -7,9 +7,7 @@
 
 use crate::tables::{task_config, task_kind};
 use flyloop_core::tasks::InfoValue;
-use flyloop_sitl::model::TaskInstance;
-use flyloop_sitl::task_frame::push_infos;
-use flyloop_sitl::vehicle::clamp_controls;
+use flyloop_core::tasks::registry::{TaskInstance, clamp_controls, push_infos};
 use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2, PyReadwriteArray1, PyReadwriteArray2};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;

@@ -9,9 +9,11 @@
 //!   console command).
 //!
 //! Nothing here computes physics, a reward or a termination: every step goes through the
-//! same [`flyloop_sitl::model::TaskInstance`] the SITL flies, actions are treated by the
-//! SITL's [`flyloop_sitl::vehicle::clamp_controls`] and info values flattened by its
-//! [`flyloop_sitl::task_frame::push_infos`].
+//! core's task registry the SITL flies too ([`flyloop_core::tasks::registry`]): the same
+//! [`TaskInstance`](flyloop_core::tasks::registry::TaskInstance), actions treated by
+//! [`clamp_controls`](flyloop_core::tasks::registry::clamp_controls) and info values
+//! flattened by [`push_infos`](flyloop_core::tasks::registry::push_infos). The SITL crate is
+//! linked for the `flyloop-sitl` command alone ([`sitl_command`]).
 
 mod batch;
 mod sitl_command;
@@ -33,8 +35,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sitl_command::sitl_main, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_test, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
-    // The task frame's layout (flyloop_sitl::task_frame), for the SITL backend's reader.
-    m.add("FRAME_HEADER_LEN", flyloop_sitl::task_frame::HEADER_LEN)?;
-    m.add("FRAME_ARRAY_LEN", flyloop_sitl::task_frame::ARRAY_LEN)?;
+    sitl_command::add_frame_layout(m)?;
     Ok(())
 }

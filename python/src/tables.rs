@@ -4,9 +4,8 @@
 use flyloop_core::params::ValueKind;
 use flyloop_core::tasks::InfoValue;
 use flyloop_core::tasks::randomization::ParamRange;
-use flyloop_sitl::config;
-use flyloop_sitl::model::{TaskConfig, TaskInstance, TaskKind};
-use flyloop_sitl::param_table;
+use flyloop_core::tasks::registry::param_rows;
+use flyloop_core::tasks::registry::{TaskConfig, TaskInstance, TaskKind, from_values_and_ranges};
 use numpy::PyArray1;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -14,14 +13,11 @@ use pyo3::types::{PyDict, PyList};
 
 /// The task named `name` (the SITL's `--task`).
 pub fn task_kind(name: &str) -> PyResult<TaskKind> {
-    match name {
-        "hover" => Ok(TaskKind::Hover),
-        "waypoints" => Ok(TaskKind::Waypoints),
-        "landing" => Ok(TaskKind::Landing),
-        _ => Err(PyValueError::new_err(format!(
+    TaskKind::from_name(name).ok_or_else(|| {
+        PyValueError::new_err(format!(
             "task must be 'hover', 'waypoints' or 'landing', got {name:?}"
-        ))),
-    }
+        ))
+    })
 }
 
 /// Prefix of a config key that holds a randomisation range: `"randomize.mass": (1.2, 1.8)`
@@ -30,7 +26,7 @@ const RANGE_PREFIX: &str = "randomize.";
 
 /// The parameter sets of `task` from `{core name or param_id: number}` and
 /// `{"randomize.<name>": (low, high)}`, checked by the core exactly as the SITL checks its
-/// config file; errors are ValueErrors carrying the core's message (it names the parameter
+/// parameter file; errors are ValueErrors carrying the core's message (it names the parameter
 /// and its bound).
 pub fn task_config(task: TaskKind, params: Option<&Bound<'_, PyDict>>) -> PyResult<TaskConfig> {
     let mut pairs: Vec<(String, f64)> = Vec::new();
@@ -61,7 +57,7 @@ pub fn task_config(task: TaskKind, params: Option<&Bound<'_, PyDict>>) -> PyResu
             pairs.push((name, number));
         }
     }
-    config::from_values_and_ranges(task, pairs.iter().map(|(k, v)| (k.as_str(), *v)), ranges)
+    from_values_and_ranges(task, pairs.iter().map(|(k, v)| (k.as_str(), *v)), ranges)
         .map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
@@ -117,7 +113,7 @@ pub fn describe<'py>(
     out.set_item("info", info_layout(&instance))?;
     let defaults = TaskConfig::default();
     let rows = PyList::empty(py);
-    for e in param_table::entries(kind) {
+    for e in param_rows::entries(kind) {
         let row = PyDict::new(py);
         row.set_item("name", e.name)?;
         row.set_item("id", &e.id)?;
@@ -127,7 +123,7 @@ pub fn describe<'py>(
         row.set_item("min", e.min)?;
         row.set_item("max", e.max)?;
         let get = |c: &TaskConfig| {
-            param_table::get(c, e.group, e.name)
+            param_rows::get(c, e.group, e.name)
                 .map_err(|err| PyValueError::new_err(err.to_string()))
         };
         row.set_item("default", get(&defaults)?)?;

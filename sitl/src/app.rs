@@ -3,7 +3,6 @@
 
 use crate::cli::{Args, GcsTarget, ListFormat};
 use crate::config::{self, ConfigError};
-use crate::model::{ModelKind, TaskConfig, TaskInstance, TaskKind};
 use crate::px4::config::Px4Config;
 use crate::px4::server::Pacing;
 use crate::px4::session::{Session, SessionOptions};
@@ -14,6 +13,7 @@ use crate::{ardupilot, px4};
 use crate::{param_table, starter_config, task_frame};
 use clap::Parser;
 use flyloop_core::ParamError;
+use flyloop_core::tasks::registry::{ModelKind, TaskConfig, TaskInstance, TaskKind};
 use std::io::IsTerminal;
 use std::net::SocketAddr;
 use std::time::Instant;
@@ -114,11 +114,7 @@ fn describe_frame(task: TaskKind, config: &TaskConfig) -> Result<String, ParamEr
 /// PX4 mode: the vehicle and sensor parameters, the TCP listener, then PX4 connections until
 /// a signal.
 fn start_px4(args: Args) -> Result<(), StartError> {
-    if args.model() != ModelKind::Quadrotor {
-        return Err(StartError::Options(
-            "--px4 flies the quadrotor only".to_string(),
-        ));
-    }
+    quadrotor_only(&args, "--px4")?;
     let mut config = vehicle_config(&args)?;
     config.sensors.home_latitude = args.home.latitude_deg;
     config.sensors.home_longitude = args.home.longitude_deg;
@@ -129,12 +125,7 @@ fn start_px4(args: Args) -> Result<(), StartError> {
         step_us,
         seed: args.seed,
     })?;
-    if let Some(path) = &args.track {
-        let track =
-            Track::create(path, args.track_interval_us).map_err(|source| StartError::Track {
-                path: path.clone(),
-                source,
-            })?;
+    if let Some(track) = track(&args)? {
         session.set_track(track);
     }
     let listener =
@@ -150,9 +141,7 @@ fn start_px4(args: Args) -> Result<(), StartError> {
         "flyloop-sitl ready px4={listen} mode=px4 model=quadrotor step_us={step_us} speed_factor={speed} seed={}",
         args.seed
     );
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()?;
+    let runtime = single_thread_runtime()?;
     let session = runtime.block_on(async move {
         let shutdown = server::Shutdown::install()?;
         let listener = tokio::net::TcpListener::from_std(listener)?;
@@ -172,41 +161,53 @@ fn start_px4(args: Args) -> Result<(), StartError> {
     Ok(())
 }
 
+/// The tokio runtime every mode's sockets and signals run on.
+fn single_thread_runtime() -> std::io::Result<tokio::runtime::Runtime> {
+    tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+}
+
+/// The autopilot modes fly the quadrotor only.
+fn quadrotor_only(args: &Args, mode_flag: &str) -> Result<(), StartError> {
+    if args.model() != ModelKind::Quadrotor {
+        return Err(StartError::Options(format!(
+            "{mode_flag} flies the quadrotor only"
+        )));
+    }
+    Ok(())
+}
+
+/// The ground-truth CSV of the autopilot modes (`--track`), if asked for.
+fn track(args: &Args) -> Result<Option<Track>, StartError> {
+    let Some(path) = &args.track else {
+        return Ok(None);
+    };
+    let track =
+        Track::create(path, args.track_interval_us).map_err(|source| StartError::Track {
+            path: path.clone(),
+            source,
+        })?;
+    Ok(Some(track))
+}
+
 /// The vehicle of the autopilot modes: `--config`, else the Iris preset.
 fn vehicle_config(args: &Args) -> Result<Px4Config, StartError> {
     Ok(match &args.config {
-        Some(path) => {
-            let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
-                path: path.clone(),
-                source,
-            })?;
-            Px4Config::parse(&text).map_err(|source| ConfigError::Invalid {
-                path: path.clone(),
-                source,
-            })?
-        }
+        Some(path) => config::read(path, Px4Config::parse)?,
         None => Px4Config::iris(),
     })
 }
 
 /// ArduPilot mode: the vehicle, the UDP socket, then ArduPilot's frames until a signal.
 fn start_ardupilot(args: Args) -> Result<(), StartError> {
-    if args.model() != ModelKind::Quadrotor {
-        return Err(StartError::Options(
-            "--ardupilot flies the quadrotor only".to_string(),
-        ));
-    }
+    quadrotor_only(&args, "--ardupilot")?;
     let config = vehicle_config(&args)?;
     let mut session = ardupilot::session::Session::new(&ardupilot::session::SessionOptions {
         config,
         seed: args.seed,
     })?;
-    if let Some(path) = &args.track {
-        let track =
-            Track::create(path, args.track_interval_us).map_err(|source| StartError::Track {
-                path: path.clone(),
-                source,
-            })?;
+    if let Some(track) = track(&args)? {
         session.set_track(track);
     }
     let socket =
@@ -221,9 +222,7 @@ fn start_ardupilot(args: Args) -> Result<(), StartError> {
         "flyloop-sitl ready ardupilot={listen} mode=ardupilot model=quadrotor speed_factor={speed} seed={}",
         args.seed
     );
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()?;
+    let runtime = single_thread_runtime()?;
     let session = runtime.block_on(async move {
         let shutdown = server::Shutdown::install()?;
         println!("{ready}");
@@ -254,21 +253,30 @@ fn start(args: Args) -> Result<(), StartError> {
         Some(path) => config::load(task, path)?,
         None => TaskConfig::default(),
     };
-    match args.list_params {
-        Some(ListFormat::Table) => {
-            print!("{}", param_table::listing(task, &config));
-            return Ok(());
-        }
-        Some(ListFormat::Toml) => {
-            print!("{}", starter_config::starter_toml(task, &config));
-            return Ok(());
-        }
-        None => {}
-    }
-    if args.describe_frame {
-        print!("{}", describe_frame(task, &config)?);
+    if let Some(text) = printout(&args, task, &config)? {
+        print!("{text}");
         return Ok(());
     }
+    start_mavlink(args, task, config)
+}
+
+/// What `--list-params` or `--describe-frame` prints instead of running, if asked for.
+fn printout(
+    args: &Args,
+    task: TaskKind,
+    config: &TaskConfig,
+) -> Result<Option<String>, StartError> {
+    Ok(match args.list_params {
+        Some(ListFormat::Table) => Some(param_table::listing(task, config)),
+        Some(ListFormat::Toml) => Some(starter_config::starter_toml(task, config)),
+        None if args.describe_frame => Some(describe_frame(task, config)?),
+        None => None,
+    })
+}
+
+/// The MAVLink SITL (lockstep or real time): the vehicles, the sockets, then datagrams until
+/// a signal.
+fn start_mavlink(args: Args, task: TaskKind, config: TaskConfig) -> Result<(), StartError> {
     let mut options = SimOptions::new(task);
     options.vehicles = args.vehicles;
     options.seed = args.seed;
@@ -299,9 +307,7 @@ fn start(args: Args) -> Result<(), StartError> {
         args.seed
     );
 
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()?;
+    let runtime = single_thread_runtime()?;
     let stats = runtime.block_on(async move {
         let shutdown = server::Shutdown::install()?;
         let controller = tokio::net::UdpSocket::from_std(controller)?;

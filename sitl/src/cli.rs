@@ -1,9 +1,10 @@
 //! Command-line options.
 
 use crate::kinematics::Home;
-use crate::model::{ModelKind, TaskKind};
 use crate::sim::Mode;
 use clap::Parser;
+use clap::builder::{PossibleValuesParser, TypedValueParser};
+use flyloop_core::tasks::registry::{ModelKind, TaskKind};
 use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::time::Duration;
@@ -18,11 +19,11 @@ use std::time::Duration;
 #[command(name = "flyloop-sitl", version)]
 pub struct Args {
     /// Vehicle model [default: the task's model, else quadrotor].
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = model_parser())]
     pub model: Option<ModelKind>,
 
     /// Task flown on the model [default: hover for quadrotor, landing for lander2d].
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = task_parser())]
     pub task: Option<TaskKind>,
 
     /// Controller link: UDP address to listen on (port 0 picks a free port; see the first
@@ -131,6 +132,18 @@ pub struct Args {
     /// Print the task frame layout (DEBUG_FLOAT_ARRAY indices) and exit.
     #[arg(long)]
     pub describe_frame: bool,
+}
+
+/// `--model`'s values: the core's model names.
+fn model_parser() -> impl TypedValueParser<Value = ModelKind> {
+    PossibleValuesParser::new(ModelKind::ALL.map(ModelKind::name))
+        .try_map(|name| ModelKind::from_name(&name).ok_or("unknown model"))
+}
+
+/// `--task`'s values: the core's task names.
+fn task_parser() -> impl TypedValueParser<Value = TaskKind> {
+    PossibleValuesParser::new(TaskKind::ALL.map(TaskKind::frame_name))
+        .try_map(|name| TaskKind::from_name(&name).ok_or("unknown task"))
 }
 
 /// How `--list-params` prints.

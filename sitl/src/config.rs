@@ -2,11 +2,9 @@
 //! core's names or their MAVLink short ids. Missing keys keep the core's defaults; every error
 //! names the parameter and its bound (the core's [`ParamError`]).
 
-use crate::model::{ModelKind, TaskConfig, TaskInstance, TaskKind};
-use crate::param_table::{self, Group, ParamEntry};
 use flyloop_core::ParamError;
-use flyloop_core::params::Parameters;
-use flyloop_core::tasks::randomization::{ParamRange, Randomization};
+use flyloop_core::tasks::randomization::ParamRange;
+use flyloop_core::tasks::registry::{TaskConfig, TaskKind, from_values_and_ranges, param_rows};
 use std::path::{Path, PathBuf};
 
 /// Why a config file was refused.
@@ -33,7 +31,7 @@ pub fn parse(task: TaskKind, text: &str) -> Result<TaskConfig, ParamError> {
             continue;
         }
         let Some(number) = toml_number(value) else {
-            let entry = find_entry(&param_table::entries(task), task, key)?;
+            let entry = param_rows::find(&param_rows::entries(task), task, key)?;
             return Err(ParamError::Parse(format!(
                 "parameter `{}` must be a number or a boolean",
                 entry.name
@@ -85,73 +83,22 @@ pub(crate) fn toml_number(value: &toml::Value) -> Option<f64> {
     }
 }
 
-fn find_entry(entries: &[ParamEntry], task: TaskKind, key: &str) -> Result<ParamEntry, ParamError> {
-    entries
-        .iter()
-        .find(|e| e.name == key || e.id == *key)
-        .cloned()
-        .ok_or_else(|| ParamError::UnknownName(format!("{key}` for task `{}", task.frame_name())))
-}
-
-/// The parameter sets of `task` from `(name or param_id, value)` pairs (other parameters keep
-/// their defaults), each checked against its row, the sets' relations checked once all are
-/// applied, and the task built once to check it. The config file and the Python extension
-/// both come through here.
-pub fn from_values<'a>(
-    task: TaskKind,
-    pairs: impl IntoIterator<Item = (&'a str, f64)>,
-) -> Result<TaskConfig, ParamError> {
-    from_values_and_ranges(task, pairs, Vec::new())
-}
-
-/// [`from_values`] with randomisation ranges (flight tasks only; checked against the
-/// parameter sets by the core).
-pub fn from_values_and_ranges<'a>(
-    task: TaskKind,
-    pairs: impl IntoIterator<Item = (&'a str, f64)>,
-    ranges: Vec<ParamRange>,
-) -> Result<TaskConfig, ParamError> {
-    let entries = param_table::entries(task);
-    let mut values: Vec<(ParamEntry, f64)> = Vec::new();
-    for (key, value) in pairs {
-        values.push((find_entry(&entries, task, key)?, value));
-    }
-    let pick = |group: Group| {
-        values
-            .iter()
-            .filter(move |(e, _)| e.group == group)
-            .map(|(e, v)| (e.name, *v))
-    };
-    let mut config = TaskConfig::default();
-    for &group in Group::for_task(task) {
-        match group {
-            Group::Quadrotor => config.quadrotor = Parameters::from_values(pick(group))?,
-            Group::RateLoop => config.rate_loop = Parameters::from_values(pick(group))?,
-            Group::Flight => config.flight = Parameters::from_values(pick(group))?,
-            Group::Waypoints => config.waypoints = Parameters::from_values(pick(group))?,
-            Group::Lander => config.lander = Parameters::from_values(pick(group))?,
-            Group::Landing => config.landing = Parameters::from_values(pick(group))?,
-        }
-    }
-    if !ranges.is_empty() {
-        if task.model() != ModelKind::Quadrotor {
-            return Err(ParamError::Parse(format!(
-                "task `{}` has no randomisation; the flight tasks (hover, waypoints) do",
-                task.frame_name()
-            )));
-        }
-        config.randomize = Randomization::new(ranges)?;
-    }
-    TaskInstance::build(task, &config)?;
-    Ok(config)
-}
-
+/// The parameter sets of `task` from the file at `path`.
 pub fn load(task: TaskKind, path: &Path) -> Result<TaskConfig, ConfigError> {
+    read(path, |text| parse(task, text))
+}
+
+/// Reads the parameter file at `path` with `parse`; the one loader of every mode, so a
+/// missing file and a bad value are reported the same way.
+pub fn read<T>(
+    path: &Path,
+    parse: impl FnOnce(&str) -> Result<T, ParamError>,
+) -> Result<T, ConfigError> {
     let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
         path: path.to_path_buf(),
         source,
     })?;
-    parse(task, &text).map_err(|source| ConfigError::Invalid {
+    parse(&text).map_err(|source| ConfigError::Invalid {
         path: path.to_path_buf(),
         source,
     })

@@ -4,9 +4,9 @@
 //! The promise it checks: any bytes, on either link, in lockstep or real time, never panic
 //! the handler, and a valid step that follows (from another controller) is still answered.
 
-use crate::model::TaskKind;
 use crate::sim::{Link, Mode, Sim, SimOptions};
 use crate::wire::{Encoder, frames};
+use flyloop_core::tasks::registry::TaskKind;
 use mavlink::dialects::common::{HIL_ACTUATOR_CONTROLS_DATA, HilActuatorControlsFlags, MavMessage};
 use std::net::SocketAddr;
 use std::time::{Duration, Instant};

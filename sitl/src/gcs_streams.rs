@@ -1,6 +1,7 @@
 //! The ground-station link's message streams: which messages go out how often (wall clock),
 //! changed by SET_MESSAGE_INTERVAL.
 
+use crate::pacer::Cadence;
 use crate::telemetry::id;
 use mavlink::dialects::common::MavResult;
 use std::time::{Duration, Instant};
@@ -27,7 +28,7 @@ const MIN_INTERVAL: Duration = Duration::from_millis(20);
 struct Stream {
     message_id: u32,
     interval: Option<Duration>,
-    next_due: Instant,
+    cadence: Cadence,
 }
 
 /// The streams of the ground-station link.
@@ -52,7 +53,7 @@ impl GcsStreams {
             .map(|(message_id, interval)| Stream {
                 message_id,
                 interval,
-                next_due: now,
+                cadence: Cadence::starting(now),
             })
             .collect();
         GcsStreams { streams }
@@ -81,12 +82,9 @@ impl GcsStreams {
         let mut out = Vec::new();
         for s in &mut self.streams {
             if let Some(interval) = s.interval {
-                if s.next_due <= now {
+                if s.cadence.take(now, interval) {
                     out.push(s.message_id);
-                    s.next_due += interval;
-                    if s.next_due <= now {
-                        s.next_due = now + interval;
-                    }
+                    s.cadence.skip_if_behind(now, interval);
                 }
             }
         }
@@ -98,7 +96,7 @@ impl GcsStreams {
         self.streams
             .iter()
             .filter(|s| s.interval.is_some())
-            .map(|s| s.next_due)
+            .map(|s| s.cadence.next())
             .min()
             .unwrap_or_else(|| Instant::now() + Duration::from_secs(1))
     }

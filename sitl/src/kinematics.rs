@@ -4,6 +4,7 @@
 
 use flyloop_core::lander2d::Lander2d;
 use flyloop_core::quadrotor::Quadrotor;
+use flyloop_core::tasks::registry::TaskInstance;
 use nalgebra::{UnitQuaternion, Vector3};
 
 /// Standard gravity for milli-g units (mG), m/s².
@@ -38,6 +39,15 @@ pub fn euler_ned(attitude_enu: &UnitQuaternion<f64>) -> (f64, f64, f64) {
 }
 
 impl Kinematics {
+    /// The state of `task`'s vehicle.
+    pub fn of_task(task: &TaskInstance) -> Self {
+        match task {
+            TaskInstance::Hover(t) => Kinematics::of_quadrotor(t.quadrotor()),
+            TaskInstance::Waypoints(t) => Kinematics::of_quadrotor(t.quadrotor()),
+            TaskInstance::Landing(t) => Kinematics::of_lander(t.lander()),
+        }
+    }
+
     /// The quadrotor's state, already in ENU/FLU.
     pub fn of_quadrotor(q: &Quadrotor) -> Self {
         let b = &q.body;
@@ -48,7 +58,7 @@ impl Kinematics {
             body_rates: b.body_rates,
             acceleration: q.accelerations().0,
             gravity: q.params.gravity,
-            air_velocity: b.velocity - q.wind_velocity(),
+            air_velocity: q.air_velocity(),
         }
     }
 
@@ -59,15 +69,15 @@ impl Kinematics {
     pub fn of_lander(l: &Lander2d) -> Self {
         let d = l.drone();
         let [ax, ay] = l.acceleration();
-        let velocity = Vector3::new(d.vx, 0.0, d.vy);
+        let [air_x, air_y] = l.air_velocity();
         Kinematics {
             position: Vector3::new(d.x, 0.0, d.y),
-            velocity,
+            velocity: Vector3::new(d.vx, 0.0, d.vy),
             attitude: UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -d.angle),
             body_rates: Vector3::new(0.0, -d.angular_velocity, 0.0),
             acceleration: Vector3::new(ax, 0.0, ay),
             gravity: l.params().gravity,
-            air_velocity: velocity,
+            air_velocity: Vector3::new(air_x, 0.0, air_y),
         }
     }
 

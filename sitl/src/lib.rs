@@ -7,7 +7,8 @@
 //! - [`wire`]: frames in and out of datagrams,
 //! - [`kinematics`]: the one place where ENU/FLU becomes NED/FRD,
 //! - [`task_frame`]: the task frame layout (DEBUG_FLOAT_ARRAY),
-//! - [`param_table`], [`param_protocol`], [`config`]: parameters over MAVLink and from TOML,
+//! - [`param_table`], [`param_protocol`], [`config`]: parameters over MAVLink and from TOML
+//!   (the task registry itself is the core's `flyloop_core::tasks::registry`),
 //! - [`px4`]: PX4 mode, flyloop as PX4's simulator over TCP,
 //! - [`ardupilot`]: ArduPilot mode, flyloop as ArduPilot's JSON physics backend over UDP,
 //! - [`pacer`]: the wall-clock pacer of both autopilot modes.
@@ -20,7 +21,6 @@ pub mod config;
 pub mod fuzz;
 pub mod gcs_streams;
 pub mod kinematics;
-pub mod model;
 pub mod pacer;
 pub mod param_protocol;
 pub mod param_table;

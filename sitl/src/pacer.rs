@@ -1,5 +1,7 @@
-//! The one wall-clock pacer of the autopilot modes (PX4, ArduPilot): simulation time runs
-//! `speed_factor` times the wall clock, or as fast as the autopilot answers (0).
+//! Every wall-clock pacer of the SITL. The autopilot modes (PX4, ArduPilot) run simulation
+//! time `speed_factor` times the wall clock, or as fast as the autopilot answers (0)
+//! ([`Pacing`], [`Anchor`]); real-time mode's vehicles and the ground-station streams tick at
+//! fixed periods ([`Cadence`]).
 
 use std::time::{Duration, Instant};
 
@@ -74,6 +76,41 @@ pub fn wait_for(pacing: Pacing, anchor: &mut Option<Anchor>, sim_us: u64, start:
     }
 }
 
+/// A fixed-period schedule on the wall clock: due once per period, and when it falls a
+/// period behind it skips ahead instead of bursting.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cadence {
+    next: Instant,
+}
+
+impl Cadence {
+    /// First due at `at`.
+    pub fn starting(at: Instant) -> Self {
+        Cadence { next: at }
+    }
+
+    /// When the next tick is due.
+    pub fn next(&self) -> Instant {
+        self.next
+    }
+
+    /// Whether a tick is due at `now`; a due tick is taken (the next one is a period later).
+    pub fn take(&mut self, now: Instant, period: Duration) -> bool {
+        let due = self.next <= now;
+        if due {
+            self.next += period;
+        }
+        due
+    }
+
+    /// Still due at `now` after the ticks taken: the next tick a period from now.
+    pub fn skip_if_behind(&mut self, now: Instant, period: Duration) {
+        if self.next <= now {
+            self.next = now + period;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -95,5 +132,22 @@ mod tests {
         // Time back (a reset): re-anchored.
         assert_eq!(a.due(10, 2.0, late), late);
         assert_eq!(a.sim_us, 10);
+    }
+
+    #[test]
+    fn a_cadence_ticks_once_per_period_and_skips_ahead_when_behind() {
+        let t0 = Instant::now();
+        let period = Duration::from_millis(10);
+        let mut c = Cadence::starting(t0);
+        assert!(c.take(t0, period));
+        assert!(!c.take(t0, period), "the next tick is a period later");
+        assert_eq!(c.next(), t0 + period);
+        let late = t0 + Duration::from_millis(35);
+        assert!(c.take(late, period));
+        assert!(c.take(late, period));
+        c.skip_if_behind(late, period);
+        assert_eq!(c.next(), late + period, "behind: skipped ahead");
+        c.skip_if_behind(late, period);
+        assert_eq!(c.next(), late + period, "not behind: unchanged");
     }
 }

@@ -8,11 +8,11 @@
 //! A refused set is answered with PARAM_ERROR, a STATUSTEXT naming the parameter and its
 //! bound, and PARAM_VALUE with the unchanged value.
 
-use crate::model::TaskInstance;
-use crate::param_table::{self, ParamEntry};
 use crate::sim::{Link, Sim};
 use flyloop_core::ParamError;
 use flyloop_core::params::ValueKind;
+use flyloop_core::tasks::registry::TaskInstance;
+use flyloop_core::tasks::registry::param_rows::{self, ParamEntry};
 use mavlink::MavHeader;
 use mavlink::dialects::common::{
     MavMessage, MavParamError, MavParamType, MavSeverity, PARAM_ERROR_DATA,
@@ -55,7 +55,7 @@ fn error_code(e: &ParamError) -> MavParamError {
 impl Sim {
     fn param_value(&self, i: usize, index: usize, entry: &ParamEntry, count: usize) -> MavMessage {
         let value =
-            param_table::get(&self.vehicles[i].config, entry.group, entry.name).unwrap_or(f64::NAN);
+            param_rows::get(&self.vehicles[i].config, entry.group, entry.name).unwrap_or(f64::NAN);
         MavMessage::PARAM_VALUE(PARAM_VALUE_DATA {
             param_value: value as f32,
             param_count: count as u16,
@@ -74,7 +74,7 @@ impl Sim {
         let Some(targets) = self.targets(target_system) else {
             return;
         };
-        let entries = param_table::entries(self.options.task);
+        let entries = param_rows::entries(self.options.task);
         for i in targets {
             for (index, e) in entries.iter().enumerate() {
                 let m = self.param_value(i, index, e, entries.len());
@@ -93,7 +93,7 @@ impl Sim {
         let Some(targets) = self.targets(m.target_system) else {
             return;
         };
-        let entries = param_table::entries(self.options.task);
+        let entries = param_rows::entries(self.options.task);
         let wanted = param_id(&m.param_id);
         let found = if m.param_index >= 0 {
             entries
@@ -126,7 +126,7 @@ impl Sim {
         let Some(targets) = self.targets(m.target_system) else {
             return;
         };
-        let entries = param_table::entries(self.options.task);
+        let entries = param_rows::entries(self.options.task);
         let wanted = param_id(&m.param_id);
         let Some((index, entry)) = entries.iter().enumerate().find(|(_, e)| e.id == wanted) else {
             for i in targets {
@@ -139,7 +139,7 @@ impl Sim {
         for i in targets {
             let v = &self.vehicles[i];
             let mut candidate = v.config.clone();
-            let result = param_table::set(&mut candidate, entry.group, entry.name, value)
+            let result = param_rows::set(&mut candidate, entry.group, entry.name, value)
                 .and_then(|()| TaskInstance::build(v.kind, &candidate).map(|_| ()));
             match result {
                 Ok(()) => {

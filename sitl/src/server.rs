@@ -58,6 +58,25 @@ impl Shutdown {
             terminate: signal(SignalKind::terminate())?,
         })
     }
+
+    /// Waits for SIGINT or SIGTERM.
+    pub async fn signalled(&mut self) {
+        tokio::select! {
+            biased;
+            _ = self.interrupt.recv() => {}
+            _ = self.terminate.recv() => {}
+        }
+    }
+}
+
+/// How long a blocking receive of the autopilot modes waits before it looks at its stop flag
+/// again.
+pub(crate) const STOP_POLL: std::time::Duration = std::time::Duration::from_millis(100);
+
+/// Whether a blocking receive's error only means "nothing yet, try again".
+pub(crate) fn is_retry(kind: io::ErrorKind) -> bool {
+    use io::ErrorKind::{Interrupted, TimedOut, WouldBlock};
+    matches!(kind, WouldBlock | TimedOut | Interrupted)
 }
 
 /// Runs until SIGINT or SIGTERM; returns the counters.
@@ -65,12 +84,8 @@ pub async fn run(
     mut sim: Sim,
     controller: UdpSocket,
     gcs: Option<GcsLink>,
-    shutdown: Shutdown,
+    mut shutdown: Shutdown,
 ) -> io::Result<Stats> {
-    let Shutdown {
-        mut interrupt,
-        mut terminate,
-    } = shutdown;
     let mut buf = vec![0u8; RECEIVE_BUFFER];
     let mut gcs_buf = vec![0u8; RECEIVE_BUFFER];
     let mut out = Vec::with_capacity(RECEIVE_BUFFER);
@@ -81,8 +96,7 @@ pub async fn run(
     loop {
         tokio::select! {
             biased;
-            _ = interrupt.recv() => break,
-            _ = terminate.recv() => break,
+            _ = shutdown.signalled() => break,
             r = controller.recv_from(&mut buf) => match r {
                 Ok((n, from)) => {
                     let start = Instant::now();

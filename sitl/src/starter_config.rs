@@ -1,9 +1,9 @@
 //! `flyloop-sitl --task T --list-params toml`: a starter parameter file for `--config`,
 //! every parameter of the task at its current value with unit, range and description.
 
-use crate::model::{TaskConfig, TaskKind};
-use crate::param_table::{self, Group};
 use flyloop_core::params::ValueKind;
+use flyloop_core::tasks::registry::param_rows::{self, Group};
+use flyloop_core::tasks::registry::{TaskConfig, TaskKind};
 
 /// The TOML text; [`crate::config::parse`] reads it back to `config`.
 pub fn starter_toml(task: TaskKind, config: &TaskConfig) -> String {
@@ -14,11 +14,11 @@ pub fn starter_toml(task: TaskKind, config: &TaskConfig) -> String {
          # Every parameter at its default; keep the lines you change (a missing key keeps its\n\
          # default). Keys are the core's names; the MAVLink short ids work too.\n"
     );
-    let entries = param_table::entries(task);
+    let entries = param_rows::entries(task);
     for &group in Group::for_task(task) {
         out.push_str(&format!("\n# {}\n", group.label()));
         for e in entries.iter().filter(|e| e.group == group) {
-            let value = param_table::get(config, group, e.name).unwrap_or(f64::NAN);
+            let value = param_rows::get(config, group, e.name).unwrap_or(f64::NAN);
             let (text, range) = match e.kind {
                 // `{:?}` always writes a TOML float (1.0, 1e-5, inf).
                 ValueKind::Real => (format!("{value:?}"), format!("[{}, {}]", e.min, e.max)),
@@ -51,7 +51,7 @@ mod tests {
             let back = config::parse(task, &text).unwrap();
             assert_eq!(back, TaskConfig::default(), "{task:?}");
             let lines = text.lines().filter(|l| l.contains(" = ")).count();
-            assert_eq!(lines, param_table::entries(task).len(), "{task:?}");
+            assert_eq!(lines, param_rows::entries(task).len(), "{task:?}");
         }
     }
 

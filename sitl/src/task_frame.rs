@@ -16,8 +16,7 @@
 //! The values are concatenated over DEBUG_FLOAT_ARRAY messages with array_id 1, 2, … (58
 //! values each); `name` is the task's name, `time_usec` the vehicle's simulation time.
 
-use crate::model::TaskInstance;
-use flyloop_core::tasks::InfoValue;
+use flyloop_core::tasks::registry::{TaskInstance, push_info, push_infos};
 use mavlink::dialects::common::{DEBUG_FLOAT_ARRAY_DATA, MavMessage};
 
 /// Values per DEBUG_FLOAT_ARRAY.
@@ -36,24 +35,6 @@ pub struct FrameHeader {
 
 fn flag(b: bool) -> f32 {
     if b { 1.0 } else { 0.0 }
-}
-
-/// Appends one info value's numbers to `out`.
-pub fn push_info(out: &mut Vec<f32>, value: &InfoValue) {
-    match value {
-        InfoValue::Real(x) => out.push(*x as f32),
-        InfoValue::Integer(i) => out.push(*i as f32),
-        InfoValue::Flag(b) => out.push(flag(*b)),
-        InfoValue::Vector(v) => out.extend(v.iter().map(|x| *x as f32)),
-    }
-}
-
-/// Appends every info value of `task`, flattened in the task's info order, as the frame
-/// carries them (float32).
-pub fn push_infos(task: &TaskInstance, out: &mut Vec<f32>) {
-    for (_, value) in task.info() {
-        push_info(out, &value);
-    }
 }
 
 /// The frame values of `task` after a step (or a reset) with outcome `header`.
@@ -111,7 +92,7 @@ pub fn messages(name: &str, time_usec: u64, values: &[f32]) -> impl Iterator<Ite
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{TaskConfig, TaskKind};
+    use flyloop_core::tasks::registry::{TaskConfig, TaskKind};
 
     #[test]
     fn the_layout_holds_header_observation_and_info() {

@@ -3,8 +3,8 @@
 //! MAVLink spec (world NED, body FRD); the conversion itself lives in [`crate::kinematics`].
 
 use crate::kinematics::{Home, Kinematics, STANDARD_GRAVITY, round_i16, round_u16};
-use crate::model::TaskKind;
 use crate::vehicle::Vehicle;
+use flyloop_core::tasks::registry::TaskKind;
 use mavlink::dialects::common::*;
 use mavlink::types::CharArray;
 
@@ -35,7 +35,7 @@ pub enum Status {
 /// Ground truth for a controller: attitude (FRD → NED), body rates, global position,
 /// NED velocity, airspeed and the accelerometer's specific force, at simulation time.
 pub fn hil_state_quaternion(v: &Vehicle, home: &Home) -> MavMessage {
-    hil_state_quaternion_of(&v.task.kinematics(), home, v.clock_us)
+    hil_state_quaternion_of(&Kinematics::of_task(&v.task), home, v.clock_us)
 }
 
 /// HIL_STATE_QUATERNION of state `k` at simulation time `time_usec` (µs).
@@ -68,8 +68,8 @@ pub fn hil_state_quaternion_of(k: &Kinematics, home: &Home, time_usec: u64) -> M
 
 pub fn mav_type(kind: TaskKind) -> MavType {
     match kind.model() {
-        crate::model::ModelKind::Quadrotor => MavType::MAV_TYPE_QUADROTOR,
-        crate::model::ModelKind::Lander2d => MavType::MAV_TYPE_GENERIC,
+        flyloop_core::tasks::registry::ModelKind::Quadrotor => MavType::MAV_TYPE_QUADROTOR,
+        flyloop_core::tasks::registry::ModelKind::Lander2d => MavType::MAV_TYPE_GENERIC,
     }
 }
 
@@ -95,7 +95,7 @@ pub fn heartbeat(v: &Vehicle, status: Status) -> MavMessage {
 }
 
 pub fn attitude(v: &Vehicle) -> MavMessage {
-    let k = v.task.kinematics();
+    let k = Kinematics::of_task(&v.task);
     let (roll, pitch, yaw) = crate::kinematics::euler_ned(&k.attitude);
     let rates = k.body_rates_frd();
     MavMessage::ATTITUDE(ATTITUDE_DATA {
@@ -111,13 +111,13 @@ pub fn attitude(v: &Vehicle) -> MavMessage {
 
 /// Heading in centidegrees [0, 36000).
 fn heading_cdeg(v: &Vehicle) -> u16 {
-    let (_, _, yaw) = crate::kinematics::euler_ned(&v.task.kinematics().attitude);
+    let (_, _, yaw) = crate::kinematics::euler_ned(&Kinematics::of_task(&v.task).attitude);
     let deg = yaw.to_degrees().rem_euclid(360.0);
     round_u16(deg * 100.0) % 36000
 }
 
 pub fn global_position_int(v: &Vehicle, home: &Home) -> MavMessage {
-    let k = v.task.kinematics();
+    let k = Kinematics::of_task(&v.task);
     let g = home.global(&k.position);
     let vel = k.velocity_ned();
     MavMessage::GLOBAL_POSITION_INT(GLOBAL_POSITION_INT_DATA {
@@ -134,7 +134,7 @@ pub fn global_position_int(v: &Vehicle, home: &Home) -> MavMessage {
 }
 
 pub fn local_position_ned(v: &Vehicle) -> MavMessage {
-    let k = v.task.kinematics();
+    let k = Kinematics::of_task(&v.task);
     let p = k.position_ned();
     let vel = k.velocity_ned();
     MavMessage::LOCAL_POSITION_NED(LOCAL_POSITION_NED_DATA {
@@ -149,7 +149,7 @@ pub fn local_position_ned(v: &Vehicle) -> MavMessage {
 }
 
 pub fn vfr_hud(v: &Vehicle, home: &Home) -> MavMessage {
-    let k = v.task.kinematics();
+    let k = Kinematics::of_task(&v.task);
     let n = v.command.len().max(1) as f64;
     let (lo, hi) = v.task.action_bounds();
     let throttle: f64 = v
@@ -282,7 +282,7 @@ pub fn statustext(severity: MavSeverity, text: &str, id: u16) -> Vec<MavMessage>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::TaskConfig;
+    use flyloop_core::tasks::registry::TaskConfig;
 
     fn hover() -> Vehicle {
         let mut config = TaskConfig::default();

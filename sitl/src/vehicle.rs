@@ -1,16 +1,11 @@
 //! One simulated vehicle: its system id, its parameter sets, its core task instance, its
 //! simulation clock and seed sequence.
 
-use crate::model::{TaskConfig, TaskInstance, TaskKind};
 use crate::task_frame::FrameHeader;
 use flyloop_core::ParamError;
-
-/// Why a set of controls was refused.
-#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
-pub enum ControlError {
-    #[error("controls[{channel}] = {value}: step refused")]
-    NotFinite { channel: usize, value: f32 },
-}
+use flyloop_core::tasks::registry::{
+    ControlError, TaskConfig, TaskInstance, TaskKind, clamp_controls,
+};
 
 /// The next seed of a vehicle's sequence: the SplitMix64 output of the previous seed.
 pub fn next_seed(seed: u64) -> u64 {
@@ -18,36 +13,6 @@ pub fn next_seed(seed: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^ (z >> 31)
-}
-
-/// Checks `controls` (the first `lo.len()` channels are used, missing ones are 0; each used
-/// one must be finite) and writes them clamped into [lo, hi] to `command`; returns whether any
-/// was clamped. On error `command` is unchanged. The SITL and the Python extension both
-/// treat actions through here.
-pub fn clamp_controls(
-    controls: &[f32],
-    lo: &[f64],
-    hi: &[f64],
-    command: &mut Vec<f64>,
-) -> Result<bool, ControlError> {
-    let n = lo.len();
-    if let Some((channel, &value)) = controls
-        .iter()
-        .take(n)
-        .enumerate()
-        .find(|(_, c)| !c.is_finite())
-    {
-        return Err(ControlError::NotFinite { channel, value });
-    }
-    let mut clamped = false;
-    command.clear();
-    for i in 0..n {
-        let c = controls.get(i).map_or(0.0, |&c| f64::from(c));
-        let v = c.clamp(lo[i], hi[i]);
-        clamped |= v != c;
-        command.push(v);
-    }
-    Ok(clamped)
 }
 
 /// A vehicle of the simulation.

@@ -4,7 +4,7 @@
 // Test code: a failed unwrap is a failed test.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use flyloop_sitl::model::TaskKind;
+use flyloop_core::tasks::registry::TaskKind;
 use flyloop_sitl::sim::{Link, Sim, SimOptions};
 use flyloop_sitl::wire::{Encoder, frames};
 use mavlink::dialects::common::{

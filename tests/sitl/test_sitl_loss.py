@@ -90,12 +90,12 @@ def test_ten_thousand_steps_through_a_lossy_relay_equal_an_undisturbed_run(start
     # The link's first re-send comes after 20 ms; 5 ms here keeps the ~400 losses of the run
     # from costing 8 s of waiting in CI (and re-sends some replies that were only slow, which
     # the SITL must answer from its cache too).
-    env.unwrapped._link.resend_after = 0.005
+    env.unwrapped._backend._link.resend_after = 0.005
     try:
         start = time.monotonic()
         got = scripted_rollout(env, LOSSY_STEPS, seed=100)
         elapsed = time.monotonic() - start
-        link = env.unwrapped._link
+        link = env.unwrapped._backend._link
         resends = link.resends
     finally:
         env.close()

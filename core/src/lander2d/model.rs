@@ -373,6 +373,13 @@ impl Lander2d {
         ]
     }
 
+    /// Velocity relative to the air, m/s. The lander's wind is a force on the drone, not a
+    /// moving air mass, so the air is still and this is the drone's own velocity.
+    pub fn air_velocity(&self) -> [f64; 2] {
+        let d = self.drone();
+        [d.vx, d.vy]
+    }
+
     /// The wind force added from outside, N.
     pub fn external_wind_force(&self) -> [f64; 2] {
         self.external_wind_force

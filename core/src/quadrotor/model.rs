@@ -1,7 +1,7 @@
 //! A quadrotor instance: parameters, state, command, wind and its random generator — what
 //! an FMU instance or a SITL vehicle holds.
 
-use super::contact::foot_heights;
+use super::contact::{foot_heights, rest_height};
 use super::dynamics::{accelerations, integrate};
 use super::params::{QuadrotorInitial, QuadrotorParams};
 use super::state::{BodyState, WindState};
@@ -50,6 +50,16 @@ impl Quadrotor {
             rng,
             ou_cache: OuCache::default(),
         })
+    }
+
+    /// The vehicle standing level on its landing gear at the origin, facing north, with the
+    /// episode's wind drawn from `SimRng::new(seed)`: where an autopilot's flight starts. The
+    /// centre of mass is at the rest height, the feet carrying m·g, so the first sensor
+    /// sample already feels the ground carrying it (−g, not free fall).
+    pub fn standing(params: QuadrotorParams, seed: u64) -> Result<Self, ParamError> {
+        let position = Vector3::new(0.0, 0.0, rest_height(&params));
+        let body = BodyState::at_rest(position, 0.0, 0.0, std::f64::consts::FRAC_PI_2, 0.0);
+        Quadrotor::new(params, body, SimRng::new(seed))
     }
 
     /// Starts a new episode in place: the vehicle at `body`, a fresh wind drawn from `rng`,
@@ -167,6 +177,11 @@ impl Quadrotor {
     /// Total wind at the vehicle (episode wind + external), world ENU, m/s.
     pub fn wind_velocity(&self) -> Vector3<f64> {
         self.wind.velocity() + self.external_wind
+    }
+
+    /// Velocity relative to the air (the vehicle's minus the wind's), world ENU, m/s.
+    pub fn air_velocity(&self) -> Vector3<f64> {
+        self.body.velocity - self.wind_velocity()
     }
 
     /// Whether a foot touches the ground (ground enabled and a foot height ≤ 0).

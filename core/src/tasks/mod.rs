@@ -99,4 +99,5 @@ pub mod hover;
 pub mod landing;
 pub mod landing_reward;
 pub mod randomization;
+pub mod registry;
 pub mod waypoints;

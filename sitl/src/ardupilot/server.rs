@@ -3,15 +3,13 @@
 
 use super::session::{Outcome, Session};
 use crate::pacer::{self, Anchor, Pacing};
-use crate::server::Shutdown;
+use crate::server::{STOP_POLL, Shutdown, is_retry};
 use std::io;
 use std::net::UdpSocket;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-/// How long a blocking receive waits before it looks at the stop flag again.
-const STOP_POLL: Duration = Duration::from_millis(100);
 /// Wall time without a servo packet after which ArduPilot is reported silent (it re-sends
 /// an unanswered frame after 1 s, so a live ArduPilot is never this quiet).
 pub const SILENCE: Duration = Duration::from_millis(1500);
@@ -24,12 +22,8 @@ pub async fn run(
     mut session: Session,
     socket: UdpSocket,
     pacing: Pacing,
-    shutdown: Shutdown,
+    mut shutdown: Shutdown,
 ) -> io::Result<Session> {
-    let Shutdown {
-        mut interrupt,
-        mut terminate,
-    } = shutdown;
     socket.set_nonblocking(false)?;
     socket.set_read_timeout(Some(STOP_POLL))?;
     let stop = Arc::new(AtomicBool::new(false));
@@ -47,17 +41,11 @@ pub async fn run(
                 Ok(session) => break session,
                 Err(e) => return Err(io::Error::other(format!("ArduPilot thread failed: {e}"))),
             },
-            _ = interrupt.recv(), if !stopping => { stop.store(true, Ordering::Relaxed); stopping = true; }
-            _ = terminate.recv(), if !stopping => { stop.store(true, Ordering::Relaxed); stopping = true; }
+            _ = shutdown.signalled(), if !stopping => { stop.store(true, Ordering::Relaxed); stopping = true; }
         }
     };
     tracing::info!("stopping on a signal");
     Ok(session)
-}
-
-fn is_retry(kind: io::ErrorKind) -> bool {
-    use io::ErrorKind::{Interrupted, TimedOut, WouldBlock};
-    matches!(kind, WouldBlock | TimedOut | Interrupted)
 }
 
 /// The receive–step–send loop until `stop`.

@@ -7,9 +7,7 @@ use crate::kinematics::{attitude_ned, enu_to_ned, flu_to_frd};
 use crate::px4::config::Px4Config;
 use crate::px4::track::Track;
 use flyloop_core::ParamError;
-use flyloop_core::quadrotor::contact::rest_height;
-use flyloop_core::quadrotor::{BodyState, Quadrotor};
-use flyloop_core::rng::SimRng;
+use flyloop_core::quadrotor::Quadrotor;
 use flyloop_core::sensors::Sensors;
 use nalgebra::Vector3;
 use std::fmt;
@@ -142,9 +140,7 @@ impl Session {
     /// The vehicle at rest on its landing gear at home, facing north.
     pub fn new(options: &SessionOptions) -> Result<Self, ParamError> {
         let c = &options.config;
-        let standing = Vector3::new(0.0, 0.0, rest_height(&c.quadrotor));
-        let body = BodyState::at_rest(standing, 0.0, 0.0, std::f64::consts::FRAC_PI_2, 0.0);
-        let quad = Quadrotor::new(c.quadrotor.clone(), body, SimRng::new(options.seed))?;
+        let quad = Quadrotor::standing(c.quadrotor.clone(), options.seed)?;
         let sensors = Sensors::new(c.sensors.clone(), options.seed)?;
         Ok(Session {
             start: (quad.clone(), sensors.clone()),

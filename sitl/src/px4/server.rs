@@ -2,7 +2,7 @@
 //! through PX4 going away (reset, accept the next one).
 
 use super::session::Session;
-use crate::server::Shutdown;
+use crate::server::{STOP_POLL, Shutdown, is_retry};
 use std::io::{self, Read, Write};
 use std::net::TcpStream;
 use std::sync::Arc;
@@ -25,9 +25,6 @@ enum End {
     Closed(String),
 }
 
-/// How long a blocking read waits in lockstep before it looks at the stop flag again.
-const STOP_POLL: Duration = Duration::from_millis(100);
-
 /// Serves PX4 connections one at a time until SIGINT / SIGTERM.
 ///
 /// Each connection runs on a thread of its own with blocking socket calls: one read and one
@@ -38,18 +35,13 @@ pub async fn run(
     mut session: Session,
     listener: TcpListener,
     pacing: Pacing,
-    shutdown: Shutdown,
+    mut shutdown: Shutdown,
 ) -> io::Result<Session> {
-    let Shutdown {
-        mut interrupt,
-        mut terminate,
-    } = shutdown;
     let mut connections = 0u64;
     loop {
         let accepted = tokio::select! {
             biased;
-            _ = interrupt.recv() => break,
-            _ = terminate.recv() => break,
+            _ = shutdown.signalled() => break,
             r = listener.accept() => r,
         };
         let (stream, peer) = match accepted {
@@ -86,8 +78,7 @@ pub async fn run(
                     Ok(done) => break done,
                     Err(e) => return Err(io::Error::other(format!("PX4 connection thread failed: {e}"))),
                 },
-                _ = interrupt.recv(), if !stopping => { stop.store(true, Ordering::Relaxed); stopping = true; }
-                _ = terminate.recv(), if !stopping => { stop.store(true, Ordering::Relaxed); stopping = true; }
+                _ = shutdown.signalled(), if !stopping => { stop.store(true, Ordering::Relaxed); stopping = true; }
                 r = listener.accept() => {
                     if let Ok((second, addr)) = r {
                         tracing::warn!(peer = %addr, "refused a second PX4 connection: one PX4 is already connected");
@@ -111,11 +102,6 @@ pub async fn run(
     }
     tracing::info!("stopping on a signal");
     Ok(session)
-}
-
-fn is_retry(kind: io::ErrorKind) -> bool {
-    use io::ErrorKind::{Interrupted, TimedOut, WouldBlock};
-    matches!(kind, WouldBlock | TimedOut | Interrupted)
 }
 
 /// One PX4 connection, from its first HIL_SENSOR to its end, with blocking socket calls.

@@ -9,12 +9,9 @@ use crate::stats::Stats;
 use crate::telemetry;
 use crate::wire::{Encoder, StreamDecoder};
 use flyloop_core::ParamError;
-use flyloop_core::quadrotor::contact::rest_height;
-use flyloop_core::quadrotor::{BodyState, Quadrotor};
-use flyloop_core::rng::SimRng;
+use flyloop_core::quadrotor::Quadrotor;
 use flyloop_core::sensors::Sensors;
 use mavlink::dialects::common::{COMMAND_LONG_DATA, MavCmd, MavMessage};
-use nalgebra::Vector3;
 use std::time::Instant;
 
 /// System id of the simulator's messages to PX4.
@@ -58,11 +55,7 @@ impl Session {
     /// The vehicle at rest on its landing gear at the origin, facing north.
     pub fn new(options: &SessionOptions) -> Result<Self, ParamError> {
         let c = &options.config;
-        // Standing on its feet (centre of mass at the rest height, the feet carrying m·g), so
-        // the first HIL_SENSOR already feels the ground carrying it (−g, not free fall).
-        let standing = Vector3::new(0.0, 0.0, rest_height(&c.quadrotor));
-        let body = BodyState::at_rest(standing, 0.0, 0.0, std::f64::consts::FRAC_PI_2, 0.0);
-        let mut quad = Quadrotor::new(c.quadrotor.clone(), body, SimRng::new(options.seed))?;
+        let mut quad = Quadrotor::standing(c.quadrotor.clone(), options.seed)?;
         // One step with the motors off: the state PX4's first controls meet.
         quad.step(options.step_us.max(1) as f64 * 1e-6);
         let sensors = Sensors::new(c.sensors.clone(), options.seed)?;

@@ -5,11 +5,12 @@
 
 use crate::gcs_streams::GcsStreams;
 use crate::kinematics::Home;
-use crate::model::{TaskConfig, TaskKind};
+use crate::pacer::Cadence;
 use crate::stats::Stats;
 use crate::telemetry;
 use crate::vehicle::Vehicle;
 use crate::wire::{self, Encoder, Incoming};
+use flyloop_core::tasks::registry::{TaskConfig, TaskKind};
 
 use flyloop_core::ParamError;
 use mavlink::MavHeader;
@@ -115,7 +116,7 @@ struct Runtime {
     running: bool,
     failsafe: bool,
     last_command: Option<Instant>,
-    next_due: Instant,
+    cadence: Cadence,
 }
 
 /// The simulation.
@@ -152,7 +153,7 @@ impl Sim {
                 running: false,
                 failsafe: false,
                 last_command: None,
-                next_due: now,
+                cadence: Cadence::starting(now),
             };
             vehicles.len()
         ];

@@ -2,6 +2,7 @@
 //! failsafe switches the motors off, and state streams to the controller peers.
 
 use super::{Link, MAX_CATCH_UP, PEER_TIMEOUT, Sim};
+use crate::pacer::Cadence;
 use mavlink::dialects::common::MavSeverity;
 use std::net::SocketAddr;
 use std::time::{Duration, Instant};
@@ -12,7 +13,7 @@ impl Sim {
         rt.last_command = Some(now);
         if !rt.running {
             rt.running = true;
-            rt.next_due = now;
+            rt.cadence = Cadence::starting(now);
         }
         if rt.failsafe {
             rt.failsafe = false;
@@ -52,31 +53,30 @@ impl Sim {
             self.failsafe_check(i, now);
             let dt = Duration::from_micros(self.vehicles[i].dt_us().max(1));
             if !self.runtime[i].running {
-                self.runtime[i].next_due = now + dt;
+                self.runtime[i].cadence = Cadence::starting(now + dt);
                 continue;
             }
             let mut steps = 0;
-            while self.runtime[i].next_due <= now && steps < MAX_CATCH_UP && self.runtime[i].running
+            while steps < MAX_CATCH_UP
+                && self.runtime[i].running
+                && self.runtime[i].cadence.take(now, dt)
             {
                 let start = Instant::now();
                 self.vehicles[i].step();
                 self.stats.physics += start.elapsed();
                 self.stats.steps += 1;
-                self.runtime[i].next_due += dt;
                 steps += 1;
                 self.stream_step(i, now);
                 if self.vehicles[i].last.terminated {
                     self.episode_terminated(i);
                 }
             }
-            if self.runtime[i].next_due <= now {
-                // Too far behind (a stalled machine): skip ahead instead of racing.
-                self.runtime[i].next_due = now + dt;
-            }
+            // Too far behind (a stalled machine): skip ahead instead of racing.
+            self.runtime[i].cadence.skip_if_behind(now, dt);
         }
         self.runtime
             .iter()
-            .map(|r| r.next_due)
+            .map(|r| r.cadence.next())
             .min()
             .unwrap_or(now + Duration::from_millis(10))
     }

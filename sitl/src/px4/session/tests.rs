@@ -3,9 +3,11 @@
 
 use super::*;
 use crate::wire::{Encoder, frames};
+use flyloop_core::quadrotor::contact::rest_height;
 use mavlink::dialects::common::{
     HIL_ACTUATOR_CONTROLS_DATA, HIL_SENSOR_DATA, HilActuatorControlsFlags, MavModeFlag,
 };
+use nalgebra::Vector3;
 
 fn session(seed: u64) -> Session {
     Session::new(&SessionOptions {

@@ -1,96 +1,11 @@
-//! Which model and task a vehicle flies, its parameter sets, and the task instance built from
-//! them. The SITL never steps physics itself: it calls the core's [`Task`] and reads the
-//! model's state for the MAVLink messages.
+//! A built task of any kind, driven through the core's [`Task`] trait.
 
-use crate::kinematics::Kinematics;
-use flyloop_core::ParamError;
-use flyloop_core::lander2d::Lander2dParams;
-use flyloop_core::quadrotor::QuadrotorParams;
-use flyloop_core::rate_loop::RateLoopParams;
-use flyloop_core::tasks::flight::FlightParams;
-use flyloop_core::tasks::hover::Hover;
-use flyloop_core::tasks::landing::{Landing, LandingParams};
-use flyloop_core::tasks::randomization::{Randomization, VehicleParams};
-use flyloop_core::tasks::waypoints::{WaypointParams, Waypoints};
-use flyloop_core::tasks::{ActionError, Info, StepOutcome, Task};
-
-/// The simulated vehicle model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum ModelKind {
-    Quadrotor,
-    Lander2d,
-}
-
-impl ModelKind {
-    /// The name used on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            ModelKind::Quadrotor => "quadrotor",
-            ModelKind::Lander2d => "lander2d",
-        }
-    }
-}
-
-/// The task flown on the model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum TaskKind {
-    Hover,
-    Waypoints,
-    Landing,
-}
-
-impl TaskKind {
-    /// The model a task runs on.
-    pub fn model(self) -> ModelKind {
-        match self {
-            TaskKind::Hover | TaskKind::Waypoints => ModelKind::Quadrotor,
-            TaskKind::Landing => ModelKind::Lander2d,
-        }
-    }
-
-    /// The default task of a model.
-    pub fn default_for(model: ModelKind) -> TaskKind {
-        match model {
-            ModelKind::Quadrotor => TaskKind::Hover,
-            ModelKind::Lander2d => TaskKind::Landing,
-        }
-    }
-
-    /// The name carried in the task frame (DEBUG_FLOAT_ARRAY.name, at most 10 characters).
-    pub fn frame_name(self) -> &'static str {
-        match self {
-            TaskKind::Hover => "hover",
-            TaskKind::Waypoints => "waypoints",
-            TaskKind::Landing => "landing",
-        }
-    }
-}
-
-/// Every parameter set a task is built from. Only the sets the task uses are served over the
-/// parameter protocol (see [`crate::param_table`]).
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct TaskConfig {
-    pub quadrotor: QuadrotorParams,
-    /// PX4's rate loop, flown by the flight tasks' rates interface.
-    pub rate_loop: RateLoopParams,
-    pub flight: FlightParams,
-    pub waypoints: WaypointParams,
-    pub lander: Lander2dParams,
-    pub landing: LandingParams,
-    /// Per-episode ranges of the flight tasks' vehicle parameters (empty: off).
-    pub randomize: Randomization,
-}
-
-impl TaskConfig {
-    /// The flight tasks' vehicle: quadrotor, rate loop and flight parameters.
-    pub fn vehicle(&self) -> VehicleParams {
-        VehicleParams {
-            quadrotor: self.quadrotor.clone(),
-            rate_loop: self.rate_loop.clone(),
-            flight: self.flight.clone(),
-        }
-    }
-}
+use super::{TaskConfig, TaskKind};
+use crate::ParamError;
+use crate::tasks::hover::Hover;
+use crate::tasks::landing::Landing;
+use crate::tasks::waypoints::Waypoints;
+use crate::tasks::{ActionError, Info, StepOutcome, Task};
 
 /// A task instance of one of the three kinds.
 #[derive(Debug)]
@@ -203,15 +118,6 @@ impl TaskInstance {
             _ => None,
         }
     }
-
-    /// The vehicle's state in the core's frames (world ENU, body FLU).
-    pub fn kinematics(&self) -> Kinematics {
-        match self {
-            TaskInstance::Hover(t) => Kinematics::of_quadrotor(t.quadrotor()),
-            TaskInstance::Waypoints(t) => Kinematics::of_quadrotor(t.quadrotor()),
-            TaskInstance::Landing(t) => Kinematics::of_lander(t.lander()),
-        }
-    }
 }
 
 #[cfg(test)]
@@ -228,7 +134,7 @@ mod tests {
             let off = task.motors_off();
             assert_eq!(off.len(), n);
             task.step(&off).unwrap();
-            assert!(task.kinematics().position.iter().all(|v| v.is_finite()));
+            assert!(task.observation().iter().all(|v| v.is_finite()));
         }
     }
 
