@@ -21,6 +21,7 @@ Wall-clock time, so run it on a quiet machine (`uptime` load < 1).
 from __future__ import annotations
 
 import argparse
+import glob
 import os
 import subprocess
 import sys
@@ -104,6 +105,30 @@ def memory_child(env_id: str, n: int) -> None:
     print(_rss_bytes() - before)
 
 
+def machine() -> str:
+    """CPU model, logical CPUs and cache sizes (Linux), so figures from different machines are
+    never mixed."""
+    model = "unknown CPU"
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    caches = []
+    for index in sorted(glob.glob("/sys/devices/system/cpu/cpu0/cache/index*")):
+        try:
+            level = open(f"{index}/level").read().strip()
+            kind = open(f"{index}/type").read().strip()
+            size = open(f"{index}/size").read().strip()
+        except OSError:
+            continue
+        name = {"Data": "d", "Instruction": "i"}.get(kind, "")
+        caches.append(f"L{level}{name} {size}")
+    return f"{model}, {os.cpu_count()} logical CPUs; caches: {', '.join(caches) or 'unknown'}"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=3.0, help="per measurement")
@@ -117,6 +142,7 @@ def main() -> None:
     if args.memory_child:
         memory_child(args.memory_child[0], int(args.memory_child[1]))
         return
+    print(machine())
     load = os.getloadavg()[0]
     print(f"load average {load:.2f}{'  (busy machine: figures are low)' if load > 1 else ''}")
     print(

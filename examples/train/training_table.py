@@ -2,7 +2,7 @@
 seeds each, one run per cell, on this machine.
 
     .venv/bin/python examples/train/training_table.py [--seeds 0 1 2] [--tasks hover lander
-        lander_moving] [--jobs 1] [--out runs/training_table]
+        lander_moving] [--jobs 1] [--out runs/training_table] [--timesteps N]
 
 Each cell is `fast_ppo.py --env TASK --seed S --out OUT/TASK_sS` with the task's own settings
 (TASKS in fast_ppo.py); the table reads the runs' summary.json: env steps, wall seconds of
@@ -36,10 +36,12 @@ def cpu_model() -> str:
     return "unknown CPU"
 
 
-def train(task: str, seed: int, out: Path) -> dict:
+def train(task: str, seed: int, out: Path, timesteps: int | None) -> dict:
     folder = out / f"{task}_s{seed}"
     command = [sys.executable, str(HERE / "fast_ppo.py"), "--env", task, "--seed", str(seed)]
     command += ["--out", str(folder), "--no-progress-bar"]
+    if timesteps is not None:
+        command += ["--timesteps", str(timesteps)]
     done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode != 0:
         raise RuntimeError(f"{' '.join(command)} failed:\n{done.stderr[-3000:]}")
@@ -52,6 +54,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2])
     parser.add_argument("--jobs", type=int, default=1, help="runs trained at the same time")
     parser.add_argument("--out", type=Path, default=Path("runs/training_table"))
+    parser.add_argument(
+        "--timesteps", type=int, help="env steps of every run (default: each task's own)"
+    )
     args = parser.parse_args(argv)
     if args.jobs < 1:
         parser.error("--jobs must be at least 1")
@@ -59,7 +64,7 @@ def main(argv: list[str] | None = None) -> int:
     start = time.perf_counter()
     cells = [(task, seed) for task in args.tasks for seed in args.seeds]
     with ThreadPoolExecutor(args.jobs) as pool:
-        summaries = list(pool.map(lambda c: train(c[0], c[1], args.out), cells))
+        summaries = list(pool.map(lambda c: train(c[0], c[1], args.out, args.timesteps), cells))
     by_cell = dict(zip(cells, summaries, strict=True))
     lines = [
         f"{cpu_model()}, {os.cpu_count()} CPUs, load {load:.2f} at the start, "
