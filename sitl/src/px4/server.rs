@@ -88,6 +88,11 @@ pub async fn run(
             }
         };
         session = returned;
+        // A signal taken while the connection was ending on its own is still a stop: the
+        // connection's own end (e.g. PX4 closed the socket) must not swallow it.
+        if stopping {
+            break;
+        }
         match end {
             End::Shutdown => break,
             End::Closed(why) => {
