@@ -179,7 +179,8 @@ class ActorCritic(nn.Module):
         matrix = BASES[basis]
         if matrix is not None and matrix.shape != (act_size, act_size):
             raise ValueError(f"action basis {basis!r} is for {len(matrix)} actions, not {act_size}")
-        self.basis = np.eye(act_size) if matrix is None else matrix
+        # None: the motors themselves (the outputs pass through untouched, float32 as sampled).
+        self.basis = matrix
 
         def mlp(out: int, gain: float) -> nn.Sequential:
             layers = [nn.Linear(obs_size, hidden), nn.Tanh(), nn.Linear(hidden, hidden)]
@@ -198,8 +199,11 @@ class ActorCritic(nn.Module):
         return torch.distributions.Normal(self.mu(x), self.log_std.exp())
 
     def to_actions(self, coordinates: np.ndarray) -> np.ndarray:
-        """Policy outputs (rows) in the action basis to [-1, 1] actions (not yet clipped)."""
-        return coordinates @ self.basis.T
+        """Policy outputs (rows) in the action basis to [-1, 1] actions (not yet clipped), in
+        the outputs' dtype."""
+        if self.basis is None:
+            return coordinates
+        return (coordinates @ self.basis.T).astype(coordinates.dtype)
 
 
 def make_envs(task: str, backend: str, num_envs: int, **overrides) -> gym.vector.VectorEnv:
