@@ -10,11 +10,13 @@ For each env id:
   stepping random actions and resetting when an episode ends, rendering off;
 - the SITL vector env with --vehicles vehicles in one SITL process;
 - the native vector env with --native-envs sub-envs (all CPUs), NEXT_STEP autoreset,
-  copy=False (the arrays a learner reads in place).
+  copy=False (the arrays a learner reads in place); then at scale: 1,024 envs on one
+  thread, and 10,000 Lander2D envs on all CPUs.
 Random actions are drawn from numpy in batches, so the figure is the env's own cost
 (--sample-actions calls action_space.sample() every step instead).
-Memory: resident-set growth of making the native vector env, per env, for QuadHover and
-Lander2D, and for --memory-envs QuadHover envs in one vector env (0 skips).
+Memory: peak resident-set growth of making the native vector env and stepping it 500 times,
+per env, for QuadHover and Lander2D, and for --memory-envs QuadHover envs in one vector env
+(0 skips).
 Wall-clock time, so run it on a quiet machine (`uptime` load < 1).
 """
 
@@ -33,6 +35,13 @@ import numpy as np
 from flyloop.registration import ENVS
 
 BATCH = 4096
+# The native vector env at scale: (env id, envs, threads; None = all CPUs).
+SCALE = [
+    ("flyloop/QuadHover-v0", 1024, 1),
+    ("flyloop/QuadWaypoints-v0", 1024, 1),
+    ("flyloop/Lander2D-v1", 1024, 1),
+    ("flyloop/Lander2D-v1", 10_000, None),
+]
 
 
 def _actions(space, rng, n):
@@ -82,9 +91,9 @@ def _rss_bytes() -> int:
 
 
 def memory_per_env(env_id: str, n: int) -> tuple[float, float]:
-    """(bytes per env, total MB) of a native vector env of `n` envs after a reset and one
-    step, measured in a fresh interpreter (in this one, heap freed by the throughput runs
-    would be reused and hide the growth)."""
+    """(bytes per env, total MB) of a native vector env of `n` envs, the peak over a reset
+    and MEMORY_STEPS steps, measured in a fresh interpreter (in this one, heap freed by the
+    throughput runs would be reused and hide the growth)."""
     child = subprocess.run(
         [sys.executable, __file__, "--memory-child", env_id, str(n)],
         capture_output=True,
@@ -95,14 +104,24 @@ def memory_per_env(env_id: str, n: int) -> tuple[float, float]:
     return grown / n, grown / 1e6
 
 
+MEMORY_STEPS = 500
+
+
 def memory_child(env_id: str, n: int) -> None:
-    """Prints the resident-set growth, bytes, of making, resetting and stepping the env."""
+    """Prints the resident-set growth, bytes, of making, resetting and stepping the env
+    MEMORY_STEPS times with random actions (episodes end and restart meanwhile, so a
+    Lander2D's rapier worlds, built only near the ground and the pad, are counted as they
+    come and go)."""
     before = _rss_bytes()
     kwargs = dict(num_envs=n, vectorization_mode="vector_entry_point", backend="native")
     envs = gym.make_vec(env_id, **kwargs)
     envs.reset(seed=0)
-    envs.step(_actions(envs.single_action_space, np.random.default_rng(0), n))
-    print(_rss_bytes() - before)
+    rng = np.random.default_rng(0)
+    peak = 0
+    for _ in range(MEMORY_STEPS):
+        envs.step(_actions(envs.single_action_space, rng, n))
+        peak = max(peak, _rss_bytes())
+    print(peak - before)
 
 
 def machine() -> str:
@@ -161,6 +180,14 @@ def main() -> None:
             f"| {v_sitl:,.0f} | {v_nat:,.0f} | {v_nat / v_sitl:.0f}x |",
             flush=True,
         )
+    print("\n| native vector env | envs | threads | env steps/s |")
+    print("|---|---|---|---|")
+    for env_id, n, threads in SCALE:
+        if args.env and env_id not in args.env:
+            continue
+        rate = vector(env_id, n, t, s, backend="native", copy=False, num_threads=threads)
+        shown = threads or os.cpu_count()
+        print(f"| {env_id} | {n:,} | {shown} | {rate:,.0f} |", flush=True)
     print("\n| native vector env | envs | memory per env | total |")
     print("|---|---|---|---|")
     sizes = [("flyloop/QuadHover-v0", 10_000), ("flyloop/Lander2D-v1", 10_000)]

@@ -169,7 +169,7 @@ fn the_snapshot_keeps_the_grid_phase() {
     assert_eq!(a.save().unwrap(), b.save().unwrap());
     // Bytes of the version before the grid are refused, not misread.
     let mut bytes = a.save().unwrap();
-    assert_eq!(&bytes[..8], b"FLYL2D03");
+    assert_eq!(&bytes[..8], b"FLYL2D04");
     bytes[7] = b'2';
     assert!(Lander2d::restore(&bytes).is_err());
 }

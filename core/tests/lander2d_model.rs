@@ -528,3 +528,40 @@ fn the_air_velocity_is_the_drone_velocity_since_the_wind_is_a_force() {
     assert!(d.vx > 0.0, "the wind pushes it east: {d:?}");
     assert_eq!(l.air_velocity(), [d.vx, d.vy]);
 }
+
+#[test]
+fn the_rapier_world_exists_only_near_the_pad_and_the_ground() {
+    // A gentle descent from 10 m above the pad: the world appears within reach of the pad, is
+    // there at the touch-down, and goes once the drone climbs away again.
+    let mut l = lander(quiet(), at(25.0, 20.5));
+    assert!(!l.in_contact_world());
+    let (mut free_steps, mut world_steps) = (0, 0);
+    for _ in 0..3000 {
+        descend(&mut l, 0.5);
+        if l.in_contact_world() {
+            world_steps += 1;
+            // Never built early: the drone's outline (reach 0.51 m) is within 1 m of the pad.
+            assert!(l.drone().y - 10.5 < 0.51 + 1.0, "{:?}", l.drone());
+        } else {
+            free_steps += 1;
+        }
+        if l.landed() {
+            break;
+        }
+    }
+    assert!(l.landed() && l.in_contact_world(), "{l:?}");
+    assert!(
+        free_steps > 5 * world_steps,
+        "{free_steps} free, {world_steps} in the world"
+    );
+    // Full thrust: it climbs out and the world is dropped again.
+    l.set_command([1.0, 1.0]).unwrap();
+    for _ in 0..100 {
+        l.step();
+    }
+    assert!(
+        l.drone().y > 14.0 && !l.in_contact_world(),
+        "{:?}",
+        l.drone()
+    );
+}

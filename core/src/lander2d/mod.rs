@@ -1,13 +1,16 @@
 //! The 2D landing drone of seed 000 on rapier2d, with the reference's numbers and without
 //! its bugs (see docs/reference/lander2d.md).
 //!
-//! [`world`] builds the rapier scene, [`model`] steps it (thrust, noise, battery, wind,
-//! moving platform), [`contact`] judges touch-downs, [`params`] holds the parameter tables,
-//! [`variables`] the table the FMU and the SITL read.
+//! [`model`] steps a lander (thrust, noise, battery, wind, moving platform) through its
+//! [`scene`]: [`free_body`] integrates the drone in free flight, [`world`] builds the rapier
+//! world where a contact is within reach; [`contact`] judges touch-downs, [`params`] holds
+//! the parameter tables, [`variables`] the table the FMU and the SITL read.
 
 pub mod contact;
+pub(crate) mod free_body;
 pub mod model;
 pub mod params;
+pub(crate) mod scene;
 pub mod variables;
 pub mod world;
 

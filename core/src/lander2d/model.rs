@@ -1,25 +1,26 @@
-//! A Lander2D instance: parameters, its rapier world, battery, wind, contact outcome and its
-//! random generator — what an FMU instance, a SITL vehicle or the Landing task holds.
+//! A Lander2D instance: parameters, its scene (the drone alone in free flight, a rapier world
+//! near the ground and the pad), battery, wind, contact outcome and its random generator —
+//! what an FMU instance, a SITL vehicle or the Landing task holds.
 
 use super::contact::ContactState;
+use super::free_body::MassProps;
 use super::params::{Lander2dInitial, Lander2dParams};
-use super::world::{self, DroneGeometry, DroneState, Handles};
+use super::scene::Scene;
+use super::world::DroneState;
 use crate::error::{InputError, ParamError, check_finite};
 use crate::params::Parameters;
 use crate::rng::SimRng;
 use crate::snapshot::{self, SnapshotError};
-use rapier2d_f64::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// One simulated 2D drone over its landing platform.
 ///
-/// Plain data with its whole physics world inside: [`Lander2d::save`] stores it and
+/// Plain data with its whole physics inside: [`Lander2d::save`] stores it and
 /// [`Lander2d::restore`] brings back an instance that continues bit-identically.
 #[derive(Serialize, Deserialize)]
 pub struct Lander2d {
     params: Lander2dParams,
-    world: PhysicsWorld,
-    handles: Handles,
+    scene: Scene,
     rng: SimRng,
     /// Motor commands (left, right) in [-1, 1], held until changed.
     command: [f64; 2],
@@ -109,17 +110,17 @@ impl Lander2d {
         };
         let platform_direction = draws.platform_heading;
         let wind_force = draws.wind_force(&params);
-        let (world, handles) = world::build(
+        let scene = Scene::new(
             &params,
             &drone,
             draws.platform_start_x(&params),
             platform_direction * params.platform_speed,
+            wind_force,
         );
         Lander2d {
             battery: params.initial_battery,
             params,
-            world,
-            handles,
+            scene,
             rng,
             command: [-1.0; 2],
             external_wind_force: [0.0; 2],
@@ -230,13 +231,14 @@ impl Lander2d {
                 * self.params.physics_step;
             self.battery = (self.battery - drain).max(0.0);
         }
+        let wind = self.wind_force();
+        self.scene.choose_mode(&self.params, wind);
     }
 
     /// The start of a control period: the velocity its mean acceleration is measured from;
     /// its contact flags start clear.
     fn begin_period(&mut self) {
-        let v0 = self.drone_body().linvel();
-        self.period_start_velocity = [v0.x, v0.y];
+        self.period_start_velocity = self.scene.velocity();
         self.contact.begin_period();
         self.period_begun = true;
     }
@@ -245,36 +247,23 @@ impl Lander2d {
     /// step), under the current command, with the contacts classified after it.
     fn physics_step(&mut self, length: Option<f64>) {
         self.thrust = self.current_thrust();
-        self.apply_forces();
         let before = self.drone();
         let platform_vx = self.platform_vx();
-        match length {
-            None => self.world.step(),
-            Some(length) => {
-                let nominal = self.world.integration_parameters.dt;
-                self.world.integration_parameters.dt = length;
-                self.world.step();
-                self.world.integration_parameters.dt = nominal;
-            }
-        }
+        let dt = length.unwrap_or(self.params.physics_step);
+        let wind = self.wind_force();
+        let (on_platform, on_ground) = self.scene.step(&self.params, dt, self.thrust, wind);
         self.steer_platform();
-        let on_platform = self
-            .handles
-            .drone_touches(&self.world, self.handles.platform_collider);
-        let on_ground = self
-            .handles
-            .drone_touches(&self.world, self.handles.ground_collider);
         self.contact
             .update(&self.params, &before, platform_vx, on_platform, on_ground);
     }
 
     /// The end of a control period: its mean acceleration; the period count moves on.
     fn end_period(&mut self) {
-        let v1 = self.drone_body().linvel();
+        let v1 = self.scene.velocity();
         let v0 = self.period_start_velocity;
         self.acceleration = [
-            (v1.x - v0[0]) / self.params.dt,
-            (v1.y - v0[1]) / self.params.dt,
+            (v1[0] - v0[0]) / self.params.dt,
+            (v1[1] - v0[1]) / self.params.dt,
         ];
         self.steps += 1;
         self.period_begun = false;
@@ -299,26 +288,6 @@ impl Lander2d {
         })
     }
 
-    /// Replaces last step's user forces (rapier keeps them until reset) with the thrust at
-    /// the motors along the body's +y, in the current pose, and the wind at the centre of mass.
-    fn apply_forces(&mut self) {
-        let motor_x = DroneGeometry::of(&self.params).motor_x;
-        let wind = Vector::new(
-            self.wind_force[0] + self.external_wind_force[0],
-            self.wind_force[1] + self.external_wind_force[1],
-        );
-        let thrust = self.thrust;
-        let body = self.drone_body_mut();
-        body.reset_forces(false);
-        body.reset_torques(false);
-        let pose = *body.position();
-        let up = pose.rotation.transform_vector(Vector::Y);
-        for (t, x) in thrust.into_iter().zip([-motor_x, motor_x]) {
-            body.add_force_at_point(up * t, pose.transform_point(Vector::new(x, 0.0)), true);
-        }
-        body.add_force(wind, true);
-    }
-
     /// Turns a moving platform around once its centre reaches either end of its travel.
     fn steer_platform(&mut self) {
         if !self.params.moving_platform {
@@ -331,33 +300,29 @@ impl Lander2d {
         } else if x >= hi && self.platform_direction > 0.0 {
             self.platform_direction = -1.0;
         }
-        let v = Vector::new(self.platform_direction * self.params.platform_speed, 0.0);
-        self.world.bodies[self.handles.platform].set_linvel(v, true);
-    }
-
-    // The handles were checked against the world when it was built or restored, and the
-    // world is private: indexing cannot miss.
-    fn drone_body(&self) -> &RigidBody {
-        &self.world.bodies[self.handles.drone]
-    }
-
-    fn drone_body_mut(&mut self) -> &mut RigidBody {
-        &mut self.world.bodies[self.handles.drone]
+        self.scene
+            .set_platform_vx(self.platform_direction * self.params.platform_speed);
     }
 
     /// The drone's position, angle and velocities now.
     pub fn drone(&self) -> DroneState {
-        world::drone_state(self.drone_body())
+        self.scene.drone()
+    }
+
+    /// Whether a rapier world steps the drone now (it is within reach of a contact), rather
+    /// than the free-flight integrator.
+    pub fn in_contact_world(&self) -> bool {
+        self.scene.in_contact_world()
     }
 
     /// Platform centre x, m.
     pub fn platform_x(&self) -> f64 {
-        self.world.bodies[self.handles.platform].translation().x
+        self.scene.platform_x()
     }
 
     /// Platform velocity along x, m/s (0 for a fixed platform).
     pub fn platform_vx(&self) -> f64 {
-        self.world.bodies[self.handles.platform].linvel().x
+        self.scene.platform_vx()
     }
 
     /// The platform's top centre, the landing target, m.
@@ -444,12 +409,9 @@ impl Lander2d {
         &self.params
     }
 
-    /// Composite moment of inertia of the drone, from its colliders' mass properties, kg·m².
+    /// Composite moment of inertia of the drone (frame and motor boxes), kg·m².
     pub fn inertia(&self) -> f64 {
-        self.drone_body()
-            .mass_properties()
-            .local_mprops
-            .principal_inertia()
+        MassProps::of(&self.params).inertia
     }
 
     /// Sets parameter `name` and rebuilds the scene; on error nothing changes. Before the
@@ -483,10 +445,12 @@ impl Lander2d {
             self.platform_x()
         };
         let platform_vx = self.platform_direction * params.platform_speed;
-        let (world, handles) = world::build(&params, &drone, platform_x, platform_vx);
-        self.world = world;
-        self.handles = handles;
         self.wind_force = self.draws.wind_force(&params);
+        let wind = [
+            self.wind_force[0] + self.external_wind_force[0],
+            self.wind_force[1] + self.external_wind_force[1],
+        ];
+        self.scene = Scene::new(&params, &drone, platform_x, platform_vx, wind);
         self.params = params;
         Ok(())
     }
@@ -526,8 +490,9 @@ impl EpisodeDraws {
 }
 
 /// Format tag of a Lander2d snapshot (name and version; 03 put the physics on its own grid:
-/// whole grid steps, the grid step's noise draws and charge, whether a period has begun).
-const SNAPSHOT_TAG: &[u8; 8] = b"FLYL2D03";
+/// whole grid steps, the grid step's noise draws and charge, whether a period has begun;
+/// 04 keeps a rapier world only within reach of a contact).
+const SNAPSHOT_TAG: &[u8; 8] = b"FLYL2D04";
 
 /// How far a communication point may miss a grid point (of the physics grid or of the
 /// control periods) and still count as on it, as a fraction of the smaller grid step:
@@ -535,8 +500,9 @@ const SNAPSHOT_TAG: &[u8; 8] = b"FLYL2D03";
 const GRID_SLACK: f64 = 1e-6;
 
 impl Lander2d {
-    /// The whole state as bytes: the rapier world (bodies, colliders, islands, broad and
-    /// narrow phase with their warm-start impulses), RNG, battery, counters and contact flags.
+    /// The whole state as bytes: the drone in free flight or the rapier world (bodies,
+    /// colliders, islands, broad and narrow phase with their warm-start impulses), RNG,
+    /// battery, counters and contact flags.
     pub fn save(&self) -> Result<Vec<u8>, SnapshotError> {
         snapshot::encode(SNAPSHOT_TAG, self)
     }
@@ -556,7 +522,7 @@ impl Lander2d {
             .params
             .validate()
             .map_err(|e| SnapshotError::Invalid(e.to_string()))?;
-        if !lander.handles.are_valid_in(&lander.world) {
+        if !lander.scene.is_valid() {
             return Err(SnapshotError::Invalid(
                 "body or collider handles do not match the world".into(),
             ));

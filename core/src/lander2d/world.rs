@@ -3,6 +3,7 @@
 //! joints and stayed rigid only because the parts collided with each other; a single body is rigid
 //! by construction.
 
+use super::free_body::FreeBody;
 use super::params::Lander2dParams;
 use rapier2d_f64::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -50,6 +51,11 @@ pub struct DroneGeometry {
 }
 
 impl DroneGeometry {
+    /// Farthest point of the drone from its centre (a motor's outer corner), m.
+    pub fn reach(&self) -> f64 {
+        (self.motor_x + self.motor_half).hypot(self.motor_half.max(self.frame_half.1))
+    }
+
     pub fn of(p: &Lander2dParams) -> Self {
         let motor_x = (p.drone_width - p.drone_height) / 2.0;
         DroneGeometry {
@@ -62,11 +68,11 @@ impl DroneGeometry {
     }
 }
 
-/// Builds the scene with the drone in `drone` state and the platform centred at `platform_x`
-/// moving at `platform_vx` (ignored unless the platform moves).
+/// Builds the world with the drone's body in `drone` state and the platform centred at
+/// `platform_x` moving at `platform_vx` (ignored unless the platform moves).
 pub(crate) fn build(
     p: &Lander2dParams,
-    drone: &DroneState,
+    drone: &FreeBody,
     platform_x: f64,
     platform_vx: f64,
 ) -> (PhysicsWorld, Handles) {
@@ -109,11 +115,12 @@ pub(crate) fn build(
     let (platform, platform_collider) = world.insert(platform_body, platform_shape);
 
     let g = DroneGeometry::of(p);
+    let [x, y] = drone.translation;
+    let pose = Pose::from_parts(Vector::new(x, y), drone.rotation());
     let body = RigidBodyBuilder::dynamic()
-        .translation(Vector::new(drone.x, drone.y))
-        .rotation(drone.angle)
-        .linvel(Vector::new(drone.vx, drone.vy))
-        .angvel(drone.angular_velocity)
+        .pose(pose)
+        .linvel(Vector::new(drone.linvel[0], drone.linvel[1]))
+        .angvel(drone.angvel)
         // A hovering drone is nearly at rest; asleep it would ignore its next command.
         .can_sleep(false)
         .ccd_enabled(true);
@@ -207,7 +214,7 @@ mod tests {
             y: 40.0,
             ..Default::default()
         };
-        let (world, h) = build(&p, &start, 25.0, 0.0);
+        let (world, h) = build(&p, &FreeBody::from_state(&start), 25.0, 0.0);
         let body = &world.bodies[h.drone];
         let mprops = body.mass_properties().local_mprops;
         // Frame 0.3·(0.8² + 0.1²)/12 = 0.01625; each motor 0.6·(0.2² + 0.2²)/12 + 0.6·0.4² = 0.1.
@@ -251,7 +258,7 @@ mod tests {
             angle: 0.3,
             ..Default::default()
         };
-        let (world, h) = build(&p, &start, 25.0, 0.0);
+        let (world, h) = build(&p, &FreeBody::from_state(&start), 25.0, 0.0);
         assert_eq!(world.impulse_joints.len(), 0);
         assert_eq!(world.multibody_joints.multibodies().count(), 0);
         assert_eq!(

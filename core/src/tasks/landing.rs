@@ -237,8 +237,9 @@ impl Landing {
     }
 }
 
-/// Format tag of a Landing snapshot (02: its lander is a FLYL2D03 one, on its physics grid).
-const SNAPSHOT_TAG: &[u8; 8] = b"FLYLND02";
+/// Format tag of a Landing snapshot (02: its lander is on its physics grid; 03: a FLYL2D04
+/// one, with a rapier world only within reach of a contact).
+const SNAPSHOT_TAG: &[u8; 8] = b"FLYLND03";
 
 /// The seed's per-step reward on normalised observation values (module docs).
 pub use landing_reward::seed_step_reward as shaping_reward;
