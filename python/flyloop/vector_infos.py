@@ -31,7 +31,11 @@ class InfoColumns:
         for name, kind, count in layout:
             self.fields.append((name, kind, at, at + count))
             at += count
+        # Every env has every key every step: one read-only all-True mask per key, handed out
+        # each step instead of a fresh copy.
         self.masks = {f"_{name}": np.ones(num_envs, bool) for name, _, _ in layout}
+        for mask in self.masks.values():
+            mask.flags.writeable = False
 
     def infos(self, values: np.ndarray) -> dict[str, Any]:
         """Every key as an array over the envs: reals float64, flags bool, integers int64,
@@ -46,5 +50,5 @@ class InfoColumns:
                 infos[name] = values[:, a].astype(np.int64)
             else:
                 infos[name] = values[:, a:b].astype(np.float64)
-        infos.update({k: m.copy() for k, m in self.masks.items()})
+        infos.update(self.masks)
         return infos

@@ -7,7 +7,7 @@ use crate::params::{ParamSpec, Parameters};
 use crate::quadrotor::contact::foot_heights;
 use crate::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
 use crate::rng::SimRng;
-use crate::tasks::{Info, InfoValue, clip_f32};
+use crate::tasks::{InfoRef, InfoVisitor, clip_f32};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -299,35 +299,29 @@ pub struct FlightStatus {
     pub out_of_bounds: bool,
 }
 
-/// The info fields every flight task reports (seed 001's DroneEnv info, crash flags always).
-pub fn flight_info(
+/// The info fields every flight task reports (seed 001's DroneEnv info, crash flags always),
+/// for a flight towards `target`.
+pub fn visit_flight_info(
     quad: &Quadrotor,
     target: &Vector3<f64>,
     status: &FlightStatus,
     dt: f64,
-) -> Info {
+    visit: &mut InfoVisitor<'_>,
+) {
     let position = quad.body.position;
     let d = (target - position).norm();
-    vec![
-        ("distance_to_target", InfoValue::Real(d)),
-        ("position", InfoValue::Vector(position.as_slice().to_vec())),
-        (
-            "target_position",
-            InfoValue::Vector(target.as_slice().to_vec()),
-        ),
-        (
-            "step_count",
-            InfoValue::Integer(i64::from(status.step_count)),
-        ),
-        (
-            "episode_time",
-            InfoValue::Real(f64::from(status.step_count) * dt),
-        ),
-        (
-            "distance_progress",
-            InfoValue::Real(status.initial_distance - d),
-        ),
-        ("crashed", InfoValue::Flag(status.crashed)),
-        ("out_of_bounds", InfoValue::Flag(status.out_of_bounds)),
-    ]
+    visit("distance_to_target", InfoRef::Real(d));
+    visit("position", InfoRef::Vector(position.as_slice()));
+    visit("target_position", InfoRef::Vector(target.as_slice()));
+    visit("step_count", InfoRef::Integer(i64::from(status.step_count)));
+    visit(
+        "episode_time",
+        InfoRef::Real(f64::from(status.step_count) * dt),
+    );
+    visit(
+        "distance_progress",
+        InfoRef::Real(status.initial_distance - d),
+    );
+    visit("crashed", InfoRef::Flag(status.crashed));
+    visit("out_of_bounds", InfoRef::Flag(status.out_of_bounds));
 }

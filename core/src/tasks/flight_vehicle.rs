@@ -27,7 +27,7 @@ use crate::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
 use crate::rate_loop::{RateLoop, RatesSetpoint};
 use crate::rng::SimRng;
 use crate::sensors::frames::{attitude_ned, enu_to_ned, flu_to_frd};
-use crate::tasks::{ActionError, InfoValue, check_action};
+use crate::tasks::{ActionError, InfoRef, InfoVisitor, check_action};
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
@@ -327,9 +327,10 @@ impl FlightVehicle {
     }
 
     /// Info entries of the vehicle: the values drawn this episode, when randomised.
-    pub fn info(&self) -> Option<(&'static str, InfoValue)> {
-        (!self.randomization.is_off())
-            .then(|| ("randomized", InfoValue::Vector(self.drawn.clone())))
+    pub fn visit_info(&self, visit: &mut InfoVisitor<'_>) {
+        if !self.randomization.is_off() {
+            visit("randomized", InfoRef::Vector(&self.drawn));
+        }
     }
 }
 

@@ -16,12 +16,12 @@
 //! appears after the step's reward, in the observation that step returns.
 
 use super::flight::{
-    FlightParams, FlightStatus, distance_and_direction, flight_info, is_crashed, sample_start,
-    sample_target, velocity_reward,
+    FlightParams, FlightStatus, distance_and_direction, is_crashed, sample_start, sample_target,
+    velocity_reward, visit_flight_info,
 };
 use super::flight_vehicle::FlightVehicle;
 use super::randomization::{Randomization, VehicleParams};
-use super::{Info, StepOutcome, Task};
+use super::{InfoVisitor, StepOutcome, Task};
 use crate::error::ParamError;
 use crate::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
 use crate::rng::SimRng;
@@ -183,10 +183,10 @@ impl Task for Hover {
             .write_observation(&self.target, &self.obs_low, &self.obs_high, out);
     }
 
-    fn info(&self) -> Info {
-        let mut info = flight_info(self.quadrotor(), &self.target, &self.status, self.params.dt);
-        info.extend(self.vehicle.info());
-        info
+    fn visit_info(&self, visit: &mut InfoVisitor<'_>) {
+        let (quad, dt) = (self.quadrotor(), self.params.dt);
+        visit_flight_info(quad, &self.target, &self.status, dt, visit);
+        self.vehicle.visit_info(visit);
     }
 
     fn dt(&self) -> f64 {

@@ -28,7 +28,7 @@
 use super::landing_reward::{
     self, Ending, REWARD_LANDING, REWARD_SEED, landing_terminal_reward, seed_terminal_reward,
 };
-use super::{ActionError, Info, InfoValue, StepOutcome, Task, check_action, clip_f32};
+use super::{ActionError, InfoRef, InfoVisitor, StepOutcome, Task, check_action, clip_f32};
 use crate::error::ParamError;
 use crate::lander2d::{DroneState, Lander2d, Lander2dParams, wrap_angle};
 use crate::param;
@@ -364,37 +364,30 @@ impl Task for Landing {
         }
     }
 
-    fn info(&self) -> Info {
+    fn visit_info(&self, visit: &mut InfoVisitor<'_>) {
         let l = &self.lander;
         let d = l.drone();
         let (tx, ty) = l.platform_target();
         let s = &self.status;
-        vec![
-            ("position", InfoValue::Vector(vec![d.x, d.y])),
-            ("velocity", InfoValue::Vector(vec![d.vx, d.vy])),
-            ("angle", InfoValue::Real(wrap_angle(d.angle))),
-            ("angular_velocity", InfoValue::Real(d.angular_velocity)),
-            ("battery", InfoValue::Real(l.battery())),
-            ("thrust", InfoValue::Vector(l.thrust().to_vec())),
-            ("wind_force", InfoValue::Vector(l.wind_force().to_vec())),
-            ("platform_position", InfoValue::Vector(vec![tx, ty])),
-            ("distance", InfoValue::Real((tx - d.x).hypot(ty - d.y))),
-            ("landed", InfoValue::Flag(l.landed())),
-            ("crashed", InfoValue::Flag(l.crashed())),
-            ("lost_control", InfoValue::Flag(s.lost_control)),
-            ("out_of_bounds", InfoValue::Flag(s.out_of_bounds)),
-            ("battery_empty", InfoValue::Flag(s.battery_empty)),
-            ("time_limit", InfoValue::Flag(s.time_limit)),
-            (
-                "platform_contact",
-                InfoValue::Flag(l.contact().touched_platform),
-            ),
-            (
-                "touchdown_speed",
-                InfoValue::Real(l.contact().touchdown_speed),
-            ),
-            ("step", InfoValue::Integer(i64::from(s.step))),
-        ]
+        let c = l.contact();
+        visit("position", InfoRef::Vector(&[d.x, d.y]));
+        visit("velocity", InfoRef::Vector(&[d.vx, d.vy]));
+        visit("angle", InfoRef::Real(wrap_angle(d.angle)));
+        visit("angular_velocity", InfoRef::Real(d.angular_velocity));
+        visit("battery", InfoRef::Real(l.battery()));
+        visit("thrust", InfoRef::Vector(&l.thrust()));
+        visit("wind_force", InfoRef::Vector(&l.wind_force()));
+        visit("platform_position", InfoRef::Vector(&[tx, ty]));
+        visit("distance", InfoRef::Real((tx - d.x).hypot(ty - d.y)));
+        visit("landed", InfoRef::Flag(l.landed()));
+        visit("crashed", InfoRef::Flag(l.crashed()));
+        visit("lost_control", InfoRef::Flag(s.lost_control));
+        visit("out_of_bounds", InfoRef::Flag(s.out_of_bounds));
+        visit("battery_empty", InfoRef::Flag(s.battery_empty));
+        visit("time_limit", InfoRef::Flag(s.time_limit));
+        visit("platform_contact", InfoRef::Flag(c.touched_platform));
+        visit("touchdown_speed", InfoRef::Real(c.touchdown_speed));
+        visit("step", InfoRef::Integer(i64::from(s.step)));
     }
 
     fn dt(&self) -> f64 {

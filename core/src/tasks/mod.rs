@@ -15,6 +15,30 @@ pub enum InfoValue {
 /// The info dictionary: ordered (name, value) pairs, the same names every step.
 pub type Info = Vec<(&'static str, InfoValue)>;
 
+/// One info value lent to a visitor ([`Task::visit_info`]): a vector is borrowed, so a
+/// vector env can flatten every env's info each step without allocating.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum InfoRef<'a> {
+    Real(f64),
+    Integer(i64),
+    Flag(bool),
+    Vector(&'a [f64]),
+}
+
+impl InfoRef<'_> {
+    pub fn to_owned(self) -> InfoValue {
+        match self {
+            InfoRef::Real(x) => InfoValue::Real(x),
+            InfoRef::Integer(i) => InfoValue::Integer(i),
+            InfoRef::Flag(b) => InfoValue::Flag(b),
+            InfoRef::Vector(v) => InfoValue::Vector(v.to_vec()),
+        }
+    }
+}
+
+/// What [`Task::visit_info`] calls with each (name, value), in order.
+pub type InfoVisitor<'v> = dyn FnMut(&'static str, InfoRef<'_>) + 'v;
+
 /// Result of one task step (the observation is read with [`Task::write_observation`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepOutcome {
@@ -70,10 +94,17 @@ pub trait Task {
     fn step(&mut self, action: &[f64]) -> Result<StepOutcome, ActionError>;
     /// Writes the current observation into `out` (length [`Task::observation_size`]).
     fn write_observation(&self, out: &mut [f32]);
-    /// The info dictionary of the current step.
-    fn info(&self) -> Info;
+    /// Calls `visit` with each entry of the current step's info dictionary, in order.
+    fn visit_info(&self, visit: &mut InfoVisitor<'_>);
     /// Control period, s.
     fn dt(&self) -> f64;
+
+    /// The info dictionary of the current step.
+    fn info(&self) -> Info {
+        let mut info = Vec::new();
+        self.visit_info(&mut |name, value| info.push((name, value.to_owned())));
+        info
+    }
 
     /// The current observation as a new vector.
     fn observation(&self) -> Vec<f32> {

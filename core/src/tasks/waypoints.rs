@@ -13,12 +13,12 @@
 //! max_steps or when every waypoint is reached.
 
 use super::flight::{
-    FlightParams, FlightStatus, distance_and_direction, flight_info, is_crashed, sample_start,
-    sample_target, velocity_reward,
+    FlightParams, FlightStatus, distance_and_direction, is_crashed, sample_start, sample_target,
+    velocity_reward, visit_flight_info,
 };
 use super::flight_vehicle::FlightVehicle;
 use super::randomization::{Randomization, VehicleParams};
-use super::{ActionError, Info, InfoValue, StepOutcome, Task, clip_f32};
+use super::{ActionError, InfoRef, InfoVisitor, StepOutcome, Task, clip_f32};
 use crate::error::ParamError;
 use crate::param;
 use crate::params::{ParamSpec, Parameters};
@@ -278,29 +278,22 @@ impl Task for Waypoints {
         );
     }
 
-    fn info(&self) -> Info {
+    fn visit_info(&self, visit: &mut InfoVisitor<'_>) {
         let current = self.current_waypoint();
-        let mut info = flight_info(self.quadrotor(), &current, &self.status, self.flight.dt);
-        info.extend([
-            (
-                "waypoints_reached",
-                InfoValue::Integer(i64::from(self.reached)),
-            ),
-            (
-                "current_waypoint_pos",
-                InfoValue::Vector(current.as_slice().to_vec()),
-            ),
-            (
-                "next_waypoint_pos",
-                InfoValue::Vector(self.next_waypoint().as_slice().to_vec()),
-            ),
-            (
-                "steps_since_checkpoint",
-                InfoValue::Real(self.time_since_checkpoint()),
-            ),
-        ]);
-        info.extend(self.vehicle.info());
-        info
+        let (quad, dt) = (self.quadrotor(), self.flight.dt);
+        visit_flight_info(quad, &current, &self.status, dt, visit);
+        visit(
+            "waypoints_reached",
+            InfoRef::Integer(i64::from(self.reached)),
+        );
+        visit("current_waypoint_pos", InfoRef::Vector(current.as_slice()));
+        let next = self.next_waypoint();
+        visit("next_waypoint_pos", InfoRef::Vector(next.as_slice()));
+        visit(
+            "steps_since_checkpoint",
+            InfoRef::Real(self.time_since_checkpoint()),
+        );
+        self.vehicle.visit_info(visit);
     }
 
     fn dt(&self) -> f64 {

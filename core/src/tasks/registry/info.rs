@@ -2,7 +2,7 @@
 //! extension's info arrays carry it.
 
 use super::TaskInstance;
-use crate::tasks::InfoValue;
+use crate::tasks::{InfoRef, InfoValue};
 
 /// Appends one info value's numbers to `out` (flags as 0 or 1).
 pub fn push_info(out: &mut Vec<f32>, value: &InfoValue) {
@@ -14,11 +14,15 @@ pub fn push_info(out: &mut Vec<f32>, value: &InfoValue) {
     }
 }
 
-/// Appends every info value of `task`, flattened in the task's info order.
+/// Appends every info value of `task`, flattened in the task's info order (no allocation
+/// beyond `out`'s: the vector env calls this for every env every step).
 pub fn push_infos(task: &TaskInstance, out: &mut Vec<f32>) {
-    for (_, value) in task.info() {
-        push_info(out, &value);
-    }
+    task.visit_info(&mut |_, value| match value {
+        InfoRef::Real(x) => out.push(x as f32),
+        InfoRef::Integer(i) => out.push(i as f32),
+        InfoRef::Flag(b) => out.push(if b { 1.0 } else { 0.0 }),
+        InfoRef::Vector(v) => out.extend(v.iter().map(|x| *x as f32)),
+    });
 }
 
 #[cfg(test)]

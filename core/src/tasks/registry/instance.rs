@@ -5,7 +5,7 @@ use crate::ParamError;
 use crate::tasks::hover::Hover;
 use crate::tasks::landing::Landing;
 use crate::tasks::waypoints::Waypoints;
-use crate::tasks::{ActionError, Info, StepOutcome, Task};
+use crate::tasks::{ActionError, Info, InfoVisitor, StepOutcome, Task};
 
 /// A task instance of one of the three kinds.
 #[derive(Debug)]
@@ -92,6 +92,11 @@ impl TaskInstance {
 
     pub fn info(&self) -> Info {
         self.task().info()
+    }
+
+    /// Calls `visit` with each info entry, in order (see [`Task::visit_info`]).
+    pub fn visit_info(&self, visit: &mut InfoVisitor<'_>) {
+        self.task().visit_info(visit)
     }
 
     /// Control period, s.
