@@ -270,13 +270,10 @@ pub enum Causality3 {
 
 impl Causality3 {
     /// The attribute's text in the modelDescription.
-    pub fn name(self) -> &'static str {
+    pub fn name(self) -> String {
         match self {
-            Causality3::Independent => "independent",
-            Causality3::Model(Causality::Parameter) => "parameter",
-            Causality3::Model(Causality::Input) => "input",
-            Causality3::Model(Causality::Output) => "output",
-            Causality3::Model(Causality::Local) => "local",
+            Causality3::Independent => "independent".to_string(),
+            Causality3::Model(c) => format!("{c:?}").to_lowercase(),
         }
     }
 }
@@ -318,6 +315,15 @@ impl Variable3 {
         self.dimension.unwrap_or(1)
     }
 
+    /// The positions in [`ModelTable::variables`] of the model variables behind this one
+    /// (none for `time` and the event indicators).
+    pub fn elements(&self) -> &[usize] {
+        match &self.source {
+            Source::Model(elements) => elements,
+            _ => &[],
+        }
+    }
+
     /// Never true: every variable holds at least one value.
     pub fn is_empty(&self) -> bool {
         false
@@ -343,7 +349,7 @@ impl Variable3 {
 
     /// The model's variables `run` (at positions from `first`) as one variable: a scalar, or
     /// the array `array`.
-    fn of(run: &[Variable], first: usize, array: Option<&Array>) -> Self {
+    pub(crate) fn of(run: &[Variable], first: usize, array: Option<&Array>) -> Self {
         let v = &run[0];
         Variable3 {
             name: array.map_or(v.name, |a| a.name).to_string(),
