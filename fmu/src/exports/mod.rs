@@ -22,6 +22,17 @@ macro_rules! exports {
     )*};
 }
 
+/// Defines exported C functions that hand their arguments, after their own name, to a body
+/// in [`shared`]: `fn name(arguments) -> status = body;`.
+macro_rules! forward {
+    ($($(#[doc = $doc:literal])* fn $name:ident($c:ident: $ct:ty $(, $arg:ident: $t:ty)*) $(-> $ret:ty)? = $body:path;)*) => {
+        exports! {$(
+            $(#[doc = $doc])*
+            fn $name($c: $ct $(, $arg: $t)*) $(-> $ret)? { $body($c, stringify!($name) $(, $arg)*) }
+        )*}
+    };
+}
+
 pub mod fmi2;
 pub mod fmi3;
 mod guard;
