@@ -29,12 +29,12 @@ unsafe fn count(
 exports! {
     /// Model Exchange only (Co-Simulation has no event mode here).
     fn fmi3EnterEventMode(instance: fmi3Instance) -> fmi3Status {
-        enter(instance, "fmi3EnterEventMode", masks::ENTER_EVENT_MODE, Stage::EventMode).into()
+        enter(instance, "fmi3EnterEventMode", masks::ENTER_EVENT_MODE, Stage::EventMode)
     }
 
     fn fmi3EnterContinuousTimeMode(instance: fmi3Instance) -> fmi3Status {
         let mask = masks::ENTER_CONTINUOUS_TIME_MODE;
-        enter(instance, "fmi3EnterContinuousTimeMode", mask, Stage::ContinuousTimeMode).into()
+        enter(instance, "fmi3EnterContinuousTimeMode", mask, Stage::ContinuousTimeMode)
     }
 
     /// The discrete changes of the event at the current time (turbulence sample, released
@@ -67,7 +67,7 @@ exports! {
     /// No step event and no termination; an error once the state is not finite.
     fn fmi3CompletedIntegratorStep(instance: fmi3Instance, _noSetFMUStatePriorToCurrentPoint: fmi3Boolean, enterEventMode: *mut fmi3Boolean, terminateSimulation: *mut fmi3Boolean) -> fmi3Status {
         let function = "fmi3CompletedIntegratorStep";
-        completed_integrator_step(instance, function, enterEventMode, terminateSimulation, fmi3False).into()
+        completed_integrator_step(instance, function, enterEventMode, terminateSimulation, fmi3False)
     }
 
     /// A finite time not before the last event.
@@ -105,8 +105,7 @@ exports! {
     /// 1 for every state.
     fn fmi3GetNominalsOfContinuousStates(instance: fmi3Instance, nominals: *mut fmi3Float64, nContinuousStates: usize) -> fmi3Status {
         with_instance(instance, "fmi3GetNominalsOfContinuousStates", masks::GET_NOMINALS, |instance| {
-            instance.sim.nominals(c_slice_mut(nominals, nContinuousStates, "nominals")?)?;
-            Ok(crate::fmi2_types::fmi2Status::fmi2OK)
+            instance.sim.nominals(c_slice_mut(nominals, nContinuousStates, "nominals")?)
         })
     }
 

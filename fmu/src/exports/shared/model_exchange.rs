@@ -10,15 +10,15 @@ use crate::instance::{Instance, Mask, Stage, masks};
 use flyloop_core::number::Compact;
 
 /// The body of a Model Exchange function that only moves the instance to `stage`.
-pub(crate) fn enter(
+pub(crate) fn enter<S: From<fmi2Status>>(
     c: fmi2Component,
     function: &'static str,
     mask: Mask,
     stage: Stage,
-) -> fmi2Status {
+) -> S {
     with_instance(c, function, mask, |instance| {
         instance.stage = stage;
-        Ok(fmi2Status::fmi2OK)
+        Ok(())
     })
 }
 
@@ -44,13 +44,13 @@ pub(crate) fn discrete_update(
 ///
 /// # Safety
 /// The two flags must be NULL or writable.
-pub(crate) unsafe fn completed_integrator_step<B: Copy>(
+pub(crate) unsafe fn completed_integrator_step<S: From<fmi2Status>, B: Copy>(
     c: fmi2Component,
     function: &'static str,
     enter_event_mode: *mut B,
     terminate_simulation: *mut B,
     no: B,
-) -> fmi2Status {
+) -> S {
     with_instance(c, function, masks::COMPLETED_INTEGRATOR_STEP, |instance| {
         if enter_event_mode.is_null() {
             return Err(FmuError::NullArgument("enterEventMode"));
@@ -62,8 +62,7 @@ pub(crate) unsafe fn completed_integrator_step<B: Copy>(
         // SAFETY: both non-NULL (checked above) and writable per the contract.
         unsafe {
             write_out(enter_event_mode, no, "enterEventMode")?;
-            write_out(terminate_simulation, no, "terminateSimulation")?;
+            write_out(terminate_simulation, no, "terminateSimulation")
         }
-        Ok(fmi2Status::fmi2OK)
     })
 }
