@@ -5,7 +5,7 @@
 use crate::engine::Simulation;
 use crate::error::FmuError;
 use crate::fmi2_types::fmi2Status;
-use crate::log::{Category, LogFilter, Logger, category_of};
+use crate::log::{LogFilter, Logger, category_of};
 use crate::table::Api;
 use std::collections::HashMap;
 
@@ -208,7 +208,7 @@ pub struct Instance {
 impl std::fmt::Debug for Instance {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Instance")
-            .field("name", &self.logger.instance_name())
+            .field("name", &self.logger.instance_name)
             .field("model", &self.sim.table().info.identifier)
             .field("stage", &self.stage)
             .field("states", &self.states.len())
@@ -248,12 +248,9 @@ impl Instance {
         }
     }
 
-    /// Logs a lifecycle event.
+    /// Logs a lifecycle event (status OK: category logEvents).
     pub fn event(&self, message: &str) {
-        if self.filter.enabled(Category::Events) {
-            self.logger
-                .log(fmi2Status::fmi2OK, Category::Events, message);
-        }
+        self.log(fmi2Status::fmi2OK, message);
     }
 
     /// Logs why `function` failed and moves to the Error stage when the error says so.

@@ -45,14 +45,6 @@ pub const CATEGORIES: [(Category, &CStr, &str); 4] = [
 ];
 
 impl Category {
-    fn index(self) -> usize {
-        self as usize
-    }
-
-    fn c_name(self) -> &'static CStr {
-        CATEGORIES[self.index()].1
-    }
-
     /// The category called `name`.
     pub fn from_name(name: &str) -> Option<Category> {
         CATEGORIES
@@ -73,7 +65,7 @@ impl LogFilter {
     }
 
     pub fn set(&mut self, category: Category, on: bool) {
-        self.0[category.index()] = on;
+        self.0[category as usize] = on;
     }
 
     pub fn set_all(&mut self, on: bool) {
@@ -81,7 +73,7 @@ impl LogFilter {
     }
 
     pub fn enabled(&self, category: Category) -> bool {
-        self.0[category.index()]
+        self.0[category as usize]
     }
 }
 
@@ -102,22 +94,11 @@ pub enum Sink {
 /// The importer's logger with what it needs on every call.
 #[derive(Debug)]
 pub struct Logger {
-    sink: Sink,
-    instance_name: CString,
+    pub sink: Sink,
+    pub instance_name: CString,
 }
 
 impl Logger {
-    pub fn new(sink: Sink, instance_name: CString) -> Self {
-        Logger {
-            sink,
-            instance_name,
-        }
-    }
-
-    pub fn instance_name(&self) -> &CStr {
-        &self.instance_name
-    }
-
     /// Sends `message` (see [`Sink::send`]).
     pub fn log(&self, status: fmi2Status, category: Category, message: &str) {
         // SAFETY: callback and environment came together from the importer, which keeps
@@ -143,7 +124,7 @@ impl Sink {
         message: &str,
     ) {
         let text = CString::new(message.replace('\0', "\u{fffd}")).unwrap_or_default();
-        let category = category.c_name().as_ptr();
+        let category = CATEGORIES[category as usize].1.as_ptr();
         match *self {
             // SAFETY: the caller's contract; every string is NUL-terminated and outlives the
             // call; the format consumes exactly one string argument.
