@@ -29,7 +29,7 @@ pub const MAX_INTERNAL_STEPS: f64 = 1e8;
 
 /// The time grid: t = base + n·h while the step size stays h, so time is never a running
 /// sum. A new step size starts a new segment at the current time.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Clock {
     base: f64,
     step: f64,
@@ -131,7 +131,7 @@ pub struct Engine<M: FmuModel> {
 }
 
 /// What an instance holds besides the model (all of it goes into FMU states).
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 struct Book<I> {
     initial: I,
     /// Inputs set before initialisation, applied again whenever start values rebuild the
@@ -164,17 +164,9 @@ type Body<I> = (Book<I>, Vec<u8>);
 impl<M: FmuModel> Engine<M> {
     /// An instance at its start values.
     pub fn new() -> Result<Self, FmuError> {
-        let initial = M::Initial::default();
-        Ok(Engine {
-            model: M::build(None, &initial)?,
-            book: Book {
-                initial,
-                early_inputs: Vec::new(),
-                experiment: Experiment::default(),
-                clock: Clock::at(0.0),
-                event_time: 0.0,
-            },
-        })
+        let book = Book::<M::Initial>::default();
+        let model = M::build(None, &book.initial)?;
+        Ok(Engine { model, book })
     }
 
     /// Rebuilds the model from the start values, keeping the inputs set so far.

@@ -202,7 +202,7 @@ impl ModelTable {
             token3_c: CString::new(token3.clone()).unwrap_or_default(),
             guid,
             token3,
-            fmi3: Fmi3View::new(info, &variables, model_exchange.as_ref()),
+            fmi3: Fmi3View::new(info, &variables),
             by_vr: VrIndex::new(variables.iter().map(|v| v.value_reference)),
             variables,
             model_exchange,
@@ -379,10 +379,6 @@ pub struct Fmi3View {
     pub variables: Vec<Variable3>,
     /// Value reference → position in `variables`.
     by_vr: VrIndex,
-    /// FMI 3.0 value references of the continuous states and of their derivatives, in
-    /// state-vector order (an array once, where its first element comes).
-    pub states: Vec<u32>,
-    pub derivatives: Vec<u32>,
     /// Value references of the event-indicator variables, in order.
     pub event_indicators: Vec<u32>,
     /// Model value reference → (FMI 3.0 value reference, element index), sorted.
@@ -390,7 +386,7 @@ pub struct Fmi3View {
 }
 
 impl Fmi3View {
-    fn new(info: &ModelInfo, model: &[Variable], me: Option<&ModelExchangeTable>) -> Self {
+    fn new(info: &ModelInfo, model: &[Variable]) -> Self {
         let time = Variable3 {
             causality: Causality3::Independent,
             ..Variable3::computed("time", TIME_VR, "s", "Simulation time", Source::Time)
@@ -406,44 +402,27 @@ impl Fmi3View {
             variables.push(Variable3::of(run, at, array));
             at += len;
         }
-        let event_indicators: Vec<u32> = (EVENT_INDICATOR_VR..)
-            .take(info.event_indicators.len())
-            .collect();
-        for (i, (&(name, unit, text), &vr)) in info
-            .event_indicators
-            .iter()
-            .zip(&event_indicators)
-            .enumerate()
-        {
+        let event_indicators = (EVENT_INDICATOR_VR..).zip(info.event_indicators);
+        for (i, (vr, &(name, unit, text))) in event_indicators.enumerate() {
             let source = Source::EventIndicator(i);
             variables.push(Variable3::computed(name, vr, unit, text, source));
         }
-        let mut element_of: Vec<(u32, (u32, usize))> = variables
-            .iter()
-            .flat_map(|v| {
-                match &v.source {
-                    Source::Model(elements) => elements.clone(),
-                    _ => Vec::new(),
-                }
-                .into_iter()
-                .enumerate()
-                .map(|(i, at)| (model[at].value_reference, (v.value_reference, i)))
-            })
-            .collect();
+        let mut element_of: Vec<(u32, (u32, usize))> = Vec::new();
+        for v in &variables {
+            let elements = v.elements().iter().enumerate();
+            element_of.extend(
+                elements.map(|(i, &at)| (model[at].value_reference, (v.value_reference, i))),
+            );
+        }
         element_of.sort_unstable_by_key(|&(vr, _)| vr);
-        let mut view = Fmi3View {
+        Fmi3View {
             by_vr: VrIndex::new(variables.iter().map(|v| v.value_reference)),
             variables,
-            states: Vec::new(),
-            derivatives: Vec::new(),
-            event_indicators,
+            event_indicators: (EVENT_INDICATOR_VR..)
+                .take(info.event_indicators.len())
+                .collect(),
             element_of,
-        };
-        if let Some(me) = me {
-            view.states = view.collapse(&me.states);
-            view.derivatives = view.collapse(&me.derivatives);
         }
-        view
     }
 
     /// The FMI 3.0 variables holding the model variables `vrs`, each once, in order.
@@ -501,8 +480,9 @@ mod tests {
         assert_eq!(layout.by_name("der(motor_state)").unwrap().len(), 4);
         assert_eq!(layout.element(2), Some((0, 2)));
         // 25 states: 13 body scalars + motor_state[4] + 8 bristles = 22 variables.
-        assert_eq!(layout.states.len(), 22);
-        assert_eq!(layout.derivatives.len(), 22);
+        let me = quad.model_exchange.as_ref().unwrap();
+        assert_eq!(layout.collapse(&me.states).len(), 22);
+        assert_eq!(layout.collapse(&me.derivatives).len(), 22);
         assert_eq!(layout.event_indicators, [1001, 1002, 1003, 1004]);
         for table in [quad, lander] {
             let layout = &table.fmi3;
