@@ -22,13 +22,17 @@ macro_rules! exports {
     )*};
 }
 
-/// Defines exported C functions that hand their arguments, after their own name, to a body
-/// in [`shared`]: `fn name(arguments) -> status = body;`.
+/// Defines exported C functions whose body, once the instance passed the NULL and stage
+/// checks of `mask` ([`guard::with_instance`]), is a function of [`shared`] given the instance,
+/// the export's name and its other arguments: `fn name(arguments) -> status = mask => body;`.
 macro_rules! forward {
-    ($($(#[doc = $doc:literal])* fn $name:ident($c:ident: $ct:ty $(, $arg:ident: $t:ty)*) $(-> $ret:ty)? = $body:path;)*) => {
+    ($($(#[doc = $doc:literal])* fn $name:ident($c:ident: $ct:ty $(, $arg:ident: $t:ty)*) -> $ret:ty = $mask:path => $body:path;)*) => {
         exports! {$(
             $(#[doc = $doc])*
-            fn $name($c: $ct $(, $arg: $t)*) $(-> $ret)? { $body($c, stringify!($name) $(, $arg)*) }
+            fn $name($c: $ct $(, $arg: $t)*) -> $ret {
+                let function = stringify!($name);
+                $crate::exports::guard::with_instance($c, function, $mask, |instance| $body(instance, function $(, $arg)*))
+            }
         )*}
     };
 }

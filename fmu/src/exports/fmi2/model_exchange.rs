@@ -4,13 +4,9 @@ use crate::error::FmuError;
 use crate::exports::guard::{c_slice, c_slice_mut, with_instance, write_out};
 use crate::exports::shared::model_exchange::*;
 use crate::fmi2_types::*;
-use crate::instance::{Stage, masks};
+use crate::instance::masks;
 
 exports! {
-    fn fmi2EnterEventMode(c: fmi2Component) -> fmi2Status {
-        enter(c, "fmi2EnterEventMode", masks::ENTER_EVENT_MODE, Stage::EventMode)
-    }
-
     /// The discrete changes of the event at the current time (turbulence sample, released
     /// bristles) and the next time event.
     fn fmi2NewDiscreteStates(c: fmi2Component, eventInfo: *mut fmi2EventInfo) -> fmi2Status {
@@ -30,17 +26,6 @@ exports! {
             };
             write_out(eventInfo, info, "eventInfo")
         })
-    }
-
-    fn fmi2EnterContinuousTimeMode(c: fmi2Component) -> fmi2Status {
-        let mask = masks::ENTER_CONTINUOUS_TIME_MODE;
-        enter(c, "fmi2EnterContinuousTimeMode", mask, Stage::ContinuousTimeMode)
-    }
-
-    /// No step event and no termination; an error once the state is not finite.
-    fn fmi2CompletedIntegratorStep(c: fmi2Component, _noSetFMUStatePriorToCurrentPoint: fmi2Boolean, enterEventMode: *mut fmi2Boolean, terminateSimulation: *mut fmi2Boolean) -> fmi2Status {
-        let function = "fmi2CompletedIntegratorStep";
-        completed_integrator_step(c, function, enterEventMode, terminateSimulation, fmi2False)
     }
 
     /// A finite time not before the last event.
@@ -83,4 +68,12 @@ exports! {
             instance.sim.nominals(c_slice_mut(x_nominal, nx, "x_nominal")?)
         })
     }
+}
+
+forward! {
+    /// Model Exchange only (Co-Simulation has no event mode here).
+    fn fmi2EnterEventMode(c: fmi2Component) -> fmi2Status = masks::ENTER_EVENT_MODE => enter_event_mode;
+    fn fmi2EnterContinuousTimeMode(c: fmi2Component) -> fmi2Status = masks::ENTER_CONTINUOUS_TIME_MODE => enter_continuous_time_mode;
+    /// No step event and no termination; an error once the state is not finite.
+    fn fmi2CompletedIntegratorStep(c: fmi2Component, _noSetFMUStatePriorToCurrentPoint: fmi2Boolean, enterEventMode: *mut fmi2Boolean, terminateSimulation: *mut fmi2Boolean) -> fmi2Status = masks::COMPLETED_INTEGRATOR_STEP => completed_integrator_step;
 }

@@ -6,7 +6,7 @@ use crate::exports::shared::fmu_state::*;
 use crate::exports::shared::instantiate::{Request, instantiate};
 use crate::exports::shared::lifecycle::*;
 use crate::fmi3_types::*;
-use crate::instance::{Interface, Stage, masks3};
+use crate::instance::{Interface, Stage, masks, masks3};
 use crate::log::Sink;
 use crate::table::Api;
 use std::ffi::c_char;
@@ -46,6 +46,11 @@ unsafe fn request<'a>(
 }
 
 exports! {
+    /// Frees the instance and every FMU state it handed out. NULL is ignored.
+    fn fmi3FreeInstance(instance: fmi3Instance) {
+        free_instance(instance, "fmi3FreeInstance");
+    }
+
     /// A Model Exchange instance of the model whose token is `instantiationToken`
     /// (Quadrotor; Lander2D is Co-Simulation only). NULL, with the reason logged, on any
     /// failure.
@@ -90,23 +95,21 @@ exports! {
 }
 
 forward! {
-    fn fmi3SetDebugLogging(instance: fmi3Instance, loggingOn: fmi3Boolean, nCategories: usize, categories: *const fmi3String) -> fmi3Status = set_debug_logging;
-    /// Frees the instance and every FMU state it handed out. NULL is ignored.
-    fn fmi3FreeInstance(instance: fmi3Instance) = free_instance;
+    fn fmi3SetDebugLogging(instance: fmi3Instance, loggingOn: fmi3Boolean, nCategories: usize, categories: *const fmi3String) -> fmi3Status = masks::SET_DEBUG_LOGGING => set_debug_logging;
     /// Co-Simulation enters step mode, Model Exchange event mode.
-    fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status = exit_initialization_mode;
-    fn fmi3Terminate(instance: fmi3Instance) -> fmi3Status = terminate;
+    fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status = masks::EXIT_INITIALIZATION_MODE => exit_initialization_mode;
+    fn fmi3Terminate(instance: fmi3Instance) -> fmi3Status = masks::TERMINATE => terminate;
     /// Back to the state right after instantiation: start values, no experiment.
-    fn fmi3Reset(instance: fmi3Instance) -> fmi3Status = reset;
+    fn fmi3Reset(instance: fmi3Instance) -> fmi3Status = masks::RESET => reset;
     /// Copies the current state; `*FMUState` NULL gets a new state, a state of this instance
     /// is overwritten in place.
-    fn fmi3GetFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status = get_state;
+    fn fmi3GetFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status = masks::FMU_STATE => get_state;
     /// Restores a state of this instance; `FMUState` is looked up, never dereferenced.
-    fn fmi3SetFMUState(instance: fmi3Instance, FMUState: fmi3FMUState) -> fmi3Status = set_state;
+    fn fmi3SetFMUState(instance: fmi3Instance, FMUState: fmi3FMUState) -> fmi3Status = masks::FMU_STATE => set_state;
     /// Frees a state and sets `*FMUState` to NULL.
-    fn fmi3FreeFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status = free_state;
-    fn fmi3SerializedFMUStateSize(instance: fmi3Instance, FMUState: fmi3FMUState, size: *mut usize) -> fmi3Status = serialized_size;
-    fn fmi3SerializeFMUState(instance: fmi3Instance, FMUState: fmi3FMUState, serializedState: *mut fmi3Byte, size: usize) -> fmi3Status = serialize;
+    fn fmi3FreeFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status = masks::FMU_STATE => free_state;
+    fn fmi3SerializedFMUStateSize(instance: fmi3Instance, FMUState: fmi3FMUState, size: *mut usize) -> fmi3Status = masks::FMU_STATE => serialized_size;
+    fn fmi3SerializeFMUState(instance: fmi3Instance, FMUState: fmi3FMUState, serializedState: *mut fmi3Byte, size: usize) -> fmi3Status = masks::FMU_STATE => serialize;
     /// Makes a state from serialized bytes after checking them completely.
-    fn fmi3DeserializeFMUState(instance: fmi3Instance, serializedState: *const fmi3Byte, size: usize, FMUState: *mut fmi3FMUState) -> fmi3Status = deserialize;
+    fn fmi3DeserializeFMUState(instance: fmi3Instance, serializedState: *const fmi3Byte, size: usize, FMUState: *mut fmi3FMUState) -> fmi3Status = masks::FMU_STATE => deserialize;
 }

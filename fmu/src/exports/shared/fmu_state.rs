@@ -6,9 +6,8 @@
 //! foreign, garbage) is refused with an error instead of being dereferenced.
 
 use crate::error::FmuError;
-use crate::exports::guard::{c_slice, c_slice_mut, with_instance, write_out};
-use crate::fmi2_types::*;
-use crate::instance::masks;
+use crate::exports::guard::{c_slice, c_slice_mut, write_out};
+use crate::instance::Instance;
 use flyloop_core::number::Compact;
 use std::ffi::c_void;
 
@@ -29,20 +28,18 @@ unsafe fn slot<'a>(FMUstate: *mut StatePtr) -> Result<&'a mut StatePtr, FmuError
 ///
 /// # Safety
 /// `FMUstate` must be NULL or valid for reads and writes of one pointer.
-pub(crate) unsafe fn get_state<S: From<fmi2Status>>(
-    c: fmi2Component,
-    function: &'static str,
+pub(crate) unsafe fn get_state(
+    instance: &mut Instance,
+    function: &str,
     FMUstate: *mut StatePtr,
-) -> S {
-    with_instance(c, function, masks::FMU_STATE, |instance| {
-        // SAFETY: per the contract.
-        let slot = unsafe { slot(FMUstate) }?;
-        let bytes = instance.sim.save(instance.stage.code())?;
-        *slot = instance.keep_state(*slot as usize, bytes)?.cast();
-        let t = Compact(instance.sim.time());
-        instance.event(&format!("{function}: state saved at t = {t}"));
-        Ok(())
-    })
+) -> Result<(), FmuError> {
+    // SAFETY: per the contract.
+    let slot = unsafe { slot(FMUstate) }?;
+    let bytes = instance.sim.save(instance.stage.code())?;
+    *slot = instance.keep_state(*slot as usize, bytes)?.cast();
+    let t = Compact(instance.sim.time());
+    instance.event(&format!("{function}: state saved at t = {t}"));
+    Ok(())
 }
 
 /// Restores a state of this instance (stage, time and everything else included).
@@ -50,27 +47,25 @@ pub(crate) unsafe fn get_state<S: From<fmi2Status>>(
 /// # Safety
 /// `c` must be NULL or a live instance; `FMUstate` may be anything (it is looked up, not
 /// dereferenced).
-pub(crate) unsafe fn set_state<S: From<fmi2Status>>(
-    c: fmi2Component,
-    function: &'static str,
+pub(crate) unsafe fn set_state(
+    instance: &mut Instance,
+    function: &str,
     FMUstate: StatePtr,
-) -> S {
-    with_instance(c, function, masks::FMU_STATE, |instance| {
-        if FMUstate.is_null() {
-            return Err(FmuError::NullArgument("FMUstate"));
-        }
-        // A copy: the lookup borrows the instance that restore changes. Every state in the
-        // registry was made by fmi2GetFMUstate or checked by fmi2DeSerializeFMUstate, stage
-        // code included, and restore changes nothing when it fails.
-        let bytes = instance.state(FMUstate as usize)?.bytes.clone();
-        let code = instance.sim.restore(&bytes)?;
-        instance.stage = instance.stage_from_code(code)?;
-        let (t, stage) = (Compact(instance.sim.time()), instance.stage);
-        instance.event(&format!(
-            "{function}: state restored, t = {t}, stage {stage:?}"
-        ));
-        Ok(())
-    })
+) -> Result<(), FmuError> {
+    if FMUstate.is_null() {
+        return Err(FmuError::NullArgument("FMUstate"));
+    }
+    // A copy: the lookup borrows the instance that restore changes. Every state in the
+    // registry was made by fmi2GetFMUstate or checked by fmi2DeSerializeFMUstate, stage
+    // code included, and restore changes nothing when it fails.
+    let bytes = instance.state(FMUstate as usize)?.bytes.clone();
+    let code = instance.sim.restore(&bytes)?;
+    instance.stage = instance.stage_from_code(code)?;
+    let (t, stage) = (Compact(instance.sim.time()), instance.stage);
+    instance.event(&format!(
+        "{function}: state restored, t = {t}, stage {stage:?}"
+    ));
+    Ok(())
 }
 
 /// Frees a state and sets `*FMUstate` to NULL. `*FMUstate` NULL is ignored; a pointer this
@@ -78,62 +73,56 @@ pub(crate) unsafe fn set_state<S: From<fmi2Status>>(
 ///
 /// # Safety
 /// `FMUstate` must be NULL or valid for reads and writes of one pointer.
-pub(crate) unsafe fn free_state<S: From<fmi2Status>>(
-    c: fmi2Component,
-    function: &'static str,
+pub(crate) unsafe fn free_state(
+    instance: &mut Instance,
+    _function: &str,
     FMUstate: *mut StatePtr,
-) -> S {
-    with_instance(c, function, masks::FMU_STATE, |instance| {
-        // SAFETY: per the contract.
-        let slot = unsafe { slot(FMUstate) }?;
-        if !slot.is_null() {
-            instance.release_state(*slot as usize)?;
-            *slot = std::ptr::null_mut();
-        }
-        Ok(())
-    })
+) -> Result<(), FmuError> {
+    // SAFETY: per the contract.
+    let slot = unsafe { slot(FMUstate) }?;
+    if !slot.is_null() {
+        instance.release_state(*slot as usize)?;
+        *slot = std::ptr::null_mut();
+    }
+    Ok(())
 }
 
 /// # Safety
 /// `size` must be NULL or writable.
-pub(crate) unsafe fn serialized_size<S: From<fmi2Status>>(
-    c: fmi2Component,
-    function: &'static str,
+pub(crate) unsafe fn serialized_size(
+    instance: &mut Instance,
+    _function: &str,
     FMUstate: StatePtr,
     size: *mut usize,
-) -> S {
-    with_instance(c, function, masks::FMU_STATE, |instance| {
-        let length = instance.state(FMUstate as usize)?.bytes.len();
-        // SAFETY: per the contract.
-        unsafe { write_out(size, length, "size") }
-    })
+) -> Result<(), FmuError> {
+    let length = instance.state(FMUstate as usize)?.bytes.len();
+    // SAFETY: per the contract.
+    unsafe { write_out(size, length, "size") }
 }
 
 /// Copies a state's bytes; `size` must be what fmi2SerializedFMUstateSize said.
 ///
 /// # Safety
 /// `serializedState` must be NULL or writable for `size` bytes.
-pub(crate) unsafe fn serialize<S: From<fmi2Status>, B>(
-    c: fmi2Component,
-    function: &'static str,
+pub(crate) unsafe fn serialize<B>(
+    instance: &mut Instance,
+    _function: &str,
     FMUstate: StatePtr,
     serializedState: *mut B,
     size: usize,
-) -> S {
-    with_instance(c, function, masks::FMU_STATE, |instance| {
-        let bytes = &instance.state(FMUstate as usize)?.bytes;
-        if size != bytes.len() {
-            return Err(FmuError::InvalidArgument(format!(
-                "size is {size}, but the serialized state has {} bytes \
-                 (ask fmi2SerializedFMUstateSize)",
-                bytes.len()
-            )));
-        }
-        // SAFETY: per the contract.
-        let out = unsafe { c_slice_mut(serializedState.cast::<u8>(), size, "serializedState") }?;
-        out.copy_from_slice(bytes);
-        Ok(())
-    })
+) -> Result<(), FmuError> {
+    let bytes = &instance.state(FMUstate as usize)?.bytes;
+    if size != bytes.len() {
+        return Err(FmuError::InvalidArgument(format!(
+            "size is {size}, but the serialized state has {} bytes \
+             (ask fmi2SerializedFMUstateSize)",
+            bytes.len()
+        )));
+    }
+    // SAFETY: per the contract.
+    let out = unsafe { c_slice_mut(serializedState.cast::<u8>(), size, "serializedState") }?;
+    out.copy_from_slice(bytes);
+    Ok(())
 }
 
 /// Makes a state from serialized bytes after checking them completely (format, checksum,
@@ -142,20 +131,18 @@ pub(crate) unsafe fn serialize<S: From<fmi2Status>, B>(
 /// # Safety
 /// `serializedState` must be NULL or readable for `size` bytes; `FMUstate` must be NULL or
 /// valid for reads and writes of one pointer.
-pub(crate) unsafe fn deserialize<S: From<fmi2Status>, B>(
-    c: fmi2Component,
-    function: &'static str,
+pub(crate) unsafe fn deserialize<B>(
+    instance: &mut Instance,
+    _function: &str,
     serializedState: *const B,
     size: usize,
     FMUstate: *mut StatePtr,
-) -> S {
-    with_instance(c, function, masks::FMU_STATE, |instance| {
-        // SAFETY: per the contract.
-        let slot = unsafe { slot(FMUstate) }?;
-        // SAFETY: per the contract.
-        let bytes = unsafe { c_slice(serializedState.cast::<u8>(), size, "serializedState") }?;
-        instance.stage_from_code(instance.sim.check_saved(bytes)?)?;
-        *slot = instance.keep_state(*slot as usize, bytes.to_vec())?.cast();
-        Ok(())
-    })
+) -> Result<(), FmuError> {
+    // SAFETY: per the contract.
+    let slot = unsafe { slot(FMUstate) }?;
+    // SAFETY: per the contract.
+    let bytes = unsafe { c_slice(serializedState.cast::<u8>(), size, "serializedState") }?;
+    instance.stage_from_code(instance.sim.check_saved(bytes)?)?;
+    *slot = instance.keep_state(*slot as usize, bytes.to_vec())?.cast();
+    Ok(())
 }

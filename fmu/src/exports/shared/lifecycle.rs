@@ -29,15 +29,15 @@ pub(crate) fn free_instance(c: fmi2Component, function: &'static str) {
 ///
 /// # Safety
 /// `categories` must be NULL or point to `n` C strings.
-pub(crate) unsafe fn set_debug_logging<S: From<fmi2Status>>(
-    c: fmi2Component,
-    function: &'static str,
+pub(crate) unsafe fn set_debug_logging(
+    instance: &mut Instance,
+    function: &str,
     on: impl Into<i32>,
     n: usize,
     categories: *const fmi2String,
-) -> S {
+) -> Result<fmi2Status, FmuError> {
     let on = on.into() != 0;
-    with_instance(c, function, masks::SET_DEBUG_LOGGING, |instance| {
+    {
         // SAFETY: per the function's contract.
         let names = unsafe { c_slice(categories, n, "categories[]") }?;
         if names.is_empty() {
@@ -62,7 +62,7 @@ pub(crate) unsafe fn set_debug_logging<S: From<fmi2Status>>(
             worst = worst.max(instance.report(function, &error));
         }
         Ok(worst)
-    })
+    }
 }
 
 /// The experiment (fmi2SetupExperiment; fmi3EnterInitializationMode's arguments).
@@ -83,35 +83,29 @@ pub(crate) fn setup_experiment(
 
 /// The body of fmi2ExitInitializationMode and fmi3ExitInitializationMode: Co-Simulation
 /// goes to step mode, Model Exchange to event mode.
-pub(crate) fn exit_initialization_mode<S: From<fmi2Status>>(
-    c: fmi2Component,
-    function: &'static str,
-) -> S {
-    with_instance(c, function, masks::EXIT_INITIALIZATION_MODE, |instance| {
-        instance.stage = match instance.interface {
-            Interface::CoSimulation => Stage::StepComplete,
-            Interface::ModelExchange => Stage::EventMode,
-        };
-        instance.event(&format!("{function}: t = {}", Compact(instance.sim.time())));
-        Ok(())
-    })
+pub(crate) fn exit_initialization_mode(
+    instance: &mut Instance,
+    function: &str,
+) -> Result<(), FmuError> {
+    instance.stage = match instance.interface {
+        Interface::CoSimulation => Stage::StepComplete,
+        Interface::ModelExchange => Stage::EventMode,
+    };
+    instance.event(&format!("{function}: t = {}", Compact(instance.sim.time())));
+    Ok(())
 }
 
 /// The body of fmi2Terminate and fmi3Terminate.
-pub(crate) fn terminate<S: From<fmi2Status>>(c: fmi2Component, function: &'static str) -> S {
-    with_instance(c, function, masks::TERMINATE, |instance| {
-        instance.stage = Stage::Terminated;
-        instance.event(&format!("{function}: t = {}", Compact(instance.sim.time())));
-        Ok(())
-    })
+pub(crate) fn terminate(instance: &mut Instance, function: &str) -> Result<(), FmuError> {
+    instance.stage = Stage::Terminated;
+    instance.event(&format!("{function}: t = {}", Compact(instance.sim.time())));
+    Ok(())
 }
 
 /// The body of fmi2Reset and fmi3Reset: back to the state right after instantiation.
-pub(crate) fn reset<S: From<fmi2Status>>(c: fmi2Component, function: &'static str) -> S {
-    with_instance(c, function, masks::RESET, |instance| {
-        instance.sim.reset()?;
-        instance.stage = Stage::Instantiated;
-        instance.event(&format!("{function}: back to the start values"));
-        Ok(())
-    })
+pub(crate) fn reset(instance: &mut Instance, function: &str) -> Result<(), FmuError> {
+    instance.sim.reset()?;
+    instance.stage = Stage::Instantiated;
+    instance.event(&format!("{function}: back to the start values"));
+    Ok(())
 }
