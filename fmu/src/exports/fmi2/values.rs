@@ -49,42 +49,10 @@ macro_rules! accessors {
     };
 }
 
-accessors!(
-    fmi2GetReal,
-    fmi2SetReal,
-    fmi2Real,
-    ValueType::of(Api::Fmi2, ValueKind::Real),
-    masks::SET_REAL,
-    |v| v,
-    |v| v
-);
+accessors! { fmi2GetReal, fmi2SetReal, fmi2Real, ValueType::of(Api::Fmi2, ValueKind::Real), masks::SET_REAL, |v| v, |v| v }
 // Integer variables hold integers within i32 (their table ranges say so).
-accessors!(
-    fmi2GetInteger,
-    fmi2SetInteger,
-    fmi2Integer,
-    ValueType::of(Api::Fmi2, ValueKind::Integer),
-    masks::SET_OTHER,
-    |v| v as fmi2Integer,
-    f64::from
-);
-accessors!(
-    fmi2GetBoolean,
-    fmi2SetBoolean,
-    fmi2Boolean,
-    ValueType::of(Api::Fmi2, ValueKind::Boolean),
-    masks::SET_OTHER,
-    |v| if v != 0.0 { fmi2True } else { fmi2False },
-    |v| if v != fmi2False { 1.0 } else { 0.0 }
-);
+accessors! { fmi2GetInteger, fmi2SetInteger, fmi2Integer, ValueType::of(Api::Fmi2, ValueKind::Integer), masks::SET_OTHER, |v| v as fmi2Integer, f64::from }
+accessors! { fmi2GetBoolean, fmi2SetBoolean, fmi2Boolean, ValueType::of(Api::Fmi2, ValueKind::Boolean), masks::SET_OTHER, |v| if v != 0.0 { fmi2True } else { fmi2False }, |v| if v != fmi2False { 1.0 } else { 0.0 } }
 // There are no String variables: every value reference is refused (with its real type when
 // it exists); no value is ever converted.
-accessors!(
-    fmi2GetString,
-    fmi2SetString,
-    fmi2String,
-    ValueType::none(Api::Fmi2, "String"),
-    masks::SET_OTHER,
-    |_| std::ptr::null(),
-    |_| f64::NAN
-);
+accessors! { fmi2GetString, fmi2SetString, fmi2String, ValueType::none(Api::Fmi2, "String"), masks::SET_OTHER, |_| std::ptr::null(), |_| f64::NAN }

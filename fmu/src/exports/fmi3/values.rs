@@ -147,31 +147,7 @@ macro_rules! accessors {
 }
 pub(crate) use accessors;
 
-accessors!(
-    fmi3GetFloat64,
-    fmi3SetFloat64,
-    fmi3Float64,
-    ValueType::of(Api::Fmi3, ValueKind::Real),
-    masks3::SET_FLOAT64,
-    |v| v,
-    |v| v
-);
+accessors! { fmi3GetFloat64, fmi3SetFloat64, fmi3Float64, ValueType::of(Api::Fmi3, ValueKind::Real), masks3::SET_FLOAT64, |v| v, |v| v }
 // Int32 variables hold integers within i32 (their table ranges say so).
-accessors!(
-    fmi3GetInt32,
-    fmi3SetInt32,
-    fmi3Int32,
-    ValueType::of(Api::Fmi3, ValueKind::Integer),
-    masks3::SET_OTHER,
-    |v| v as i32,
-    f64::from
-);
-accessors!(
-    fmi3GetBoolean,
-    fmi3SetBoolean,
-    fmi3Boolean,
-    ValueType::of(Api::Fmi3, ValueKind::Boolean),
-    masks3::SET_OTHER,
-    |v| u8::from(v != 0.0),
-    |v: u8| if v != 0 { 1.0 } else { 0.0 }
-);
+accessors! { fmi3GetInt32, fmi3SetInt32, fmi3Int32, ValueType::of(Api::Fmi3, ValueKind::Integer), masks3::SET_OTHER, |v| v as i32, f64::from }
+accessors! { fmi3GetBoolean, fmi3SetBoolean, fmi3Boolean, ValueType::of(Api::Fmi3, ValueKind::Boolean), masks3::SET_OTHER, |v| u8::from(v != 0.0), |v: u8| if v != 0 { 1.0 } else { 0.0 } }
