@@ -63,7 +63,6 @@ impl Clock {
         }
     }
 
-    /// The clock after one more step of `h`.
     pub fn after(&self, h: f64) -> Clock {
         if self.n > 0 && self.step.to_bits() == h.to_bits() {
             Clock {
@@ -123,7 +122,6 @@ pub trait Simulation {
     fn completed_integrator_step(&self) -> Result<(), FmuError>;
 }
 
-/// [`Simulation`] for one model type.
 #[derive(Debug)]
 pub struct Engine<M: FmuModel> {
     model: M,
@@ -162,7 +160,6 @@ struct Record {
 type Body<I> = (Book<I>, Vec<u8>);
 
 impl<M: FmuModel> Engine<M> {
-    /// An instance at its start values.
     pub fn new() -> Result<Self, FmuError> {
         let book = Book::<M::Initial>::default();
         let model = M::build(None, &book.initial)?;

@@ -192,7 +192,6 @@ pub struct SavedState {
     pub bytes: Vec<u8>,
 }
 
-/// One FMU instance.
 pub struct Instance {
     pub api: Api,
     pub interface: Interface,
@@ -240,7 +239,6 @@ impl Instance {
         !matches!(self.stage, Stage::Instantiated | Stage::InitializationMode)
     }
 
-    /// Logs `message` if its category is on.
     pub fn log(&self, status: fmi2Status, message: &str) {
         let category = category_of(status);
         if self.filter.enabled(category) {
@@ -287,7 +285,6 @@ impl Instance {
         Ok(())
     }
 
-    /// Fails unless this is a Co-Simulation instance.
     pub fn check_co_simulation(&self) -> Result<(), FmuError> {
         match self.interface {
             Interface::CoSimulation => Ok(()),
@@ -333,7 +330,6 @@ impl Instance {
         Ok(address)
     }
 
-    /// The live state at `address`.
     pub fn state(&self, address: usize) -> Result<&SavedState, FmuError> {
         self.states
             .get(&address)
@@ -341,7 +337,6 @@ impl Instance {
             .ok_or(FmuError::UnknownState)
     }
 
-    /// Frees the live state at `address`.
     pub fn release_state(&mut self, address: usize) -> Result<(), FmuError> {
         self.states
             .remove(&address)

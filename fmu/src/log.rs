@@ -11,7 +11,6 @@ use crate::fmi2_types::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status
 use crate::fmi3_types::{fmi3InstanceEnvironment, fmi3LogMessageCallback};
 use std::ffi::{CStr, CString};
 
-/// A log category.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Category {
     Events,
@@ -45,7 +44,6 @@ pub const CATEGORIES: [(Category, &CStr, &str); 4] = [
 ];
 
 impl Category {
-    /// The category called `name`.
     pub fn from_name(name: &str) -> Option<Category> {
         CATEGORIES
             .iter()
@@ -54,7 +52,6 @@ impl Category {
     }
 }
 
-/// Which categories reach the logger.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LogFilter([bool; 4]);
 
@@ -153,7 +150,6 @@ impl Sink {
     }
 }
 
-/// The category a status is logged under.
 pub fn category_of(status: fmi2Status) -> Category {
     match status {
         fmi2Status::fmi2OK | fmi2Status::fmi2Pending => Category::Events,

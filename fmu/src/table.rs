@@ -35,7 +35,6 @@ impl Api {
         }
     }
 
-    /// The prefix of this version's functions.
     pub fn prefix(self) -> &'static str {
         match self {
             Api::Fmi2 => "fmi2",
@@ -65,7 +64,6 @@ pub struct ValueType {
 }
 
 impl ValueType {
-    /// The type of `api` for variables of `kind`.
     pub const fn of(api: Api, kind: ValueKind) -> Self {
         ValueType {
             api,
@@ -74,7 +72,6 @@ impl ValueType {
         }
     }
 
-    /// A type of `api` that no variable has.
     pub const fn none(api: Api, name: &'static str) -> Self {
         ValueType {
             api,
@@ -156,7 +153,6 @@ impl VrIndex {
         VrIndex(table)
     }
 
-    /// The position of `vr`, if it is there.
     pub fn get(&self, vr: u32) -> Option<usize> {
         let at = *self.0.get(vr as usize)?;
         (at != Self::NONE).then_some(at as usize)
@@ -217,7 +213,6 @@ impl ModelTable {
         }
     }
 
-    /// The position of value reference `vr` in `variables`.
     pub fn index(&self, vr: u32) -> Option<usize> {
         self.by_vr.get(vr)
     }
@@ -230,12 +225,10 @@ impl ModelTable {
         Ok(index)
     }
 
-    /// The variable with value reference `vr`.
     pub fn variable(&self, vr: u32) -> Option<&Variable> {
         self.variables.get(self.index(vr)?)
     }
 
-    /// The variable named `name`.
     pub fn by_name(&self, name: &str) -> Option<&Variable> {
         self.variables.iter().find(|v| v.name == name)
     }
@@ -284,9 +277,7 @@ pub enum Source {
     /// The model's variables at these positions of [`ModelTable::variables`] (one for a
     /// scalar).
     Model(Vec<usize>),
-    /// The instance's time.
     Time,
-    /// Event indicator number `i`.
     EventIndicator(usize),
 }
 
@@ -310,7 +301,6 @@ pub struct Variable3 {
 }
 
 impl Variable3 {
-    /// How many values the variable holds.
     pub fn len(&self) -> usize {
         self.dimension.unwrap_or(1)
     }
