@@ -19,36 +19,22 @@ pub enum Category {
     Fatal,
 }
 
-/// Every category with its name and description, in modelDescription order.
-pub const CATEGORIES: [(Category, &CStr, &str); 4] = [
-    (
-        Category::Events,
-        c"logEvents",
-        "Lifecycle: instantiation, initialisation, reset, termination, FMU states",
-    ),
-    (
-        Category::Warning,
-        c"logStatusWarning",
-        "Calls that return fmi2Warning",
-    ),
-    (
-        Category::Error,
-        c"logStatusError",
-        "Calls that return fmi2Error, with the reason",
-    ),
-    (
-        Category::Fatal,
-        c"logStatusFatal",
-        "Calls that return fmi2Fatal (an internal failure caught at the C boundary)",
-    ),
+/// Every category's name and description, in modelDescription order (a [`Category`] is its
+/// position).
+#[rustfmt::skip]
+pub const CATEGORIES: [(&CStr, &str); 4] = [
+    (c"logEvents", "Lifecycle: instantiation, initialisation, reset, termination, FMU states"),
+    (c"logStatusWarning", "Calls that return fmi2Warning"),
+    (c"logStatusError", "Calls that return fmi2Error, with the reason"),
+    (c"logStatusFatal", "Calls that return fmi2Fatal (an internal failure caught at the C boundary)"),
 ];
 
 impl Category {
+    const ALL: [Category; 4] = [Self::Events, Self::Warning, Self::Error, Self::Fatal];
+
     pub fn from_name(name: &str) -> Option<Category> {
-        CATEGORIES
-            .iter()
-            .find(|(_, c, _)| c.to_str() == Ok(name))
-            .map(|(cat, _, _)| *cat)
+        let at = CATEGORIES.iter().position(|(c, _)| c.to_str() == Ok(name));
+        at.map(|at| Self::ALL[at])
     }
 }
 
@@ -121,7 +107,7 @@ impl Sink {
         message: &str,
     ) {
         let text = CString::new(message.replace('\0', "\u{fffd}")).unwrap_or_default();
-        let category = CATEGORIES[category as usize].1.as_ptr();
+        let category = CATEGORIES[category as usize].0.as_ptr();
         match *self {
             // SAFETY: the caller's contract; every string is NUL-terminated and outlives the
             // call; the format consumes exactly one string argument.

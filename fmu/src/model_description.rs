@@ -211,7 +211,7 @@ impl<'a> Writer<'a> {
     /// `<LogCategories>` and `<DefaultExperiment>`.
     fn categories_and_experiment(&mut self) {
         self.out.push_str("  <LogCategories>\n");
-        for (_, name, description) in CATEGORIES {
+        for (name, description) in CATEGORIES {
             let _ = writeln!(
                 self.out,
                 "    <Category name=\"{}\" description=\"{}\"/>",
