@@ -189,8 +189,8 @@ impl ModelTable {
         variables: Vec<Variable>,
         model_exchange: Option<ModelExchangeTable>,
     ) -> Self {
-        let guid = guid::of_interface(info.identifier, &variables);
-        let token3 = guid::of_fmi3_interface(info.identifier, &variables);
+        let guid = guid::of_interface(Api::Fmi2, info.identifier, &variables);
+        let token3 = guid::of_interface(Api::Fmi3, info.identifier, &variables);
         ModelTable {
             info,
             // A GUID is hex digits, dashes and braces: it never holds a NUL.

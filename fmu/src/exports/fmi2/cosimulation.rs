@@ -7,33 +7,11 @@ use crate::exports::guard::{refuse, with_instance, write_out};
 use crate::fmi2_types::*;
 use crate::instance::{Instance, masks};
 
-/// The one status answer that applies to a synchronous FMU that never discards.
-fn status_kind(
-    instance: &Instance,
-    function: &str,
-    kind: fmi2StatusKind,
-) -> Result<fmi2Status, FmuError> {
-    let why = match kind {
-        fmi2DoStepStatus | fmi2PendingStatus => "fmi2DoStep never returns fmi2Pending",
-        fmi2LastSuccessfulTime | fmi2Terminated => "fmi2DoStep never returns fmi2Discard",
-        other => {
-            return Err(FmuError::InvalidArgument(format!(
-                "unknown fmi2StatusKind {other}"
-            )));
-        }
-    };
-    instance.log(
-        fmi2Status::fmi2Discard,
-        &format!("{function}: status kind {kind} does not apply: {why}"),
-    );
-    Ok(fmi2Status::fmi2Discard)
-}
-
 /// A status kind a function answers, with the way to read its value.
 type Known<T> = Option<(fmi2StatusKind, fn(&Instance) -> T)>;
 
-/// The body of fmi2Get*Status: `known` gives the value of its status kind, every other kind
-/// gets the [`status_kind`] answer.
+/// The body of fmi2Get*Status: `known` gives the value of its status kind; any other kind
+/// does not apply to a synchronous FMU that never discards.
 ///
 /// # Safety
 /// `value` must be NULL or writable.
@@ -44,13 +22,23 @@ unsafe fn status<T>(
     value: *mut T,
     known: Known<T>,
 ) -> fmi2Status {
-    with_instance(c, function, masks::GET_STATUS, |instance| match known {
-        Some((kind, read)) if kind == s => {
-            // SAFETY: per the contract.
-            unsafe { write_out(value, read(instance), "value") }?;
-            Ok(fmi2Status::fmi2OK)
-        }
-        _ => status_kind(instance, function, s),
+    with_instance(c, function, masks::GET_STATUS, |instance| {
+        let why = match (s, known) {
+            (s, Some((kind, read))) if s == kind => {
+                // SAFETY: per the contract.
+                unsafe { write_out(value, read(instance), "value") }?;
+                return Ok(fmi2Status::fmi2OK);
+            }
+            (fmi2DoStepStatus | fmi2PendingStatus, _) => "fmi2DoStep never returns fmi2Pending",
+            (fmi2LastSuccessfulTime | fmi2Terminated, _) => "fmi2DoStep never returns fmi2Discard",
+            (other, _) => {
+                let message = format!("unknown fmi2StatusKind {other}");
+                return Err(FmuError::InvalidArgument(message));
+            }
+        };
+        let message = format!("{function}: status kind {s} does not apply: {why}");
+        instance.log(fmi2Status::fmi2Discard, &message);
+        Ok(fmi2Status::fmi2Discard)
     })
 }
 
