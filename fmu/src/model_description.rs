@@ -211,22 +211,19 @@ impl<'a> Writer<'a> {
     /// `<LogCategories>` and `<DefaultExperiment>`.
     fn categories_and_experiment(&mut self) {
         self.out.push_str("  <LogCategories>\n");
-        for (name, description) in CATEGORIES {
+        for (name, text) in CATEGORIES {
+            let (name, text) = (name.to_string_lossy(), escape(text));
             let _ = writeln!(
                 self.out,
-                "    <Category name=\"{}\" description=\"{}\"/>",
-                name.to_string_lossy(),
-                escape(description)
+                "    <Category name=\"{name}\" description=\"{text}\"/>"
             );
         }
         let (start, stop, step) = self.table.info.default_experiment;
+        let [start, stop, step] = [start, stop, step].map(real);
         let _ = writeln!(
             self.out,
-            "  </LogCategories>\n  <DefaultExperiment startTime=\"{}\" stopTime=\"{}\" \
-             stepSize=\"{}\"/>",
-            real(start),
-            real(stop),
-            real(step)
+            "  </LogCategories>\n  <DefaultExperiment startTime=\"{start}\" stopTime=\"{stop}\" \
+             stepSize=\"{step}\"/>"
         );
     }
 
@@ -242,15 +239,13 @@ impl<'a> Writer<'a> {
         if self.api == Api::Fmi2 {
             let _ = writeln!(out, "    <!-- Index {} -->", i + 1);
         }
+        let (name, vr, text) = (escape(&v.name), v.value_reference, escape(&v.description));
+        let (causality, variability) = (v.causality.name(), format!("{:?}", v.variability));
         let _ = write!(
             out,
-            "    <{element} name=\"{}\" valueReference=\"{}\" description=\"{}\" \
-             causality=\"{}\" variability=\"{}\"",
-            escape(&v.name),
-            v.value_reference,
-            escape(&v.description),
-            v.causality.name(),
-            format!("{:?}", v.variability).to_lowercase()
+            "    <{element} name=\"{name}\" valueReference=\"{vr}\" description=\"{text}\" \
+             causality=\"{causality}\" variability=\"{}\"",
+            variability.to_lowercase()
         );
         if self.api == Api::Fmi2 {
             let _ = write!(out, ">\n      <{ty}");
