@@ -29,7 +29,7 @@ pub const MAX_INTERNAL_STEPS: f64 = 1e8;
 
 /// The time grid: t = base + n·h while the step size stays h, so time is never a running
 /// sum. A new step size starts a new segment at the current time.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Clock {
     base: f64,
     step: f64,
@@ -63,7 +63,6 @@ impl Clock {
         }
     }
 
-    /// The clock after one more step of `h`.
     pub fn after(&self, h: f64) -> Clock {
         if self.n > 0 && self.step.to_bits() == h.to_bits() {
             Clock {
@@ -87,19 +86,16 @@ pub struct Experiment {
     pub stop: Option<f64>,
 }
 
-/// The instance's simulation as the FMI functions drive it.
+/// The instance's simulation as the FMI functions drive it; a method named after an FMI
+/// function (`do_step`, `set_time`...) is that function's work.
 pub trait Simulation {
     fn table(&self) -> &'static ModelTable;
-    /// fmi2SetupExperiment.
     fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> Result<(), FmuError>;
-    /// Reads the variable at position `index` of the table.
+    /// Reads or writes the variable at position `index` of the table; `initialised` once
+    /// past fmi2ExitInitializationMode.
     fn get(&self, index: usize) -> f64;
-    /// Writes the variable at position `index` of the table; `initialised` once past
-    /// fmi2ExitInitializationMode.
     fn set(&mut self, index: usize, value: f64, initialised: bool) -> Result<(), FmuError>;
-    /// fmi2DoStep.
     fn do_step(&mut self, communication_point: f64, step_size: f64) -> Result<(), FmuError>;
-    /// The instance's time, s.
     fn time(&self) -> f64;
     /// Back to the start values (fmi2Reset).
     fn reset(&mut self) -> Result<(), FmuError>;
@@ -112,17 +108,12 @@ pub trait Simulation {
     fn restore(&mut self, bytes: &[u8]) -> Result<u8, FmuError>;
 
     // Model Exchange; each is an error for a Co-Simulation-only model.
-    /// fmi2SetTime.
     fn set_time(&mut self, time: f64) -> Result<(), FmuError>;
-    /// fmi2GetContinuousStates.
     fn continuous_states(&self, x: &mut [f64]) -> Result<(), FmuError>;
     /// fmi2SetContinuousStates; nothing changes when a value is refused.
     fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), FmuError>;
-    /// fmi2GetDerivatives.
     fn derivatives(&self, dx: &mut [f64]) -> Result<(), FmuError>;
-    /// fmi2GetEventIndicators.
     fn event_indicators(&self, z: &mut [f64]) -> Result<(), FmuError>;
-    /// fmi2GetNominalsOfContinuousStates.
     fn nominals(&self, nominals: &mut [f64]) -> Result<(), FmuError>;
     /// fmi2NewDiscreteStates: the discrete changes of an event at the current time. Returns
     /// whether the continuous states changed, and the next time event (absolute time).
@@ -131,11 +122,16 @@ pub trait Simulation {
     fn completed_integrator_step(&self) -> Result<(), FmuError>;
 }
 
-/// [`Simulation`] for one model type.
 #[derive(Debug)]
 pub struct Engine<M: FmuModel> {
     model: M,
-    initial: M::Initial,
+    book: Book<M::Initial>,
+}
+
+/// What an instance holds besides the model (all of it goes into FMU states).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+struct Book<I> {
+    initial: I,
     /// Inputs set before initialisation, applied again whenever start values rebuild the
     /// model (a rebuild would otherwise put them back to the model's defaults).
     early_inputs: Vec<(u32, f64)>,
@@ -159,37 +155,23 @@ struct Record {
     body: Vec<u8>,
 }
 
-/// The model-specific part of an FMU state.
-#[derive(Serialize, Deserialize)]
-struct Body<I> {
-    initial: I,
-    early_inputs: Vec<(u32, f64)>,
-    experiment: Experiment,
-    clock: Clock,
-    event_time: f64,
-    /// The model's own snapshot (the core's format, with its own checks).
-    model: Vec<u8>,
-}
+/// The model-specific part of an FMU state: the book, then the model's own snapshot (the
+/// core's format, with its own checks).
+type Body<I> = (Book<I>, Vec<u8>);
 
 impl<M: FmuModel> Engine<M> {
-    /// An instance at its start values.
     pub fn new() -> Result<Self, FmuError> {
-        let initial = M::Initial::default();
-        Ok(Engine {
-            model: M::build(None, &initial)?,
-            initial,
-            early_inputs: Vec::new(),
-            experiment: Experiment::default(),
-            clock: Clock::at(0.0),
-            event_time: 0.0,
-        })
+        let book = Book::<M::Initial>::default();
+        let model = M::build(None, &book.initial)?;
+        Ok(Engine { model, book })
     }
 
     /// Rebuilds the model from the start values, keeping the inputs set so far.
     fn rebuild(&mut self) -> Result<(), FmuError> {
-        let mut model = M::build(Some(&self.model), &self.initial)?;
-        for &(vr, value) in &self.early_inputs {
-            variables::set(&mut model, &mut self.initial, vr, value)?;
+        let book = &mut self.book;
+        let mut model = M::build(Some(&self.model), &book.initial)?;
+        for &(vr, value) in &book.early_inputs {
+            variables::set(&mut model, &mut book.initial, vr, value)?;
         }
         self.model = model;
         Ok(())
@@ -220,7 +202,7 @@ impl<M: FmuModel> Engine<M> {
     }
 
     /// Decodes FMU state bytes completely: stage code, bookkeeping and a restored model.
-    fn decode(bytes: &[u8]) -> Result<(u8, Body<M::Initial>, M), FmuError> {
+    fn decode(bytes: &[u8]) -> Result<(u8, Book<M::Initial>, M), FmuError> {
         let record: Record = state_record::decode(bytes)?;
         let table = M::table();
         if record.guid != table.guid {
@@ -229,10 +211,9 @@ impl<M: FmuModel> Engine<M> {
                 record.guid, table.info.identifier, table.guid
             )));
         }
-        let body: Body<M::Initial> = postcard::from_bytes(&record.body)
+        let (book, model): Body<M::Initial> = postcard::from_bytes(&record.body)
             .map_err(|e| FmuError::State(SnapshotError::Decode(e.to_string())))?;
-        let model = M::restore(&body.model)?;
-        Ok((record.stage, body, model))
+        Ok((record.stage, book, M::restore(&model)?))
     }
 }
 
@@ -257,15 +238,15 @@ impl<M: FmuModel> Simulation for Engine<M> {
                 )));
             }
         }
-        self.experiment = Experiment { start, stop };
-        self.clock = Clock::at(start);
-        self.event_time = start;
+        self.book.experiment = Experiment { start, stop };
+        self.book.clock = Clock::at(start);
+        self.book.event_time = start;
         Ok(())
     }
 
     fn get(&self, index: usize) -> f64 {
         match M::table().access[index] {
-            Access::Core(row) => row.get(&self.model, &self.initial),
+            Access::Core(row) => row.get(&self.model, &self.book.initial),
             Access::Local { read, at } => read(&self.model, at),
         }
     }
@@ -295,11 +276,11 @@ impl<M: FmuModel> Simulation for Engine<M> {
         let Access::Core(row) = table.access[index] else {
             return Err(FmuError::UnknownValueReference(vr));
         };
-        row.set(&mut self.model, &mut self.initial, value)?;
+        row.set(&mut self.model, &mut self.book.initial, value)?;
         if !initialised {
             if variable.causality == Causality::Input {
-                self.early_inputs.retain(|&(v, _)| v != vr);
-                self.early_inputs.push((vr, value));
+                self.book.early_inputs.retain(|&(v, _)| v != vr);
+                self.book.early_inputs.push((vr, value));
             } else {
                 self.rebuild()?;
             }
@@ -311,7 +292,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
         if !(step_size > 0.0 && step_size.is_finite()) {
             return Err(FmuError::StepSize(step_size));
         }
-        let now = self.clock.time();
+        let now = self.time();
         let tolerance = TIME_TOLERANCE * now.abs().max(1.0);
         let offset = (communication_point - now).abs();
         if offset.is_nan() || offset > tolerance {
@@ -321,16 +302,16 @@ impl<M: FmuModel> Simulation for Engine<M> {
                 tolerance,
             });
         }
-        let step_size = self.clock.grid_step(step_size);
-        let next = self.clock.after(step_size);
+        let step_size = self.book.clock.grid_step(step_size);
+        let next = self.book.clock.after(step_size);
         let end = next.time();
-        if let Some(stop) = self.experiment.stop {
+        if let Some(stop) = self.book.experiment.stop {
             if end > stop + TIME_TOLERANCE * stop.abs().max(1.0) {
                 return Err(FmuError::PastStopTime { end, stop });
             }
         }
         let request = StepRequest {
-            start_time: self.experiment.start,
+            start_time: self.book.experiment.start,
             end_time: end,
             step_size,
         };
@@ -342,7 +323,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
             });
         }
         self.model.advance(&request);
-        self.clock = next;
+        self.book.clock = next;
         if !self.model.is_finite() {
             return Err(FmuError::Diverged { time: end });
         }
@@ -350,7 +331,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
     }
 
     fn time(&self) -> f64 {
-        self.clock.time()
+        self.book.clock.time()
     }
 
     fn reset(&mut self) -> Result<(), FmuError> {
@@ -359,14 +340,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
     }
 
     fn save(&self, stage: u8) -> Result<Vec<u8>, FmuError> {
-        let body = Body {
-            initial: self.initial.clone(),
-            early_inputs: self.early_inputs.clone(),
-            experiment: self.experiment,
-            clock: self.clock,
-            event_time: self.event_time,
-            model: self.model.save()?,
-        };
+        let body: Body<M::Initial> = (self.book.clone(), self.model.save()?);
         let record = Record {
             guid: M::table().guid.clone(),
             stage,
@@ -381,15 +355,8 @@ impl<M: FmuModel> Simulation for Engine<M> {
     }
 
     fn restore(&mut self, bytes: &[u8]) -> Result<u8, FmuError> {
-        let (stage, body, model) = Self::decode(bytes)?;
-        *self = Engine {
-            model,
-            initial: body.initial,
-            early_inputs: body.early_inputs,
-            experiment: body.experiment,
-            clock: body.clock,
-            event_time: body.event_time,
-        };
+        let (stage, book, model) = Self::decode(bytes)?;
+        *self = Engine { model, book };
         Ok(stage)
     }
 
@@ -397,7 +364,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
     /// rejects, never past an event it has handled).
     fn set_time(&mut self, time: f64) -> Result<(), FmuError> {
         self.hybrid_mut()?;
-        let last = self.event_time;
+        let last = self.book.event_time;
         if !time.is_finite() || time < last - TIME_TOLERANCE * last.abs().max(1.0) {
             return Err(FmuError::InvalidArgument(format!(
                 "time {} is not a finite time at or after the last event ({})",
@@ -405,7 +372,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
                 Compact(last)
             )));
         }
-        self.clock = Clock::at(time);
+        self.book.clock = Clock::at(time);
         Ok(())
     }
 
@@ -437,7 +404,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
 
     fn new_discrete_states(&mut self) -> Result<(bool, Option<f64>), FmuError> {
         let now = self.time();
-        let elapsed = (now - self.event_time).max(0.0);
+        let elapsed = (now - self.book.event_time).max(0.0);
         let n = M::table()
             .model_exchange
             .as_ref()
@@ -448,7 +415,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
         hybrid.event_update(elapsed);
         hybrid.states(&mut after);
         let next = hybrid.time_event_after().map(|dt| now + dt);
-        self.event_time = now;
+        self.book.event_time = now;
         let changed = before
             .iter()
             .zip(&after)
@@ -460,9 +427,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
         if self.model.is_finite() {
             Ok(())
         } else {
-            Err(FmuError::Diverged {
-                time: self.clock.time(),
-            })
+            Err(FmuError::Diverged { time: self.time() })
         }
     }
 }

@@ -7,22 +7,17 @@ use flyloop_core::{ParamError, SnapshotError};
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FmuError {
-    /// The function is not allowed in the instance's current stage.
     #[error(
         "Illegal call sequence: the instance is in stage {stage}; \
          this function is allowed only in {allowed}"
     )]
     IllegalCall { stage: String, allowed: String },
-    /// A required pointer argument is NULL.
     #[error("argument `{0}` is NULL")]
     NullArgument(&'static str),
-    /// An argument with a value the function cannot use.
     #[error("{0}")]
     InvalidArgument(String),
-    /// No variable has this value reference.
     #[error("unknown value reference {0} (see modelDescription.xml)")]
     UnknownValueReference(u32),
-    /// The variable exists but has another type than the function's.
     #[error(
         "variable `{name}` (value reference {vr}) is of type {actual}, not {requested}: \
          use {api}Get{actual}/{api}Set{actual}"
@@ -54,7 +49,6 @@ pub enum FmuError {
          (freed already, or from another instance)"
     )]
     UnknownState,
-    /// `fmi2DoStep`'s currentCommunicationPoint is not the instance's time.
     #[error(
         "currentCommunicationPoint {g} does not match the instance's time \
          {e} (tolerance {t}); steps must follow each other, \
@@ -68,13 +62,11 @@ pub enum FmuError {
         expected: f64,
         tolerance: f64,
     },
-    /// `fmi2DoStep`'s communicationStepSize is not a positive finite number.
     #[error(
         "communicationStepSize must be a positive finite number, got {}",
         Compact(*.0)
     )]
     StepSize(f64),
-    /// The step would end after the stop time given in fmi2SetupExperiment.
     #[error(
         "the step would end at {e}, after the stop time {s} set in \
          fmi2SetupExperiment",
@@ -82,7 +74,6 @@ pub enum FmuError {
         s = Compact(*.stop)
     )]
     PastStopTime { end: f64, stop: f64 },
-    /// The step would take more internal steps than a call should run.
     #[error(
         "the step would take {s} internal steps (limit {l}); \
          use smaller communication steps",
@@ -90,7 +81,6 @@ pub enum FmuError {
         l = Compact(*.limit)
     )]
     TooManySteps { steps: f64, limit: f64 },
-    /// The dynamics produced a non-finite state; the instance stops in the Error stage.
     #[error(
         "the model state became non-finite at t = {t}; the instance is in the \
          Error stage (reset it or set an FMU state to go on)",
@@ -103,7 +93,6 @@ pub enum FmuError {
 }
 
 impl FmuError {
-    /// The status the caller gets.
     pub fn status(&self) -> fmi2Status {
         fmi2Status::fmi2Error
     }

@@ -3,6 +3,7 @@
 //! writes it into the modelDescription and checks it in fmi2Instantiate, so the two cannot
 //! drift apart; any change of the interface gives a new GUID.
 
+use crate::table::Api;
 use flyloop_core::variables::Variable;
 use std::fmt::Write;
 
@@ -13,19 +14,14 @@ fn fnv1a64(basis: u64, bytes: &[u8]) -> u64 {
     })
 }
 
-/// `{xxxxxxxx-xxxx-xxxx-xxxx-xxxxxxxxxxxx}` for the FMI 2.0 interface of `identifier`.
-pub fn of_interface(identifier: &str, variables: &[Variable]) -> String {
-    hash_interface(&format!("flyloop FMI 2.0 CS {identifier}\n"), variables)
-}
-
-/// The same for the FMI 3.0 interface (instantiationToken): another header, so that an FMI
-/// 2.0 modelDescription never instantiates through FMI 3.0 or the other way round.
-pub fn of_fmi3_interface(identifier: &str, variables: &[Variable]) -> String {
-    hash_interface(&format!("flyloop FMI 3.0 {identifier}\n"), variables)
-}
-
-fn hash_interface(header: &str, variables: &[Variable]) -> String {
-    let mut text = header.to_string();
+/// `{xxxxxxxx-xxxx-xxxx-xxxx-xxxxxxxxxxxx}` for the interface of `identifier` in `api` (FMI
+/// 2.0's GUID, FMI 3.0's instantiationToken): the header differs, so that an FMI 2.0
+/// modelDescription never instantiates through FMI 3.0 or the other way round.
+pub fn of_interface(api: Api, identifier: &str, variables: &[Variable]) -> String {
+    let mut text = match api {
+        Api::Fmi2 => format!("flyloop FMI 2.0 CS {identifier}\n"),
+        Api::Fmi3 => format!("flyloop FMI 3.0 {identifier}\n"),
+    };
     for v in variables {
         // Debug of f64 is the shortest exact form: equal text ⇔ equal values.
         let _ = writeln!(
@@ -63,15 +59,19 @@ mod tests {
     #[test]
     fn guid_has_the_uuid_shape_and_follows_the_interface() {
         let vars = variables::<Quadrotor>();
-        let guid = of_interface("Quadrotor", &vars);
+        let guid = of_interface(Api::Fmi2, "Quadrotor", &vars);
         assert_eq!(guid.len(), 38, "{guid}");
         assert!(guid.starts_with('{') && guid.ends_with('}'));
         let groups: Vec<usize> = guid[1..37].split('-').map(str::len).collect();
         assert_eq!(groups, [8, 4, 4, 4, 12]);
-        assert_eq!(guid, of_interface("Quadrotor", &vars), "deterministic");
-        assert_ne!(guid, of_interface("Other", &vars));
+        assert_eq!(
+            guid,
+            of_interface(Api::Fmi2, "Quadrotor", &vars),
+            "deterministic"
+        );
+        assert_ne!(guid, of_interface(Api::Fmi2, "Other", &vars));
         let mut changed = vars.clone();
         changed[0].max = Some(2.0);
-        assert_ne!(guid, of_interface("Quadrotor", &changed));
+        assert_ne!(guid, of_interface(Api::Fmi2, "Quadrotor", &changed));
     }
 }

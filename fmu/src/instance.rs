@@ -5,7 +5,7 @@
 use crate::engine::Simulation;
 use crate::error::FmuError;
 use crate::fmi2_types::fmi2Status;
-use crate::log::{Category, LogFilter, Logger, category_of};
+use crate::log::{LogFilter, Logger, category_of};
 use crate::table::Api;
 use std::collections::HashMap;
 
@@ -192,7 +192,6 @@ pub struct SavedState {
     pub bytes: Vec<u8>,
 }
 
-/// One FMU instance.
 pub struct Instance {
     pub api: Api,
     pub interface: Interface,
@@ -208,7 +207,7 @@ pub struct Instance {
 impl std::fmt::Debug for Instance {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Instance")
-            .field("name", &self.logger.instance_name())
+            .field("name", &self.logger.instance_name)
             .field("model", &self.sim.table().info.identifier)
             .field("stage", &self.stage)
             .field("states", &self.states.len())
@@ -240,7 +239,6 @@ impl Instance {
         !matches!(self.stage, Stage::Instantiated | Stage::InitializationMode)
     }
 
-    /// Logs `message` if its category is on.
     pub fn log(&self, status: fmi2Status, message: &str) {
         let category = category_of(status);
         if self.filter.enabled(category) {
@@ -248,12 +246,9 @@ impl Instance {
         }
     }
 
-    /// Logs a lifecycle event.
+    /// Logs a lifecycle event (status OK: category logEvents).
     pub fn event(&self, message: &str) {
-        if self.filter.enabled(Category::Events) {
-            self.logger
-                .log(fmi2Status::fmi2OK, Category::Events, message);
-        }
+        self.log(fmi2Status::fmi2OK, message);
     }
 
     /// Logs why `function` failed and moves to the Error stage when the error says so.
@@ -290,7 +285,6 @@ impl Instance {
         Ok(())
     }
 
-    /// Fails unless this is a Co-Simulation instance.
     pub fn check_co_simulation(&self) -> Result<(), FmuError> {
         match self.interface {
             Interface::CoSimulation => Ok(()),
@@ -336,7 +330,6 @@ impl Instance {
         Ok(address)
     }
 
-    /// The live state at `address`.
     pub fn state(&self, address: usize) -> Result<&SavedState, FmuError> {
         self.states
             .get(&address)
@@ -344,7 +337,6 @@ impl Instance {
             .ok_or(FmuError::UnknownState)
     }
 
-    /// Frees the live state at `address`.
     pub fn release_state(&mut self, address: usize) -> Result<(), FmuError> {
         self.states
             .remove(&address)

@@ -13,8 +13,8 @@
 //! - [`models`]: the quadrotor and the lander behind `FmuModel`; the GUID picks one.
 //!
 //! [`table`] holds each model's variables as the FMI layer looks them up (with the FMI 3.0
-//! view: arrays, `time`, event indicators); [`model_description`] and [`model_description3`]
-//! write each modelDescription.xml from it; [`pack`] zips the FMUs (binary
+//! view: arrays, `time`, event indicators); [`model_description`] writes each
+//! modelDescription.xml from it; [`pack`] zips the FMUs (binary
 //! `flyloop-fmu-pack`).
 
 pub mod engine;
@@ -27,7 +27,6 @@ pub mod instance;
 pub mod log;
 pub mod model;
 pub mod model_description;
-pub mod model_description3;
 pub mod models;
 pub mod pack;
 pub mod state_record;

@@ -11,7 +11,6 @@ use crate::fmi2_types::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status
 use crate::fmi3_types::{fmi3InstanceEnvironment, fmi3LogMessageCallback};
 use std::ffi::{CStr, CString};
 
-/// A log category.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Category {
     Events,
@@ -20,49 +19,25 @@ pub enum Category {
     Fatal,
 }
 
-/// Every category with its name and description, in modelDescription order.
-pub const CATEGORIES: [(Category, &CStr, &str); 4] = [
-    (
-        Category::Events,
-        c"logEvents",
-        "Lifecycle: instantiation, initialisation, reset, termination, FMU states",
-    ),
-    (
-        Category::Warning,
-        c"logStatusWarning",
-        "Calls that return fmi2Warning",
-    ),
-    (
-        Category::Error,
-        c"logStatusError",
-        "Calls that return fmi2Error, with the reason",
-    ),
-    (
-        Category::Fatal,
-        c"logStatusFatal",
-        "Calls that return fmi2Fatal (an internal failure caught at the C boundary)",
-    ),
+/// Every category's name and description, in modelDescription order (a [`Category`] is its
+/// position).
+#[rustfmt::skip]
+pub const CATEGORIES: [(&CStr, &str); 4] = [
+    (c"logEvents", "Lifecycle: instantiation, initialisation, reset, termination, FMU states"),
+    (c"logStatusWarning", "Calls that return fmi2Warning"),
+    (c"logStatusError", "Calls that return fmi2Error, with the reason"),
+    (c"logStatusFatal", "Calls that return fmi2Fatal (an internal failure caught at the C boundary)"),
 ];
 
 impl Category {
-    fn index(self) -> usize {
-        self as usize
-    }
+    const ALL: [Category; 4] = [Self::Events, Self::Warning, Self::Error, Self::Fatal];
 
-    fn c_name(self) -> &'static CStr {
-        CATEGORIES[self.index()].1
-    }
-
-    /// The category called `name`.
     pub fn from_name(name: &str) -> Option<Category> {
-        CATEGORIES
-            .iter()
-            .find(|(_, c, _)| c.to_str() == Ok(name))
-            .map(|(cat, _, _)| *cat)
+        let at = CATEGORIES.iter().position(|(c, _)| c.to_str() == Ok(name));
+        at.map(|at| Self::ALL[at])
     }
 }
 
-/// Which categories reach the logger.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LogFilter([bool; 4]);
 
@@ -73,7 +48,7 @@ impl LogFilter {
     }
 
     pub fn set(&mut self, category: Category, on: bool) {
-        self.0[category.index()] = on;
+        self.0[category as usize] = on;
     }
 
     pub fn set_all(&mut self, on: bool) {
@@ -81,7 +56,7 @@ impl LogFilter {
     }
 
     pub fn enabled(&self, category: Category) -> bool {
-        self.0[category.index()]
+        self.0[category as usize]
     }
 }
 
@@ -102,22 +77,11 @@ pub enum Sink {
 /// The importer's logger with what it needs on every call.
 #[derive(Debug)]
 pub struct Logger {
-    sink: Sink,
-    instance_name: CString,
+    pub sink: Sink,
+    pub instance_name: CString,
 }
 
 impl Logger {
-    pub fn new(sink: Sink, instance_name: CString) -> Self {
-        Logger {
-            sink,
-            instance_name,
-        }
-    }
-
-    pub fn instance_name(&self) -> &CStr {
-        &self.instance_name
-    }
-
     /// Sends `message` (see [`Sink::send`]).
     pub fn log(&self, status: fmi2Status, category: Category, message: &str) {
         // SAFETY: callback and environment came together from the importer, which keeps
@@ -143,7 +107,7 @@ impl Sink {
         message: &str,
     ) {
         let text = CString::new(message.replace('\0', "\u{fffd}")).unwrap_or_default();
-        let category = category.c_name().as_ptr();
+        let category = CATEGORIES[category as usize].0.as_ptr();
         match *self {
             // SAFETY: the caller's contract; every string is NUL-terminated and outlives the
             // call; the format consumes exactly one string argument.
@@ -172,7 +136,6 @@ impl Sink {
     }
 }
 
-/// The category a status is logged under.
 pub fn category_of(status: fmi2Status) -> Category {
     match status {
         fmi2Status::fmi2OK | fmi2Status::fmi2Pending => Category::Events,

@@ -1,14 +1,16 @@
-//! Writes a model's modelDescription.xml (FMI 2.0 Co-Simulation, and Model Exchange for a
-//! model that offers it: states, derivatives, event indicators) from its table: every
-//! variable with unit, description, start and range; unit definitions for every unit used;
-//! log categories; the default experiment; the model structure. Deterministic output (no
-//! date), so the checked-in copies under modelDescription/ can be compared byte for byte.
+//! Writes a model's modelDescription.xml, FMI 2.0 or FMI 3.0, from its table: Co-Simulation,
+//! and Model Exchange for a model that offers it; every variable with unit, description,
+//! start and range (FMI 3.0: the [`Fmi3View`](crate::table::Fmi3View), with arrays, `time`
+//! and the event indicators); unit definitions for every unit used; log categories; the
+//! default experiment; the model structure. One writer, the versions differ only where the
+//! standards do. Deterministic output (no date), so the checked-in copies under
+//! modelDescription/ can be compared byte for byte.
 
 use crate::log::CATEGORIES;
-use crate::table::{Api, Causality3, ModelInfo, ModelTable};
+use crate::table::{Api, Causality3, ModelTable, Variable3};
 use crate::units::{self, BASE_UNITS};
 use flyloop_core::params::ValueKind;
-use flyloop_core::variables::{Causality, Variability, Variable};
+use flyloop_core::variables::{Causality, Variable};
 use std::collections::BTreeSet;
 use std::fmt::Write;
 
@@ -21,23 +23,21 @@ pub struct UnknownUnit {
 }
 
 /// Escapes text for an XML attribute value.
-pub(crate) fn escape(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for ch in text.chars() {
-        match ch {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            c => out.push(c),
-        }
-    }
-    out
+fn escape(text: &str) -> String {
+    let pairs = [
+        ('&', "&amp;"),
+        ('<', "&lt;"),
+        ('>', "&gt;"),
+        ('"', "&quot;"),
+        ('\'', "&apos;"),
+    ];
+    pairs
+        .iter()
+        .fold(text.to_string(), |t, &(c, e)| t.replace(c, e))
 }
 
 /// An xs:double: the shortest text that reads back to the same f64.
-pub(crate) fn real(value: f64) -> String {
+fn real(value: f64) -> String {
     if value.is_nan() {
         "NaN".to_string()
     } else if value.is_infinite() {
@@ -47,8 +47,7 @@ pub(crate) fn real(value: f64) -> String {
     }
 }
 
-/// A value of `kind` as its XML attribute text.
-pub(crate) fn value_text(kind: ValueKind, value: f64) -> String {
+fn value_text(kind: ValueKind, value: f64) -> String {
     match kind {
         ValueKind::Real => real(value),
         ValueKind::Integer => format!("{}", value as i64),
@@ -56,141 +55,71 @@ pub(crate) fn value_text(kind: ValueKind, value: f64) -> String {
     }
 }
 
-pub(crate) fn variability(v: Variability) -> &'static str {
-    match v {
-        Variability::Fixed => "fixed",
-        Variability::Tunable => "tunable",
-        Variability::Continuous => "continuous",
-        Variability::Discrete => "discrete",
+/// The capability attributes of (ModelExchange, CoSimulation) in `api`.
+fn capabilities(api: Api) -> (&'static str, &'static str) {
+    match api {
+        Api::Fmi2 => (
+            "needsExecutionTool=\"false\" completedIntegratorStepNotNeeded=\"true\" \
+             canBeInstantiatedOnlyOncePerProcess=\"false\" \
+             canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" \
+             canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"",
+            "needsExecutionTool=\"false\" canHandleVariableCommunicationStepSize=\"true\" \
+             canInterpolateInputs=\"false\" maxOutputDerivativeOrder=\"0\" \
+             canRunAsynchronuously=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" \
+             canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" \
+             canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"",
+        ),
+        Api::Fmi3 => (
+            "needsExecutionTool=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" \
+             canGetAndSetFMUState=\"true\" canSerializeFMUState=\"true\" \
+             providesDirectionalDerivatives=\"false\" providesAdjointDerivatives=\"false\" \
+             providesPerElementDependencies=\"false\" needsCompletedIntegratorStep=\"false\" \
+             providesEvaluateDiscreteStates=\"false\"",
+            "needsExecutionTool=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" \
+             canGetAndSetFMUState=\"true\" canSerializeFMUState=\"true\" \
+             providesDirectionalDerivatives=\"false\" providesAdjointDerivatives=\"false\" \
+             providesPerElementDependencies=\"false\" \
+             canHandleVariableCommunicationStepSize=\"true\" maxOutputDerivativeOrder=\"0\" \
+             providesIntermediateUpdate=\"false\" mightReturnEarlyFromDoStep=\"false\" \
+             canReturnEarlyAfterIntermediateUpdate=\"false\" hasEventMode=\"false\" \
+             providesEvaluateDiscreteStates=\"false\"",
+        ),
     }
 }
 
-/// The units of Real variables, sorted.
-#[cfg(test)]
-fn units_used(variables: &[Variable]) -> BTreeSet<&'static str> {
-    variables
+/// `<UnitDefinitions>` for the units of the Real variables.
+fn write_units(out: &mut String, variables: &[Variable3]) -> Result<(), UnknownUnit> {
+    let used = variables
         .iter()
-        .filter(|v| v.kind == ValueKind::Real && !v.unit.is_empty())
-        .map(|v| v.unit)
-        .collect()
-}
-
-fn unit_definitions(out: &mut String, variables: &[Variable]) -> Result<(), UnknownUnit> {
-    let units: Vec<(&str, &str)> = variables
-        .iter()
-        .filter(|v| v.kind == ValueKind::Real && !v.unit.is_empty())
-        .map(|v| (v.unit, v.name))
-        .collect();
-    write_units(out, &units)
-}
-
-/// `<UnitDefinitions>` for the units of `used` ((unit, a variable that has it) pairs).
-pub(crate) fn write_units(out: &mut String, used: &[(&str, &str)]) -> Result<(), UnknownUnit> {
-    let units: BTreeSet<&str> = used.iter().map(|&(unit, _)| unit).collect();
+        .filter(|v| v.kind == ValueKind::Real && !v.unit.is_empty());
     out.push_str("  <UnitDefinitions>\n");
-    for unit in units {
+    for unit in used.clone().map(|v| v.unit).collect::<BTreeSet<_>>() {
         let exponents = units::exponents(unit).ok_or_else(|| UnknownUnit {
             unit: unit.to_string(),
             variable: used
-                .iter()
-                .find(|&&(u, _)| u == unit)
-                .map_or_else(String::new, |&(_, name)| name.to_string()),
+                .clone()
+                .find(|v| v.unit == unit)
+                .map_or_else(String::new, |v| v.name.clone()),
         })?;
+        let _ = write!(out, "    <Unit name=\"{}\"", escape(unit));
         match exponents {
             Some(exponents) => {
-                let _ = write!(out, "    <Unit name=\"{}\">\n      <BaseUnit", escape(unit));
-                for (name, e) in BASE_UNITS.iter().zip(exponents) {
-                    if e != 0 {
-                        let _ = write!(out, " {name}=\"{e}\"");
-                    }
+                out.push_str(">\n      <BaseUnit");
+                for (name, e) in BASE_UNITS.iter().zip(exponents).filter(|(_, e)| *e != 0) {
+                    let _ = write!(out, " {name}=\"{e}\"");
                 }
                 out.push_str("/>\n    </Unit>\n");
             }
-            None => {
-                let _ = writeln!(out, "    <Unit name=\"{}\"/>", escape(unit));
-            }
+            None => out.push_str("/>\n"),
         }
     }
     out.push_str("  </UnitDefinitions>\n");
     Ok(())
 }
 
-/// `<LogCategories>` and `<DefaultExperiment>` (the same in FMI 2.0 and 3.0).
-pub(crate) fn categories_and_experiment(out: &mut String, info: &ModelInfo) {
-    out.push_str("  <LogCategories>\n");
-    for (_, name, description) in CATEGORIES {
-        let _ = writeln!(
-            out,
-            "    <Category name=\"{}\" description=\"{}\"/>",
-            name.to_string_lossy(),
-            escape(description)
-        );
-    }
-    out.push_str("  </LogCategories>\n");
-    let (start, stop, step) = info.default_experiment;
-    let _ = writeln!(
-        out,
-        "  <DefaultExperiment startTime=\"{}\" stopTime=\"{}\" stepSize=\"{}\"/>",
-        real(start),
-        real(stop),
-        real(step)
-    );
-}
-
-/// The unit (Real variables only), range (not for Booleans) and start attributes (every
-/// element's, for an FMI 3.0 array).
-pub(crate) fn value_attributes(
-    out: &mut String,
-    kind: ValueKind,
-    unit: &str,
-    [min, max]: [Option<f64>; 2],
-    start: &[f64],
-) {
-    if kind == ValueKind::Real && !unit.is_empty() {
-        let _ = write!(out, " unit=\"{}\"", escape(unit));
-    }
-    if kind != ValueKind::Boolean {
-        for (name, bound) in [("min", min), ("max", max)] {
-            if let Some(b) = bound {
-                let _ = write!(out, " {name}=\"{}\"", value_text(kind, b));
-            }
-        }
-    }
-    if !start.is_empty() {
-        let starts: Vec<String> = start.iter().map(|&s| value_text(kind, s)).collect();
-        let _ = write!(out, " start=\"{}\"", starts.join(" "));
-    }
-}
-
-/// `derivative` is the 1-based index of the state a derivative variable belongs to.
-fn scalar_variable(out: &mut String, v: &Variable, derivative: Option<usize>) {
-    let _ = writeln!(
-        out,
-        "    <ScalarVariable name=\"{}\" valueReference=\"{}\" description=\"{}\" \
-         causality=\"{}\" variability=\"{}\">",
-        escape(v.name),
-        v.value_reference,
-        escape(v.description),
-        Causality3::Model(v.causality).name(),
-        variability(v.variability)
-    );
-    let _ = write!(out, "      <{}", Api::Fmi2.type_name(v.kind));
-    let range = [v.min, v.max];
-    value_attributes(out, v.kind, v.unit, range, v.start.as_slice());
-    if let Some(state) = derivative {
-        let _ = write!(out, " derivative=\"{state}\"");
-    }
-    out.push_str("/>\n    </ScalarVariable>\n");
-}
-
-/// 1-based position (ModelVariables order) of value reference `vr`.
-fn index_of(table: &ModelTable, vr: u32) -> Option<usize> {
-    table.index(vr).map(|i| i + 1)
-}
-
 /// The value references `output` depends on: its direct-feedthrough inputs and, under Model
 /// Exchange, the continuous states (none for a state itself, which is its own known).
-pub(crate) fn output_dependencies(table: &ModelTable, output: &Variable) -> Vec<u32> {
+fn output_dependencies(table: &ModelTable, output: &Variable) -> Vec<u32> {
     let mut dependencies: Vec<u32> = table
         .direct_feedthrough(output.name)
         .iter()
@@ -206,108 +135,238 @@ pub(crate) fn output_dependencies(table: &ModelTable, output: &Variable) -> Vec<
     dependencies
 }
 
-fn model_structure(out: &mut String, table: &ModelTable) {
-    let outputs: Vec<(usize, &Variable)> = table
-        .variables
-        .iter()
-        .enumerate()
-        .filter(|(_, v)| v.causality == Causality::Output)
-        .collect();
-    out.push_str("  <ModelStructure>\n    <Outputs>\n");
-    for &(i, v) in &outputs {
-        let _ = writeln!(
-            out,
-            "      <Unknown index=\"{}\" dependencies=\"{}\"/>",
-            i + 1,
-            output_dependencies(table, v)
-                .iter()
-                .filter_map(|&vr| index_of(table, vr))
-                .map(|i| i.to_string())
-                .collect::<Vec<_>>()
-                .join(" ")
-        );
-    }
-    out.push_str("    </Outputs>\n");
-    // Calculated during initialisation, from any of the start values: every output, and under
-    // Model Exchange the local states and every derivative.
-    let mut initial: Vec<usize> = outputs.iter().map(|&(i, _)| i + 1).collect();
-    if let Some(me) = &table.model_exchange {
-        out.push_str("    <Derivatives>\n");
-        for &vr in &me.derivatives {
-            if let Some(i) = index_of(table, vr) {
-                let _ = writeln!(out, "      <Unknown index=\"{i}\"/>");
-                initial.push(i);
-            }
-        }
-        out.push_str("    </Derivatives>\n");
-        initial.extend(me.states.iter().filter_map(|&vr| index_of(table, vr)));
-    }
-    initial.sort_unstable();
-    initial.dedup();
-    out.push_str("    <InitialUnknowns>\n");
-    for i in initial {
-        let _ = writeln!(out, "      <Unknown index=\"{i}\"/>");
-    }
-    out.push_str("    </InitialUnknowns>\n  </ModelStructure>\n");
+/// One modelDescription being written: the version and the variables in ModelVariables order
+/// (FMI 2.0: the table's, each a scalar; FMI 3.0: the FMI 3.0 view's).
+struct Writer<'a> {
+    api: Api,
+    table: &'a ModelTable,
+    variables: &'a [Variable3],
+    out: String,
 }
 
-/// The modelDescription.xml of `table`'s model.
-pub fn generate(table: &ModelTable) -> Result<String, UnknownUnit> {
-    let info = table.info;
-    let mut out = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-    let _ = writeln!(
-        out,
-        "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{}\" guid=\"{}\" \
-         description=\"{}\" version=\"{}\" generationTool=\"flyloop\" \
-         variableNamingConvention=\"flat\" numberOfEventIndicators=\"{}\">",
-        info.identifier,
-        table.guid,
-        escape(info.description),
-        env!("CARGO_PKG_VERSION"),
-        table
+impl<'a> Writer<'a> {
+    /// How ModelStructure names the variable at position `i`: FMI 2.0 by its 1-based index,
+    /// FMI 3.0 by its value reference.
+    fn id(&self, i: usize) -> u32 {
+        match self.api {
+            Api::Fmi2 => i as u32 + 1,
+            Api::Fmi3 => self.variables[i].value_reference,
+        }
+    }
+
+    /// [`Writer::id`] of the variable that holds model variable `vr`.
+    fn id_of(&self, vr: u32) -> Option<u32> {
+        match self.api {
+            Api::Fmi2 => self.table.index(vr).map(|i| i as u32 + 1),
+            Api::Fmi3 => self.table.fmi3.element(vr).map(|(vr, _)| vr),
+        }
+    }
+
+    /// The ids of the variables holding the model variables `vrs`, each once, in order.
+    fn ids_of(&self, vrs: impl IntoIterator<Item = u32>) -> Vec<u32> {
+        let mut ids: Vec<u32> = Vec::new();
+        for id in vrs.into_iter().filter_map(|vr| self.id_of(vr)) {
+            if !ids.contains(&id) {
+                ids.push(id);
+            }
+        }
+        ids
+    }
+
+    /// The id of the state whose derivative `v` is.
+    fn state_of_derivative(&self, v: &Variable3) -> Option<u32> {
+        let me = self.table.model_exchange.as_ref()?;
+        let vr = self.table.variables[*v.elements().first()?].value_reference;
+        let k = me.derivatives.iter().position(|&d| d == vr)?;
+        self.id_of(me.states[k])
+    }
+
+    fn header(&mut self) {
+        let (api, table, info) = (self.api, self.table, self.table.info);
+        let n = table
             .model_exchange
             .as_ref()
-            .map_or(0, |me| me.event_indicators)
-    );
-    if table.model_exchange.is_some() {
+            .map_or(0, |me| me.event_indicators);
+        let (version, token, events) = match api {
+            Api::Fmi2 => ("2.0", "guid", format!(" numberOfEventIndicators=\"{n}\"")),
+            Api::Fmi3 => ("3.0", "instantiationToken", String::new()),
+        };
         let _ = writeln!(
-            out,
-            "  <ModelExchange modelIdentifier=\"{}\" needsExecutionTool=\"false\" \
-             completedIntegratorStepNotNeeded=\"true\" \
-             canBeInstantiatedOnlyOncePerProcess=\"false\" \
-             canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" \
-             canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"/>",
-            info.identifier
+            self.out,
+            "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<fmiModelDescription \
+             fmiVersion=\"{version}\" modelName=\"{}\" {token}=\"{}\" description=\"{}\" \
+             version=\"{}\" generationTool=\"flyloop\" variableNamingConvention=\"flat\"{events}>",
+            info.identifier,
+            table.token(api),
+            escape(info.description),
+            env!("CARGO_PKG_VERSION"),
+        );
+        let ((me, cs), id) = (capabilities(api), info.identifier);
+        if table.model_exchange.is_some() {
+            let _ = writeln!(self.out, "  <ModelExchange modelIdentifier=\"{id}\" {me}/>");
+        }
+        let _ = writeln!(self.out, "  <CoSimulation modelIdentifier=\"{id}\" {cs}/>");
+    }
+
+    /// `<LogCategories>` and `<DefaultExperiment>`.
+    fn categories_and_experiment(&mut self) {
+        self.out.push_str("  <LogCategories>\n");
+        for (name, text) in CATEGORIES {
+            let (name, text) = (name.to_string_lossy(), escape(text));
+            let _ = writeln!(
+                self.out,
+                "    <Category name=\"{name}\" description=\"{text}\"/>"
+            );
+        }
+        let (start, stop, step) = self.table.info.default_experiment;
+        let [start, stop, step] = [start, stop, step].map(real);
+        let _ = writeln!(
+            self.out,
+            "  </LogCategories>\n  <DefaultExperiment startTime=\"{start}\" stopTime=\"{stop}\" \
+             stepSize=\"{step}\"/>"
         );
     }
-    let _ = writeln!(
-        out,
-        "  <CoSimulation modelIdentifier=\"{}\" needsExecutionTool=\"false\" \
-         canHandleVariableCommunicationStepSize=\"true\" canInterpolateInputs=\"false\" \
-         maxOutputDerivativeOrder=\"0\" canRunAsynchronuously=\"false\" \
-         canBeInstantiatedOnlyOncePerProcess=\"false\" \
-         canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" \
-         canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"/>",
-        info.identifier
-    );
-    unit_definitions(&mut out, &table.variables)?;
-    categories_and_experiment(&mut out, info);
-    out.push_str("  <ModelVariables>\n");
-    for (i, v) in table.variables.iter().enumerate() {
-        let _ = writeln!(out, "    <!-- Index {} -->", i + 1);
-        let derivative = table.model_exchange.as_ref().and_then(|me| {
-            let k = me
-                .derivatives
-                .iter()
-                .position(|&d| d == v.value_reference)?;
-            index_of(table, me.states[k])
-        });
-        scalar_variable(&mut out, v, derivative);
+
+    /// A variable with its unit (Real only), range (not for Booleans), start values (every
+    /// element's, for an FMI 3.0 array) and the state it is the derivative of.
+    fn variable(&mut self, i: usize, v: &Variable3) {
+        let ty = self.api.type_name(v.kind);
+        let element = match self.api {
+            Api::Fmi2 => "ScalarVariable",
+            Api::Fmi3 => ty,
+        };
+        let out = &mut self.out;
+        if self.api == Api::Fmi2 {
+            let _ = writeln!(out, "    <!-- Index {} -->", i + 1);
+        }
+        let (name, vr, text) = (escape(&v.name), v.value_reference, escape(&v.description));
+        let (causality, variability) = (v.causality.name(), format!("{:?}", v.variability));
+        let _ = write!(
+            out,
+            "    <{element} name=\"{name}\" valueReference=\"{vr}\" description=\"{text}\" \
+             causality=\"{causality}\" variability=\"{}\"",
+            variability.to_lowercase()
+        );
+        if self.api == Api::Fmi2 {
+            let _ = write!(out, ">\n      <{ty}");
+        }
+        if v.kind == ValueKind::Real && !v.unit.is_empty() {
+            let _ = write!(out, " unit=\"{}\"", escape(v.unit));
+        }
+        if v.kind != ValueKind::Boolean {
+            for (name, bound) in [("min", v.min), ("max", v.max)] {
+                if let Some(b) = bound {
+                    let _ = write!(out, " {name}=\"{}\"", value_text(v.kind, b));
+                }
+            }
+        }
+        if !v.start.is_empty() {
+            let starts: Vec<String> = v.start.iter().map(|&s| value_text(v.kind, s)).collect();
+            let _ = write!(out, " start=\"{}\"", starts.join(" "));
+        }
+        if let Some(state) = self.state_of_derivative(v) {
+            let _ = write!(self.out, " derivative=\"{state}\"");
+        }
+        let _ = match (self.api, v.dimension) {
+            (Api::Fmi2, _) => writeln!(self.out, "/>\n    </ScalarVariable>"),
+            (Api::Fmi3, Some(n)) => {
+                writeln!(self.out, ">\n      <Dimension start=\"{n}\"/>\n    </{ty}>")
+            }
+            (Api::Fmi3, None) => writeln!(self.out, "/>"),
+        };
     }
-    out.push_str("  </ModelVariables>\n");
-    model_structure(&mut out, table);
-    out.push_str("</fmiModelDescription>\n");
-    Ok(out)
+
+    /// A part of ModelStructure: FMI 2.0 `<Unknown index=..>`s inside `<group>`, FMI 3.0
+    /// `<element valueReference=..>`s; each with its dependencies where they are given.
+    fn structure(&mut self, group: &str, element: &str, unknowns: Vec<(u32, Option<String>)>) {
+        let (indent, element, id) = match self.api {
+            Api::Fmi2 => ("      ", "Unknown", "index"),
+            Api::Fmi3 => ("    ", element, "valueReference"),
+        };
+        if self.api == Api::Fmi2 {
+            let _ = writeln!(self.out, "    <{group}>");
+        }
+        for (unknown, dependencies) in unknowns {
+            let _ = write!(self.out, "{indent}<{element} {id}=\"{unknown}\"");
+            if let Some(d) = dependencies {
+                let _ = write!(self.out, " dependencies=\"{d}\"");
+            }
+            self.out.push_str("/>\n");
+        }
+        if self.api == Api::Fmi2 {
+            let _ = writeln!(self.out, "    </{group}>");
+        }
+    }
+
+    fn model_structure(&mut self) {
+        let me = self.table.model_exchange.as_ref();
+        let outputs: Vec<(u32, Option<String>)> = (self.variables.iter().enumerate())
+            .filter(|(_, v)| v.causality == Causality3::Model(Causality::Output))
+            .map(|(i, v)| {
+                let elements = v.elements().iter().map(|&at| &self.table.variables[at]);
+                let vrs = elements.flat_map(|e| output_dependencies(self.table, e));
+                let ids: Vec<String> = self.ids_of(vrs).iter().map(u32::to_string).collect();
+                (self.id(i), Some(ids.join(" ")))
+            })
+            .collect();
+        let derivatives = self.ids_of(me.iter().flat_map(|me| me.derivatives.iter().copied()));
+        // Calculated during initialisation: every output, every derivative, the local states.
+        let mut initial: Vec<u32> = outputs.iter().map(|&(id, _)| id).collect();
+        initial.extend(&derivatives);
+        initial.extend(self.ids_of(me.iter().flat_map(|me| me.states.iter().copied())));
+        let position = |id: &u32| (0..self.variables.len()).position(|i| self.id(i) == *id);
+        initial.sort_by_key(position);
+        initial.dedup();
+        let event_indicators = match self.api {
+            Api::Fmi2 => Vec::new(),
+            Api::Fmi3 => self.table.fmi3.event_indicators.clone(),
+        };
+        let unknowns = |ids: Vec<u32>| ids.into_iter().map(|id| (id, None)).collect();
+        self.out.push_str("  <ModelStructure>\n");
+        self.structure("Outputs", "Output", outputs);
+        if me.is_some() || self.api == Api::Fmi3 {
+            self.structure(
+                "Derivatives",
+                "ContinuousStateDerivative",
+                unknowns(derivatives),
+            );
+        }
+        self.structure("InitialUnknowns", "InitialUnknown", unknowns(initial));
+        if self.api == Api::Fmi3 {
+            self.structure("", "EventIndicator", unknowns(event_indicators));
+        }
+        self.out.push_str("  </ModelStructure>\n");
+    }
+}
+
+/// The modelDescription.xml of `table`'s model in FMI version `api`.
+pub fn generate(table: &ModelTable, api: Api) -> Result<String, UnknownUnit> {
+    let scalars: Vec<Variable3>;
+    let variables = match api {
+        Api::Fmi2 => {
+            let each = |(i, v)| Variable3::of(std::slice::from_ref(v), i, None);
+            scalars = table.variables.iter().enumerate().map(each).collect();
+            &scalars
+        }
+        Api::Fmi3 => &table.fmi3.variables,
+    };
+    let mut w = Writer {
+        api,
+        table,
+        variables,
+        out: String::new(),
+    };
+    w.header();
+    write_units(&mut w.out, variables)?;
+    w.categories_and_experiment();
+    w.out.push_str("  <ModelVariables>\n");
+    for (i, v) in variables.iter().enumerate() {
+        w.variable(i, v);
+    }
+    w.out.push_str("  </ModelVariables>\n");
+    w.model_structure();
+    w.out.push_str("</fmiModelDescription>\n");
+    Ok(w.out)
 }
 
 #[cfg(test)]
@@ -318,8 +377,12 @@ mod tests {
     #[test]
     fn every_unit_is_known_and_every_feedthrough_name_is_an_input_of_an_output() {
         for table in tables() {
-            for unit in units_used(&table.variables) {
-                assert!(units::exponents(unit).is_some(), "unit {unit} missing");
+            for v in &table.variables {
+                let unit = v.unit;
+                assert!(
+                    unit.is_empty() || units::exponents(unit).is_some(),
+                    "{unit} missing"
+                );
             }
             for (output, inputs) in table.info.direct_feedthrough {
                 let o = table.by_name(output).unwrap();
@@ -354,7 +417,7 @@ mod tests {
     #[test]
     fn structure_lists_every_output_with_its_direct_inputs() {
         let table = crate::models::tables()[0];
-        let xml = generate(table).unwrap();
+        let xml = generate(table, Api::Fmi2).unwrap();
         let outputs = table
             .variables
             .iter()

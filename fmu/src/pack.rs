@@ -4,7 +4,6 @@
 //! writes the checked-in modelDescription copies.
 
 use crate::model_description::{self, UnknownUnit};
-use crate::model_description3;
 use crate::table::{Api, ModelTable};
 use std::fs::{self, File};
 use std::io::{self, Write};
@@ -44,10 +43,7 @@ pub fn stem(table: &ModelTable, version: Api) -> String {
 
 /// The modelDescription.xml of `table` in `version`.
 pub fn model_description(table: &ModelTable, version: Api) -> Result<String, UnknownUnit> {
-    match version {
-        Api::Fmi2 => model_description::generate(table),
-        Api::Fmi3 => model_description3::generate(table),
-    }
+    model_description::generate(table, version)
 }
 
 /// Writes `<out_dir>/<stem>.fmu` holding `library` as the model's binary.

@@ -35,7 +35,6 @@ impl Api {
         }
     }
 
-    /// The prefix of this version's functions.
     pub fn prefix(self) -> &'static str {
         match self {
             Api::Fmi2 => "fmi2",
@@ -65,7 +64,6 @@ pub struct ValueType {
 }
 
 impl ValueType {
-    /// The type of `api` for variables of `kind`.
     pub const fn of(api: Api, kind: ValueKind) -> Self {
         ValueType {
             api,
@@ -74,7 +72,6 @@ impl ValueType {
         }
     }
 
-    /// A type of `api` that no variable has.
     pub const fn none(api: Api, name: &'static str) -> Self {
         ValueType {
             api,
@@ -156,7 +153,6 @@ impl VrIndex {
         VrIndex(table)
     }
 
-    /// The position of `vr`, if it is there.
     pub fn get(&self, vr: u32) -> Option<usize> {
         let at = *self.0.get(vr as usize)?;
         (at != Self::NONE).then_some(at as usize)
@@ -193,8 +189,8 @@ impl ModelTable {
         variables: Vec<Variable>,
         model_exchange: Option<ModelExchangeTable>,
     ) -> Self {
-        let guid = guid::of_interface(info.identifier, &variables);
-        let token3 = guid::of_fmi3_interface(info.identifier, &variables);
+        let guid = guid::of_interface(Api::Fmi2, info.identifier, &variables);
+        let token3 = guid::of_interface(Api::Fmi3, info.identifier, &variables);
         ModelTable {
             info,
             // A GUID is hex digits, dashes and braces: it never holds a NUL.
@@ -202,7 +198,7 @@ impl ModelTable {
             token3_c: CString::new(token3.clone()).unwrap_or_default(),
             guid,
             token3,
-            fmi3: Fmi3View::new(info, &variables, model_exchange.as_ref()),
+            fmi3: Fmi3View::new(info, &variables),
             by_vr: VrIndex::new(variables.iter().map(|v| v.value_reference)),
             variables,
             model_exchange,
@@ -217,7 +213,6 @@ impl ModelTable {
         }
     }
 
-    /// The position of value reference `vr` in `variables`.
     pub fn index(&self, vr: u32) -> Option<usize> {
         self.by_vr.get(vr)
     }
@@ -230,12 +225,10 @@ impl ModelTable {
         Ok(index)
     }
 
-    /// The variable with value reference `vr`.
     pub fn variable(&self, vr: u32) -> Option<&Variable> {
         self.variables.get(self.index(vr)?)
     }
 
-    /// The variable named `name`.
     pub fn by_name(&self, name: &str) -> Option<&Variable> {
         self.variables.iter().find(|v| v.name == name)
     }
@@ -270,13 +263,10 @@ pub enum Causality3 {
 
 impl Causality3 {
     /// The attribute's text in the modelDescription.
-    pub fn name(self) -> &'static str {
+    pub fn name(self) -> String {
         match self {
-            Causality3::Independent => "independent",
-            Causality3::Model(Causality::Parameter) => "parameter",
-            Causality3::Model(Causality::Input) => "input",
-            Causality3::Model(Causality::Output) => "output",
-            Causality3::Model(Causality::Local) => "local",
+            Causality3::Independent => "independent".to_string(),
+            Causality3::Model(c) => format!("{c:?}").to_lowercase(),
         }
     }
 }
@@ -287,9 +277,7 @@ pub enum Source {
     /// The model's variables at these positions of [`ModelTable::variables`] (one for a
     /// scalar).
     Model(Vec<usize>),
-    /// The instance's time.
     Time,
-    /// Event indicator number `i`.
     EventIndicator(usize),
 }
 
@@ -313,9 +301,17 @@ pub struct Variable3 {
 }
 
 impl Variable3 {
-    /// How many values the variable holds.
     pub fn len(&self) -> usize {
         self.dimension.unwrap_or(1)
+    }
+
+    /// The positions in [`ModelTable::variables`] of the model variables behind this one
+    /// (none for `time` and the event indicators).
+    pub fn elements(&self) -> &[usize] {
+        match &self.source {
+            Source::Model(elements) => elements,
+            _ => &[],
+        }
     }
 
     /// Never true: every variable holds at least one value.
@@ -343,7 +339,7 @@ impl Variable3 {
 
     /// The model's variables `run` (at positions from `first`) as one variable: a scalar, or
     /// the array `array`.
-    fn of(run: &[Variable], first: usize, array: Option<&Array>) -> Self {
+    pub(crate) fn of(run: &[Variable], first: usize, array: Option<&Array>) -> Self {
         let v = &run[0];
         Variable3 {
             name: array.map_or(v.name, |a| a.name).to_string(),
@@ -373,10 +369,6 @@ pub struct Fmi3View {
     pub variables: Vec<Variable3>,
     /// Value reference → position in `variables`.
     by_vr: VrIndex,
-    /// FMI 3.0 value references of the continuous states and of their derivatives, in
-    /// state-vector order (an array once, where its first element comes).
-    pub states: Vec<u32>,
-    pub derivatives: Vec<u32>,
     /// Value references of the event-indicator variables, in order.
     pub event_indicators: Vec<u32>,
     /// Model value reference → (FMI 3.0 value reference, element index), sorted.
@@ -384,7 +376,7 @@ pub struct Fmi3View {
 }
 
 impl Fmi3View {
-    fn new(info: &ModelInfo, model: &[Variable], me: Option<&ModelExchangeTable>) -> Self {
+    fn new(info: &ModelInfo, model: &[Variable]) -> Self {
         let time = Variable3 {
             causality: Causality3::Independent,
             ..Variable3::computed("time", TIME_VR, "s", "Simulation time", Source::Time)
@@ -400,44 +392,27 @@ impl Fmi3View {
             variables.push(Variable3::of(run, at, array));
             at += len;
         }
-        let event_indicators: Vec<u32> = (EVENT_INDICATOR_VR..)
-            .take(info.event_indicators.len())
-            .collect();
-        for (i, (&(name, unit, text), &vr)) in info
-            .event_indicators
-            .iter()
-            .zip(&event_indicators)
-            .enumerate()
-        {
+        let event_indicators = (EVENT_INDICATOR_VR..).zip(info.event_indicators);
+        for (i, (vr, &(name, unit, text))) in event_indicators.enumerate() {
             let source = Source::EventIndicator(i);
             variables.push(Variable3::computed(name, vr, unit, text, source));
         }
-        let mut element_of: Vec<(u32, (u32, usize))> = variables
-            .iter()
-            .flat_map(|v| {
-                match &v.source {
-                    Source::Model(elements) => elements.clone(),
-                    _ => Vec::new(),
-                }
-                .into_iter()
-                .enumerate()
-                .map(|(i, at)| (model[at].value_reference, (v.value_reference, i)))
-            })
-            .collect();
+        let mut element_of: Vec<(u32, (u32, usize))> = Vec::new();
+        for v in &variables {
+            let elements = v.elements().iter().enumerate();
+            element_of.extend(
+                elements.map(|(i, &at)| (model[at].value_reference, (v.value_reference, i))),
+            );
+        }
         element_of.sort_unstable_by_key(|&(vr, _)| vr);
-        let mut view = Fmi3View {
+        Fmi3View {
             by_vr: VrIndex::new(variables.iter().map(|v| v.value_reference)),
             variables,
-            states: Vec::new(),
-            derivatives: Vec::new(),
-            event_indicators,
+            event_indicators: (EVENT_INDICATOR_VR..)
+                .take(info.event_indicators.len())
+                .collect(),
             element_of,
-        };
-        if let Some(me) = me {
-            view.states = view.collapse(&me.states);
-            view.derivatives = view.collapse(&me.derivatives);
         }
-        view
     }
 
     /// The FMI 3.0 variables holding the model variables `vrs`, each once, in order.
@@ -495,8 +470,9 @@ mod tests {
         assert_eq!(layout.by_name("der(motor_state)").unwrap().len(), 4);
         assert_eq!(layout.element(2), Some((0, 2)));
         // 25 states: 13 body scalars + motor_state[4] + 8 bristles = 22 variables.
-        assert_eq!(layout.states.len(), 22);
-        assert_eq!(layout.derivatives.len(), 22);
+        let me = quad.model_exchange.as_ref().unwrap();
+        assert_eq!(layout.collapse(&me.states).len(), 22);
+        assert_eq!(layout.collapse(&me.derivatives).len(), 22);
         assert_eq!(layout.event_indicators, [1001, 1002, 1003, 1004]);
         for table in [quad, lander] {
             let layout = &table.fmi3;

@@ -20,17 +20,15 @@ const USAGE: &str = "usage: flyloop-fmu-pack fmus <libflyloop_fmu.so> <out-dir>\
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let result = match args.as_slice() {
-        ["fmus", library, out] => Api::ALL
-            .into_iter()
-            .flat_map(|v| tables().map(|t| (t, v)))
-            .map(|(t, v)| write_fmu(t, v, Path::new(library), Path::new(out)))
-            .collect::<Result<Vec<_>, _>>(),
-        ["model-descriptions", dir] => Api::ALL
-            .into_iter()
-            .flat_map(|v| tables().map(|t| (t, v)))
+    let pairs = Api::ALL.into_iter().flat_map(|v| tables().map(|t| (t, v)));
+    let result: Result<Vec<_>, _> = match args.as_slice() {
+        ["fmus", library, out] => {
+            let (library, out) = (Path::new(library), Path::new(out));
+            pairs.map(|(t, v)| write_fmu(t, v, library, out)).collect()
+        }
+        ["model-descriptions", dir] => pairs
             .map(|(t, v)| write_model_description(t, v, Path::new(dir)))
-            .collect::<Result<Vec<_>, _>>(),
+            .collect(),
         _ => {
             eprintln!("{USAGE}");
             return ExitCode::from(2);

@@ -38,18 +38,29 @@ pub(crate) fn with_instance<R: Into<fmi2Status>, S: From<fmi2Status>>(
         // SAFETY: as above; the borrow inside the closure ended with the unwind.
         if let Some(instance) = unsafe { c.cast::<Instance>().as_mut() } {
             instance.stage = Stage::Fatal;
+            let message = format!(
+                "{function}: internal error (panic: {message}); the instance is unusable, \
+                 call fmi2FreeInstance"
+            );
             let _ = catch_unwind(AssertUnwindSafe(|| {
-                instance.log(
-                    fmi2Status::fmi2Fatal,
-                    &format!(
-                        "{function}: internal error (panic: {message}); the instance is \
-                         unusable, call fmi2FreeInstance"
-                    ),
-                );
+                instance.log(fmi2Status::fmi2Fatal, &message)
             }));
         }
         fmi2Status::fmi2Fatal
     }))
+}
+
+/// The body of a function this FMU does not offer: refuses with `why` (after the NULL and
+/// stage checks).
+pub(crate) fn refuse<S: From<fmi2Status>>(
+    c: fmi2Component,
+    function: &'static str,
+    mask: Mask,
+    why: &'static str,
+) -> S {
+    with_instance(c, function, mask, |_| {
+        Err::<(), _>(FmuError::NotSupported(why))
+    })
 }
 
 /// A body without a status of its own answers OK.

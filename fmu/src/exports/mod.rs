@@ -22,6 +22,21 @@ macro_rules! exports {
     )*};
 }
 
+/// Defines exported C functions whose body, once the instance passed the NULL and stage
+/// checks of `mask` ([`guard::with_instance`]), is a function of [`shared`] given the instance,
+/// the export's name and its other arguments: `fn name(arguments) -> status = mask => body;`.
+macro_rules! forward {
+    ($($(#[doc = $doc:literal])* fn $name:ident($c:ident: $ct:ty $(, $arg:ident: $t:ty)*) -> $ret:ty = $mask:path => $body:path;)*) => {
+        exports! {$(
+            $(#[doc = $doc])*
+            fn $name($c: $ct $(, $arg: $t)*) -> $ret {
+                let function = stringify!($name);
+                $crate::exports::guard::with_instance($c, function, $mask, |instance| $body(instance, function $(, $arg)*))
+            }
+        )*}
+    };
+}
+
 pub mod fmi2;
 pub mod fmi3;
 mod guard;

@@ -91,34 +91,16 @@ static INFO: ModelInfo = ModelInfo {
 const BRISTLE_VR: u32 = 700;
 const DERIVATIVE_VR: u32 = 800;
 
-/// The derivative variables in state-vector order: name and unit.
-const DERIVATIVES: [(&str, &str); STATE_LEN] = [
-    ("der(x)", "m/s"),
-    ("der(y)", "m/s"),
-    ("der(z)", "m/s"),
-    ("der(vx)", "m/s2"),
-    ("der(vy)", "m/s2"),
-    ("der(vz)", "m/s2"),
-    ("der(qw)", "1/s"),
-    ("der(qx)", "1/s"),
-    ("der(qy)", "1/s"),
-    ("der(qz)", "1/s"),
-    ("der(wx)", "rad/s2"),
-    ("der(wy)", "rad/s2"),
-    ("der(wz)", "rad/s2"),
-    ("der(motor_state_0)", "1/s"),
-    ("der(motor_state_1)", "1/s"),
-    ("der(motor_state_2)", "1/s"),
-    ("der(motor_state_3)", "1/s"),
-    ("der(gear_stretch_0_x)", "m/s"),
-    ("der(gear_stretch_0_y)", "m/s"),
-    ("der(gear_stretch_1_x)", "m/s"),
-    ("der(gear_stretch_1_y)", "m/s"),
-    ("der(gear_stretch_2_x)", "m/s"),
-    ("der(gear_stretch_2_y)", "m/s"),
-    ("der(gear_stretch_3_x)", "m/s"),
-    ("der(gear_stretch_3_y)", "m/s"),
-];
+/// The continuous states' names in state-vector order.
+fn state_names() -> impl Iterator<Item = &'static str> {
+    BODY_STATE_OUTPUTS.into_iter().chain(BRISTLES.map(|b| b.0))
+}
+
+/// A name or unit for a variable: the table is built once per process, so the text lives as
+/// long as the process.
+fn leak(text: String) -> &'static str {
+    Box::leak(text.into_boxed_str())
+}
 
 fn local(name: &'static str, vr: u32, unit: &'static str, description: &'static str) -> Variable {
     Variable {
@@ -145,25 +127,28 @@ fn table() -> Table<Quadrotor> {
         read: |q: &Quadrotor, at| q.state_derivative()[at],
         at,
     };
-    let text = "Time derivative of the state";
     let bristles = (BRISTLES.iter().zip(BRISTLE_VR..).enumerate())
         .map(|(i, (&(name, text), vr))| (local(name, vr, "m", text), bristle(i)));
-    let derivatives = (DERIVATIVES.iter().zip(DERIVATIVE_VR..).enumerate())
-        .map(|(i, (&(name, unit), vr))| (local(name, vr, unit, text), derivative(i)));
-    let locals: Vec<_> = bristles.chain(derivatives).collect();
+    let mut locals: Vec<_> = bristles.collect();
     let core = variables::variables::<Quadrotor>();
-    let vr_of = |name: &str| {
-        core.iter()
-            .chain(locals.iter().map(|(v, _)| v))
-            .find(|v| v.name == name)
-            .map(|v| v.value_reference)
+    let state = |name: &str| {
+        let mut all = core.iter().chain(locals.iter().map(|(v, _)| v));
+        all.find(|v| v.name == name)
+            .map(|v| (v.value_reference, v.unit))
     };
-    let states = BODY_STATE_OUTPUTS
-        .iter()
-        .copied()
-        .chain(BRISTLES.iter().map(|b| b.0))
-        .filter_map(vr_of)
-        .collect();
+    let (states, units): (Vec<u32>, Vec<&str>) = state_names().filter_map(state).unzip();
+    // d/dt of a state has its unit per second: m → m/s, m/s → m/s2, 1 → 1/s.
+    let derivatives = (state_names().zip(units).zip(DERIVATIVE_VR..).enumerate()).map(
+        |(i, ((name, unit), vr))| {
+            let unit = unit
+                .strip_suffix("/s")
+                .map_or(format!("{unit}/s"), |u| format!("{u}/s2"));
+            let name = leak(format!("der({name})"));
+            let text = "Time derivative of the state";
+            (local(name, vr, leak(unit), text), derivative(i))
+        },
+    );
+    locals.extend(derivatives.collect::<Vec<_>>());
     let me = ModelExchangeTable {
         states,
         derivatives: (DERIVATIVE_VR..).take(STATE_LEN).collect(),
@@ -229,9 +214,7 @@ impl Hybrid for Quadrotor {
         let mut state = [0.0; STATE_LEN];
         state.copy_from_slice(x);
         self.set_continuous_state(&state).map_err(|e| {
-            // The state's name is its derivative's without "der( )".
-            let name = DERIVATIVES[e.index].0;
-            let name = name.trim_start_matches("der(").trim_end_matches(')');
+            let name = state_names().nth(e.index).unwrap_or_default();
             FmuError::InvalidArgument(format!(
                 "x[{}] (state `{name}`) is {}, not a finite number; nothing was set",
                 e.index,

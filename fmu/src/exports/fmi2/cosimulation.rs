@@ -3,37 +3,42 @@
 //! derivatives), which answer fmi2Error with the reason.
 
 use crate::error::FmuError;
-use crate::exports::guard::{with_instance, write_out};
+use crate::exports::guard::{refuse, with_instance, write_out};
 use crate::fmi2_types::*;
-use crate::instance::{Instance, Mask, masks};
+use crate::instance::{Instance, masks};
 
-/// The one status answer that applies to a synchronous FMU that never discards.
-fn status_kind(
-    instance: &Instance,
-    function: &str,
-    kind: fmi2StatusKind,
-) -> Result<fmi2Status, FmuError> {
-    let why = match kind {
-        fmi2DoStepStatus | fmi2PendingStatus => "fmi2DoStep never returns fmi2Pending",
-        fmi2LastSuccessfulTime | fmi2Terminated => "fmi2DoStep never returns fmi2Discard",
-        other => {
-            return Err(FmuError::InvalidArgument(format!(
-                "unknown fmi2StatusKind {other}"
-            )));
-        }
-    };
-    instance.log(
-        fmi2Status::fmi2Discard,
-        &format!("{function}: status kind {kind} does not apply: {why}"),
-    );
-    Ok(fmi2Status::fmi2Discard)
-}
+/// A status kind a function answers, with the way to read its value.
+type Known<T> = Option<(fmi2StatusKind, fn(&Instance) -> T)>;
 
-/// The body of a function this FMU does not offer: refuses with `why` (after the NULL and
-/// stage checks).
-fn refuse(c: fmi2Component, function: &'static str, mask: Mask, why: &'static str) -> fmi2Status {
-    with_instance(c, function, mask, |_| {
-        Err::<(), _>(FmuError::NotSupported(why))
+/// The body of fmi2Get*Status: `known` gives the value of its status kind; any other kind
+/// does not apply to a synchronous FMU that never discards.
+///
+/// # Safety
+/// `value` must be NULL or writable.
+unsafe fn status<T>(
+    c: fmi2Component,
+    function: &'static str,
+    s: fmi2StatusKind,
+    value: *mut T,
+    known: Known<T>,
+) -> fmi2Status {
+    with_instance(c, function, masks::GET_STATUS, |instance| {
+        let why = match (s, known) {
+            (s, Some((kind, read))) if s == kind => {
+                // SAFETY: per the contract.
+                unsafe { write_out(value, read(instance), "value") }?;
+                return Ok(fmi2Status::fmi2OK);
+            }
+            (fmi2DoStepStatus | fmi2PendingStatus, _) => "fmi2DoStep never returns fmi2Pending",
+            (fmi2LastSuccessfulTime | fmi2Terminated, _) => "fmi2DoStep never returns fmi2Discard",
+            (other, _) => {
+                let message = format!("unknown fmi2StatusKind {other}");
+                return Err(FmuError::InvalidArgument(message));
+            }
+        };
+        let message = format!("{function}: status kind {s} does not apply: {why}");
+        instance.log(fmi2Status::fmi2Discard, &message);
+        Ok(fmi2Status::fmi2Discard)
     })
 }
 
@@ -47,8 +52,7 @@ exports! {
     /// and the Error stage.
     fn fmi2DoStep(c: fmi2Component, currentCommunicationPoint: fmi2Real, communicationStepSize: fmi2Real, _noSetFMUStatePriorToCurrentPoint: fmi2Boolean) -> fmi2Status {
         with_instance(c, "fmi2DoStep", masks::DO_STEP, |instance| {
-            instance.sim.do_step(currentCommunicationPoint, communicationStepSize)?;
-            Ok(fmi2Status::fmi2OK)
+            instance.sim.do_step(currentCommunicationPoint, communicationStepSize)
         })
     }
 
@@ -57,43 +61,26 @@ exports! {
         refuse(c, "fmi2CancelStep", masks::CANCEL_STEP, "fmi2DoStep never returns fmi2Pending")
     }
 
-    fn fmi2GetStatus(c: fmi2Component, s: fmi2StatusKind, _value: *mut fmi2Status) -> fmi2Status {
-        let function = "fmi2GetStatus";
-        with_instance(c, function, masks::GET_STATUS, |instance| status_kind(instance, function, s))
+    fn fmi2GetStatus(c: fmi2Component, s: fmi2StatusKind, value: *mut fmi2Status) -> fmi2Status {
+        status(c, "fmi2GetStatus", s, value, None)
     }
 
     /// fmi2LastSuccessfulTime gives the instance's time.
     fn fmi2GetRealStatus(c: fmi2Component, s: fmi2StatusKind, value: *mut fmi2Real) -> fmi2Status {
-        let function = "fmi2GetRealStatus";
-        with_instance(c, function, masks::GET_STATUS, |instance| {
-            if s == fmi2LastSuccessfulTime {
-                write_out(value, instance.sim.time(), "value")?;
-                return Ok(fmi2Status::fmi2OK);
-            }
-            status_kind(instance, function, s)
-        })
+        status(c, "fmi2GetRealStatus", s, value, Some((fmi2LastSuccessfulTime, |i| i.sim.time())))
     }
 
-    fn fmi2GetIntegerStatus(c: fmi2Component, s: fmi2StatusKind, _value: *mut fmi2Integer) -> fmi2Status {
-        let function = "fmi2GetIntegerStatus";
-        with_instance(c, function, masks::GET_STATUS, |instance| status_kind(instance, function, s))
+    fn fmi2GetIntegerStatus(c: fmi2Component, s: fmi2StatusKind, value: *mut fmi2Integer) -> fmi2Status {
+        status(c, "fmi2GetIntegerStatus", s, value, None)
     }
 
     /// fmi2Terminated gives fmi2False: the models never ask to end the simulation.
     fn fmi2GetBooleanStatus(c: fmi2Component, s: fmi2StatusKind, value: *mut fmi2Boolean) -> fmi2Status {
-        let function = "fmi2GetBooleanStatus";
-        with_instance(c, function, masks::GET_STATUS, |instance| {
-            if s == fmi2Terminated {
-                write_out(value, fmi2False, "value")?;
-                return Ok(fmi2Status::fmi2OK);
-            }
-            status_kind(instance, function, s)
-        })
+        status(c, "fmi2GetBooleanStatus", s, value, Some((fmi2Terminated, |_| fmi2False)))
     }
 
-    fn fmi2GetStringStatus(c: fmi2Component, s: fmi2StatusKind, _value: *mut fmi2String) -> fmi2Status {
-        let function = "fmi2GetStringStatus";
-        with_instance(c, function, masks::GET_STATUS, |instance| status_kind(instance, function, s))
+    fn fmi2GetStringStatus(c: fmi2Component, s: fmi2StatusKind, value: *mut fmi2String) -> fmi2Status {
+        status(c, "fmi2GetStringStatus", s, value, None)
     }
 
     /// canInterpolateInputs="false".

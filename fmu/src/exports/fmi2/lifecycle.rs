@@ -24,6 +24,11 @@ pub extern "C" fn fmi2GetVersion() -> *const c_char {
 }
 
 exports! {
+    /// Frees the instance and every FMU state it handed out. NULL is ignored.
+    fn fmi2FreeInstance(c: fmi2Component) {
+        free_instance(c, "fmi2FreeInstance");
+    }
+
     /// Creates a Co-Simulation or Model Exchange instance of the model whose GUID is `fmuGUID`
     /// (Quadrotor: both; Lander2D: Co-Simulation only). Returns NULL, with the reason sent to
     /// the logger when there is one, for NULL or logger-less callbacks, a missing instance
@@ -43,25 +48,13 @@ exports! {
         })
     }
 
-    /// Frees the instance and every FMU state it handed out. NULL is ignored.
-    fn fmi2FreeInstance(c: fmi2Component) {
-        free_instance(c, "fmi2FreeInstance");
-    }
-
-    /// Switches log categories: those named in `categories`, or all of them when
-    /// `nCategories` is 0. An unknown category name is an error (the others still switch).
-    fn fmi2SetDebugLogging(c: fmi2Component, loggingOn: fmi2Boolean, nCategories: usize, categories: *const fmi2String) -> fmi2Status {
-        set_debug_logging(c, "fmi2SetDebugLogging", loggingOn != fmi2False, nCategories, categories)
-    }
-
     /// Sets the start time (and the stop time, if defined). The tolerance is not used: both
     /// models step on fixed grids.
     fn fmi2SetupExperiment(c: fmi2Component, _toleranceDefined: fmi2Boolean, _tolerance: fmi2Real, startTime: fmi2Real, stopTimeDefined: fmi2Boolean, stopTime: fmi2Real) -> fmi2Status {
         let function = "fmi2SetupExperiment";
         with_instance(c, function, masks::SETUP_EXPERIMENT, |instance| {
             let stop = (stopTimeDefined != fmi2False).then_some(stopTime);
-            setup_experiment(instance, function, startTime, stop)?;
-            Ok(fmi2Status::fmi2OK)
+            setup_experiment(instance, function, startTime, stop)
         })
     }
 
@@ -70,54 +63,33 @@ exports! {
         with_instance(c, function, masks::ENTER_INITIALIZATION_MODE, |instance| {
             instance.stage = Stage::InitializationMode;
             instance.event(function);
-            Ok(fmi2Status::fmi2OK)
+            Ok(())
         })
     }
+}
 
+forward! {
+    /// Switches log categories: those named in `categories`, or all of them when
+    /// `nCategories` is 0. An unknown category name is an error (the others still switch).
+    fn fmi2SetDebugLogging(c: fmi2Component, loggingOn: fmi2Boolean, nCategories: usize, categories: *const fmi2String) -> fmi2Status = masks::SET_DEBUG_LOGGING => set_debug_logging;
     /// Co-Simulation goes to step mode, Model Exchange to event mode.
-    fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
-        exit_initialization_mode(c, "fmi2ExitInitializationMode")
-    }
-
-    fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
-        terminate(c, "fmi2Terminate")
-    }
-
+    fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status = masks::EXIT_INITIALIZATION_MODE => exit_initialization_mode;
+    fn fmi2Terminate(c: fmi2Component) -> fmi2Status = masks::TERMINATE => terminate;
     /// Back to the state right after fmi2Instantiate: start values, no experiment. FMU
     /// states handed out stay valid.
-    fn fmi2Reset(c: fmi2Component) -> fmi2Status {
-        reset(c, "fmi2Reset")
-    }
-
+    fn fmi2Reset(c: fmi2Component) -> fmi2Status = masks::RESET => reset;
     /// Copies the current state. `*FMUstate` NULL gets a new state; a state of this instance
     /// is overwritten in place.
-    fn fmi2GetFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate) -> fmi2Status {
-        get_state(c, "fmi2GetFMUstate", FMUstate)
-    }
-
+    fn fmi2GetFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate) -> fmi2Status = masks::FMU_STATE => get_state;
     /// Restores a state of this instance (stage, time and everything else included);
     /// `FMUstate` is looked up, never dereferenced.
-    fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
-        set_state(c, "fmi2SetFMUstate", FMUstate)
-    }
-
+    fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status = masks::FMU_STATE => set_state;
     /// Frees a state and sets `*FMUstate` to NULL; a second free is an error.
-    fn fmi2FreeFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate) -> fmi2Status {
-        free_state(c, "fmi2FreeFMUstate", FMUstate)
-    }
-
-    fn fmi2SerializedFMUstateSize(c: fmi2Component, FMUstate: fmi2FMUstate, size: *mut usize) -> fmi2Status {
-        serialized_size(c, "fmi2SerializedFMUstateSize", FMUstate, size)
-    }
-
+    fn fmi2FreeFMUstate(c: fmi2Component, FMUstate: *mut fmi2FMUstate) -> fmi2Status = masks::FMU_STATE => free_state;
+    fn fmi2SerializedFMUstateSize(c: fmi2Component, FMUstate: fmi2FMUstate, size: *mut usize) -> fmi2Status = masks::FMU_STATE => serialized_size;
     /// Copies a state's bytes; `size` must be what fmi2SerializedFMUstateSize said.
-    fn fmi2SerializeFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate, serializedState: *mut fmi2Byte, size: usize) -> fmi2Status {
-        serialize(c, "fmi2SerializeFMUstate", FMUstate, serializedState.cast(), size)
-    }
-
+    fn fmi2SerializeFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate, serializedState: *mut fmi2Byte, size: usize) -> fmi2Status = masks::FMU_STATE => serialize;
     /// Makes a state from serialized bytes after checking them completely (format,
     /// checksum, model, a restorable model snapshot); bytes that fail change nothing.
-    fn fmi2DeSerializeFMUstate(c: fmi2Component, serializedState: *const fmi2Byte, size: usize, FMUstate: *mut fmi2FMUstate) -> fmi2Status {
-        deserialize(c, "fmi2DeSerializeFMUstate", serializedState.cast(), size, FMUstate)
-    }
+    fn fmi2DeSerializeFMUstate(c: fmi2Component, serializedState: *const fmi2Byte, size: usize, FMUstate: *mut fmi2FMUstate) -> fmi2Status = masks::FMU_STATE => deserialize;
 }

@@ -6,7 +6,7 @@ use crate::exports::shared::fmu_state::*;
 use crate::exports::shared::instantiate::{Request, instantiate};
 use crate::exports::shared::lifecycle::*;
 use crate::fmi3_types::*;
-use crate::instance::{Interface, Stage, masks3};
+use crate::instance::{Interface, Stage, masks, masks3};
 use crate::log::Sink;
 use crate::table::Api;
 use std::ffi::c_char;
@@ -46,8 +46,9 @@ unsafe fn request<'a>(
 }
 
 exports! {
-    fn fmi3SetDebugLogging(instance: fmi3Instance, loggingOn: fmi3Boolean, nCategories: usize, categories: *const fmi3String) -> fmi3Status {
-        set_debug_logging(instance, "fmi3SetDebugLogging", loggingOn != fmi3False, nCategories, categories).into()
+    /// Frees the instance and every FMU state it handed out. NULL is ignored.
+    fn fmi3FreeInstance(instance: fmi3Instance) {
+        free_instance(instance, "fmi3FreeInstance");
     }
 
     /// A Model Exchange instance of the model whose token is `instantiationToken`
@@ -80,11 +81,6 @@ exports! {
         instantiate(|| Some(request("fmi3InstantiateScheduledExecution", refusal, strings, loggingOn, instanceEnvironment, logMessage)))
     }
 
-    /// Frees the instance and every FMU state it handed out. NULL is ignored.
-    fn fmi3FreeInstance(instance: fmi3Instance) {
-        free_instance(instance, "fmi3FreeInstance");
-    }
-
     /// Sets the experiment (start and stop time; the tolerance is not used) and enters
     /// initialization mode.
     fn fmi3EnterInitializationMode(instance: fmi3Instance, _toleranceDefined: fmi3Boolean, _tolerance: fmi3Float64, startTime: fmi3Float64, stopTimeDefined: fmi3Boolean, stopTime: fmi3Float64) -> fmi3Status {
@@ -96,47 +92,24 @@ exports! {
             Ok(())
         })
     }
+}
 
+forward! {
+    fn fmi3SetDebugLogging(instance: fmi3Instance, loggingOn: fmi3Boolean, nCategories: usize, categories: *const fmi3String) -> fmi3Status = masks::SET_DEBUG_LOGGING => set_debug_logging;
     /// Co-Simulation enters step mode, Model Exchange event mode.
-    fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status {
-        exit_initialization_mode(instance, "fmi3ExitInitializationMode").into()
-    }
-
-    fn fmi3Terminate(instance: fmi3Instance) -> fmi3Status {
-        terminate(instance, "fmi3Terminate").into()
-    }
-
+    fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status = masks::EXIT_INITIALIZATION_MODE => exit_initialization_mode;
+    fn fmi3Terminate(instance: fmi3Instance) -> fmi3Status = masks::TERMINATE => terminate;
     /// Back to the state right after instantiation: start values, no experiment.
-    fn fmi3Reset(instance: fmi3Instance) -> fmi3Status {
-        reset(instance, "fmi3Reset").into()
-    }
-
+    fn fmi3Reset(instance: fmi3Instance) -> fmi3Status = masks::RESET => reset;
     /// Copies the current state; `*FMUState` NULL gets a new state, a state of this instance
     /// is overwritten in place.
-    fn fmi3GetFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status {
-        get_state(instance, "fmi3GetFMUState", FMUState).into()
-    }
-
+    fn fmi3GetFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status = masks::FMU_STATE => get_state;
     /// Restores a state of this instance; `FMUState` is looked up, never dereferenced.
-    fn fmi3SetFMUState(instance: fmi3Instance, FMUState: fmi3FMUState) -> fmi3Status {
-        set_state(instance, "fmi3SetFMUState", FMUState).into()
-    }
-
+    fn fmi3SetFMUState(instance: fmi3Instance, FMUState: fmi3FMUState) -> fmi3Status = masks::FMU_STATE => set_state;
     /// Frees a state and sets `*FMUState` to NULL.
-    fn fmi3FreeFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status {
-        free_state(instance, "fmi3FreeFMUState", FMUState).into()
-    }
-
-    fn fmi3SerializedFMUStateSize(instance: fmi3Instance, FMUState: fmi3FMUState, size: *mut usize) -> fmi3Status {
-        serialized_size(instance, "fmi3SerializedFMUStateSize", FMUState, size).into()
-    }
-
-    fn fmi3SerializeFMUState(instance: fmi3Instance, FMUState: fmi3FMUState, serializedState: *mut fmi3Byte, size: usize) -> fmi3Status {
-        serialize(instance, "fmi3SerializeFMUState", FMUState, serializedState, size).into()
-    }
-
+    fn fmi3FreeFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status = masks::FMU_STATE => free_state;
+    fn fmi3SerializedFMUStateSize(instance: fmi3Instance, FMUState: fmi3FMUState, size: *mut usize) -> fmi3Status = masks::FMU_STATE => serialized_size;
+    fn fmi3SerializeFMUState(instance: fmi3Instance, FMUState: fmi3FMUState, serializedState: *mut fmi3Byte, size: usize) -> fmi3Status = masks::FMU_STATE => serialize;
     /// Makes a state from serialized bytes after checking them completely.
-    fn fmi3DeserializeFMUState(instance: fmi3Instance, serializedState: *const fmi3Byte, size: usize, FMUState: *mut fmi3FMUState) -> fmi3Status {
-        deserialize(instance, "fmi3DeserializeFMUState", serializedState, size, FMUState).into()
-    }
+    fn fmi3DeserializeFMUState(instance: fmi3Instance, serializedState: *const fmi3Byte, size: usize, FMUState: *mut fmi3FMUState) -> fmi3Status = masks::FMU_STATE => deserialize;
 }

@@ -5,7 +5,7 @@ use crate::error::FmuError;
 use crate::exports::guard::{c_slice, c_slice_mut, with_instance, write_out};
 use crate::exports::shared::model_exchange::*;
 use crate::fmi3_types::*;
-use crate::instance::{Stage, masks, masks3};
+use crate::instance::{masks, masks3};
 use crate::table::ModelExchangeTable;
 
 /// How many values a Model Exchange quantity of the model has (0 for a Co-Simulation-only
@@ -27,16 +27,6 @@ unsafe fn count(
 }
 
 exports! {
-    /// Model Exchange only (Co-Simulation has no event mode here).
-    fn fmi3EnterEventMode(instance: fmi3Instance) -> fmi3Status {
-        enter(instance, "fmi3EnterEventMode", masks::ENTER_EVENT_MODE, Stage::EventMode).into()
-    }
-
-    fn fmi3EnterContinuousTimeMode(instance: fmi3Instance) -> fmi3Status {
-        let mask = masks::ENTER_CONTINUOUS_TIME_MODE;
-        enter(instance, "fmi3EnterContinuousTimeMode", mask, Stage::ContinuousTimeMode).into()
-    }
-
     /// The discrete changes of the event at the current time (turbulence sample, released
     /// bristles) and the next time event. Every output pointer must be writable.
     fn fmi3UpdateDiscreteStates(instance: fmi3Instance, discreteStatesNeedUpdate: *mut fmi3Boolean, terminateSimulation: *mut fmi3Boolean, nominalsOfContinuousStatesChanged: *mut fmi3Boolean, valuesOfContinuousStatesChanged: *mut fmi3Boolean, nextEventTimeDefined: *mut fmi3Boolean, nextEventTime: *mut fmi3Float64) -> fmi3Status {
@@ -62,12 +52,6 @@ exports! {
             }
             write_out(nextEventTime, next.unwrap_or(0.0), "nextEventTime")
         })
-    }
-
-    /// No step event and no termination; an error once the state is not finite.
-    fn fmi3CompletedIntegratorStep(instance: fmi3Instance, _noSetFMUStatePriorToCurrentPoint: fmi3Boolean, enterEventMode: *mut fmi3Boolean, terminateSimulation: *mut fmi3Boolean) -> fmi3Status {
-        let function = "fmi3CompletedIntegratorStep";
-        completed_integrator_step(instance, function, enterEventMode, terminateSimulation, fmi3False).into()
     }
 
     /// A finite time not before the last event.
@@ -105,8 +89,7 @@ exports! {
     /// 1 for every state.
     fn fmi3GetNominalsOfContinuousStates(instance: fmi3Instance, nominals: *mut fmi3Float64, nContinuousStates: usize) -> fmi3Status {
         with_instance(instance, "fmi3GetNominalsOfContinuousStates", masks::GET_NOMINALS, |instance| {
-            instance.sim.nominals(c_slice_mut(nominals, nContinuousStates, "nominals")?)?;
-            Ok(crate::fmi2_types::fmi2Status::fmi2OK)
+            instance.sim.nominals(c_slice_mut(nominals, nContinuousStates, "nominals")?)
         })
     }
 
@@ -119,4 +102,12 @@ exports! {
     fn fmi3GetNumberOfContinuousStates(instance: fmi3Instance, nContinuousStates: *mut usize) -> fmi3Status {
         count(instance, "fmi3GetNumberOfContinuousStates", nContinuousStates, |me| me.states.len())
     }
+}
+
+forward! {
+    /// Model Exchange only (Co-Simulation has no event mode here).
+    fn fmi3EnterEventMode(instance: fmi3Instance) -> fmi3Status = masks::ENTER_EVENT_MODE => enter_event_mode;
+    fn fmi3EnterContinuousTimeMode(instance: fmi3Instance) -> fmi3Status = masks::ENTER_CONTINUOUS_TIME_MODE => enter_continuous_time_mode;
+    /// No step event and no termination; an error once the state is not finite.
+    fn fmi3CompletedIntegratorStep(instance: fmi3Instance, _noSetFMUStatePriorToCurrentPoint: fmi3Boolean, enterEventMode: *mut fmi3Boolean, terminateSimulation: *mut fmi3Boolean) -> fmi3Status = masks::COMPLETED_INTEGRATOR_STEP => completed_integrator_step;
 }

@@ -3,10 +3,9 @@
 //! and adjoint derivatives, evaluateDiscreteStates and Scheduled Execution. Each is exported
 //! (importers bind every function) and answers fmi3Error with the reason in the log.
 
-use super::values::{accessors, resolve};
+use super::values::{accessors, each_variable, resolve};
 use crate::error::FmuError;
-use crate::exports::guard::{c_slice, with_instance};
-use crate::fmi2_types::fmi2Status;
+use crate::exports::guard::{c_slice, refuse, with_instance};
 use crate::fmi3_types::*;
 use crate::instance::{Mask, masks3};
 use crate::table::{Api, ValueType};
@@ -51,81 +50,23 @@ unsafe fn no_binary(
         if values_null && n_values > 0 {
             return Err(FmuError::NullArgument("values[]"));
         }
-        let mut worst = fmi2Status::fmi2OK;
-        for v in variables {
-            let binary = ValueType::none(Api::Fmi3, "Binary");
-            if let Err(e) = binary.check(&v.name, v.value_reference, v.kind) {
-                worst = worst.max(instance.report(function, &e));
-            }
-        }
-        Ok(worst)
+        let binary = ValueType::none(Api::Fmi3, "Binary");
+        each_variable(instance, function, variables, binary, |_, _, _| Ok(()))
     })
 }
 
-/// No Binary variables: every value reference is refused.
-///
-/// # Safety
-/// `valueReferences` NULL or `nValueReferences` elements.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3GetBinary(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    _valueSizes: *mut usize,
-    values: *mut fmi3Binary,
-    nValues: usize,
-) -> fmi3Status {
-    let vrs = (valueReferences, nValueReferences);
-    let function = "fmi3GetBinary";
-    // SAFETY: forwarded contract; no value is ever read or written.
-    unsafe {
-        no_binary(
-            instance,
-            function,
-            masks3::GET_VALUE,
-            vrs,
-            (values.is_null(), nValues),
-        )
+exports! {
+    /// No Binary variables: every value reference is refused.
+    fn fmi3GetBinary(instance: fmi3Instance, valueReferences: *const fmi3ValueReference, nValueReferences: usize, _valueSizes: *mut usize, values: *mut fmi3Binary, nValues: usize) -> fmi3Status {
+        let vrs = (valueReferences, nValueReferences);
+        no_binary(instance, "fmi3GetBinary", masks3::GET_VALUE, vrs, (values.is_null(), nValues))
     }
-}
 
-/// No Binary variables: every value reference is refused.
-///
-/// # Safety
-/// `valueReferences` NULL or `nValueReferences` elements.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3SetBinary(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    _valueSizes: *const usize,
-    values: *const fmi3Binary,
-    nValues: usize,
-) -> fmi3Status {
-    let vrs = (valueReferences, nValueReferences);
-    let function = "fmi3SetBinary";
-    // SAFETY: forwarded contract; no value is ever read.
-    unsafe {
-        no_binary(
-            instance,
-            function,
-            masks3::SET_OTHER,
-            vrs,
-            (values.is_null(), nValues),
-        )
+    /// No Binary variables: every value reference is refused.
+    fn fmi3SetBinary(instance: fmi3Instance, valueReferences: *const fmi3ValueReference, nValueReferences: usize, _valueSizes: *const usize, values: *const fmi3Binary, nValues: usize) -> fmi3Status {
+        let vrs = (valueReferences, nValueReferences);
+        no_binary(instance, "fmi3SetBinary", masks3::SET_OTHER, vrs, (values.is_null(), nValues))
     }
-}
-
-/// Refuses with `why` (after the NULL and stage checks).
-fn refuse(
-    instance: fmi3Instance,
-    function: &'static str,
-    mask: Mask,
-    why: &'static str,
-) -> fmi3Status {
-    with_instance(instance, function, mask, |_| {
-        Err::<(), _>(FmuError::NotSupported(why))
-    })
 }
 
 const NO_CLOCKS: &str = "this FMU has no clocks";

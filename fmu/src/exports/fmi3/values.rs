@@ -5,11 +5,13 @@
 //! FMI 2.0: a refused one is logged with its reason while the others still take effect.
 
 use crate::error::FmuError;
+use crate::fmi2_types::fmi2Status;
 use crate::fmi3_types::*;
 use crate::instance::Instance;
 use crate::instance::masks3;
 use crate::table::{Api, Fmi3View, Source, ValueType, Variable3};
 use flyloop_core::params::ValueKind;
+use std::ops::Range;
 
 /// The variables behind `vrs`, after checking that every one exists and that together they
 /// hold `n_values` values (no allocation: this runs on every get and set).
@@ -61,141 +63,91 @@ pub(crate) fn not_settable(v: &Variable3) -> FmuError {
     }
 }
 
+/// Runs `body` on each of `variables` with the range of its values in the caller's array,
+/// once it is of type `ty`; a refused variable is logged with its reason while the others
+/// still go on. Answers the worst status.
+pub(crate) fn each_variable(
+    instance: &mut Instance,
+    function: &str,
+    variables: impl Iterator<Item = &'static Variable3>,
+    ty: ValueType,
+    mut body: impl FnMut(&mut Instance, &Variable3, Range<usize>) -> Result<(), FmuError>,
+) -> Result<fmi2Status, FmuError> {
+    let (mut worst, mut at) = (fmi2Status::fmi2OK, 0);
+    for v in variables {
+        let range = at..at + v.len();
+        at = range.end;
+        let result =
+            (ty.check(&v.name, v.value_reference, v.kind)).and_then(|()| body(instance, v, range));
+        if let Err(e) = result {
+            worst = worst.max(instance.report(function, &e));
+        }
+    }
+    Ok(worst)
+}
+
 /// Defines fmi3Get<T> and fmi3Set<T> for C type `$t` and value type `$ty`: the getter
 /// converts through `$to_c`, the setter (allowed in `$mask`) through `$from_c`. The body is
 /// here, not in a helper, so the model is two calls away: the guard, then the engine.
 macro_rules! accessors {
     ($get:ident, $set:ident, $t:ty, $ty:expr, $mask:expr, $to_c:expr, $from_c:expr) => {
-        /// Reads the variables (arrays element by element) into `values`.
-        ///
-        /// # Safety
-        /// `valueReferences` NULL or `nValueReferences` elements; `values` NULL or `nValues`.
-        #[unsafe(no_mangle)]
-        pub unsafe extern "C" fn $get(
-            instance: fmi3Instance,
-            valueReferences: *const fmi3ValueReference,
-            nValueReferences: usize,
-            values: *mut $t,
-            nValues: usize,
-        ) -> fmi3Status {
-            use $crate::exports::fmi3::values::{computed, resolve};
-            use $crate::exports::guard::{c_slice, c_slice_mut, with_instance};
-            use $crate::table::Source;
-            let function = stringify!($get);
-            with_instance(instance, function, masks3::GET_VALUE, |instance| {
-                // SAFETY: per the function's contract.
-                let vrs =
-                    unsafe { c_slice(valueReferences, nValueReferences, "valueReferences[]") }?;
-                let variables = resolve(&instance.sim.table().fmi3, vrs, nValues)?;
-                // SAFETY: per the function's contract.
-                let out = unsafe { c_slice_mut(values, nValues, "values[]") }?;
-                let mut worst = $crate::fmi2_types::fmi2Status::fmi2OK;
-                let mut at = 0;
-                for v in variables {
-                    let slots = &mut out[at..at + v.len()];
-                    at += v.len();
-                    let result = $ty
-                        .check(&v.name, v.value_reference, v.kind)
-                        .and_then(|()| {
-                            match &v.source {
-                                Source::Model(elements) => {
-                                    for (slot, &index) in slots.iter_mut().zip(elements) {
-                                        *slot = $to_c(instance.sim.get(index));
-                                    }
+        exports! {
+            /// Reads the variables (arrays element by element) into `values`.
+            fn $get(instance: fmi3Instance, valueReferences: *const fmi3ValueReference, nValueReferences: usize, values: *mut $t, nValues: usize) -> fmi3Status {
+                use $crate::exports::fmi3::values::{computed, each_variable, resolve};
+                use $crate::exports::guard::{c_slice, c_slice_mut, with_instance};
+                let function = stringify!($get);
+                with_instance(instance, function, masks3::GET_VALUE, |instance| {
+                    let vrs = c_slice(valueReferences, nValueReferences, "valueReferences[]")?;
+                    let variables = resolve(&instance.sim.table().fmi3, vrs, nValues)?;
+                    let out = c_slice_mut(values, nValues, "values[]")?;
+                    each_variable(instance, function, variables, $ty, |instance, v, range| {
+                        let slots = &mut out[range];
+                        match &v.source {
+                            $crate::table::Source::Model(elements) => {
+                                for (slot, &index) in slots.iter_mut().zip(elements) {
+                                    *slot = $to_c(instance.sim.get(index));
                                 }
-                                _ => slots[0] = $to_c(computed(instance, v)?),
                             }
-                            Ok(())
-                        });
-                    if let Err(e) = result {
-                        worst = worst.max(instance.report(function, &e));
-                    }
-                }
-                Ok(worst)
-            })
-        }
+                            _ => slots[0] = $to_c(computed(instance, v)?),
+                        }
+                        Ok(())
+                    })
+                })
+            }
 
-        /// Writes `values` to the variables (arrays element by element).
-        ///
-        /// # Safety
-        /// `valueReferences` NULL or `nValueReferences` elements; `values` NULL or `nValues`.
-        #[unsafe(no_mangle)]
-        pub unsafe extern "C" fn $set(
-            instance: fmi3Instance,
-            valueReferences: *const fmi3ValueReference,
-            nValueReferences: usize,
-            values: *const $t,
-            nValues: usize,
-        ) -> fmi3Status {
-            use $crate::exports::fmi3::values::{not_settable, resolve};
-            use $crate::exports::guard::{c_slice, with_instance};
-            use $crate::table::Source;
-            let function = stringify!($set);
-            with_instance(instance, function, $mask, |instance| {
-                // SAFETY: per the function's contract.
-                let vrs =
-                    unsafe { c_slice(valueReferences, nValueReferences, "valueReferences[]") }?;
-                let variables = resolve(&instance.sim.table().fmi3, vrs, nValues)?;
-                // SAFETY: per the function's contract.
-                let values = unsafe { c_slice(values, nValues, "values[]") }?;
-                let initialised = instance.initialised();
-                let mut worst = $crate::fmi2_types::fmi2Status::fmi2OK;
-                let mut at = 0;
-                for v in variables {
-                    let mine = &values[at..at + v.len()];
-                    at += v.len();
-                    let result = $ty
-                        .check(&v.name, v.value_reference, v.kind)
-                        .and_then(|()| {
-                            let Source::Model(elements) = &v.source else {
-                                return Err(not_settable(v));
-                            };
-                            // Every element is tried; the first refusal is reported.
-                            let mut first = Ok(());
-                            for (&index, &value) in elements.iter().zip(mine) {
-                                let r = instance.sim.set(index, $from_c(value), initialised);
-                                if first.is_ok() {
-                                    first = r;
-                                }
+            /// Writes `values` to the variables (arrays element by element).
+            fn $set(instance: fmi3Instance, valueReferences: *const fmi3ValueReference, nValueReferences: usize, values: *const $t, nValues: usize) -> fmi3Status {
+                use $crate::exports::fmi3::values::{each_variable, not_settable, resolve};
+                use $crate::exports::guard::{c_slice, with_instance};
+                let function = stringify!($set);
+                with_instance(instance, function, $mask, |instance| {
+                    let vrs = c_slice(valueReferences, nValueReferences, "valueReferences[]")?;
+                    let variables = resolve(&instance.sim.table().fmi3, vrs, nValues)?;
+                    let values = c_slice(values, nValues, "values[]")?;
+                    let initialised = instance.initialised();
+                    each_variable(instance, function, variables, $ty, |instance, v, range| {
+                        let $crate::table::Source::Model(elements) = &v.source else {
+                            return Err(not_settable(v));
+                        };
+                        // Every element is tried; the first refusal is reported.
+                        let mut first = Ok(());
+                        for (&index, &value) in elements.iter().zip(&values[range]) {
+                            let r = instance.sim.set(index, $from_c(value), initialised);
+                            if first.is_ok() {
+                                first = r;
                             }
-                            first
-                        });
-                    if let Err(e) = result {
-                        worst = worst.max(instance.report(function, &e));
-                    }
-                }
-                Ok(worst)
-            })
+                        }
+                        first
+                    })
+                })
+            }
         }
     };
 }
 pub(crate) use accessors;
 
-accessors!(
-    fmi3GetFloat64,
-    fmi3SetFloat64,
-    fmi3Float64,
-    ValueType::of(Api::Fmi3, ValueKind::Real),
-    masks3::SET_FLOAT64,
-    |v| v,
-    |v| v
-);
+accessors! { fmi3GetFloat64, fmi3SetFloat64, fmi3Float64, ValueType::of(Api::Fmi3, ValueKind::Real), masks3::SET_FLOAT64, |v| v, |v| v }
 // Int32 variables hold integers within i32 (their table ranges say so).
-accessors!(
-    fmi3GetInt32,
-    fmi3SetInt32,
-    fmi3Int32,
-    ValueType::of(Api::Fmi3, ValueKind::Integer),
-    masks3::SET_OTHER,
-    |v| v as i32,
-    f64::from
-);
-accessors!(
-    fmi3GetBoolean,
-    fmi3SetBoolean,
-    fmi3Boolean,
-    ValueType::of(Api::Fmi3, ValueKind::Boolean),
-    masks3::SET_OTHER,
-    |v| u8::from(v != 0.0),
-    |v: u8| if v != 0 { 1.0 } else { 0.0 }
-);
+accessors! { fmi3GetInt32, fmi3SetInt32, fmi3Int32, ValueType::of(Api::Fmi3, ValueKind::Integer), masks3::SET_OTHER, |v| v as i32, f64::from }
+accessors! { fmi3GetBoolean, fmi3SetBoolean, fmi3Boolean, ValueType::of(Api::Fmi3, ValueKind::Boolean), masks3::SET_OTHER, |v| u8::from(v != 0.0), |v: u8| if v != 0 { 1.0 } else { 0.0 } }

@@ -3,17 +3,25 @@
 //! values), so setting it and stepping again repeats the same outputs bit for bit.
 //!
 //! The instance keeps every state it hands out; a pointer it does not know (freed already,
-//! foreign, garbage) is refused with fmi2Error instead of being dereferenced.
+//! foreign, garbage) is refused with an error instead of being dereferenced.
 
 use crate::error::FmuError;
-use crate::exports::guard::{c_slice, c_slice_mut, with_instance, write_out};
-use crate::fmi2_types::*;
-use crate::instance::masks;
+use crate::exports::guard::{c_slice, c_slice_mut, write_out};
+use crate::instance::Instance;
 use flyloop_core::number::Compact;
 use std::ffi::c_void;
 
 /// An FMU state pointer (fmi2FMUstate, fmi3FMUState).
 type StatePtr = *mut c_void;
+
+/// The importer's variable behind an `FMUstate` argument.
+///
+/// # Safety
+/// `FMUstate` must be NULL or valid for reads and writes of one pointer.
+unsafe fn slot<'a>(FMUstate: *mut StatePtr) -> Result<&'a mut StatePtr, FmuError> {
+    // SAFETY: per the contract.
+    unsafe { FMUstate.as_mut() }.ok_or(FmuError::NullArgument("FMUstate"))
+}
 
 /// Copies the current state. `*FMUstate` NULL gets a new state; a state of this instance is
 /// overwritten in place.
@@ -21,26 +29,17 @@ type StatePtr = *mut c_void;
 /// # Safety
 /// `FMUstate` must be NULL or valid for reads and writes of one pointer.
 pub(crate) unsafe fn get_state(
-    c: fmi2Component,
-    function: &'static str,
+    instance: &mut Instance,
+    function: &str,
     FMUstate: *mut StatePtr,
-) -> fmi2Status {
-    with_instance(c, function, masks::FMU_STATE, |instance| {
-        if FMUstate.is_null() {
-            return Err(FmuError::NullArgument("FMUstate"));
-        }
-        // SAFETY: non-NULL and readable per the contract.
-        let existing = unsafe { FMUstate.read() };
-        let bytes = instance.sim.save(instance.stage.code())?;
-        let address = instance.keep_state(existing as usize, bytes)?;
-        // SAFETY: non-NULL and writable per the contract.
-        unsafe { FMUstate.write(address.cast()) };
-        instance.event(&format!(
-            "{function}: state saved at t = {}",
-            Compact(instance.sim.time())
-        ));
-        Ok(fmi2Status::fmi2OK)
-    })
+) -> Result<(), FmuError> {
+    // SAFETY: per the contract.
+    let slot = unsafe { slot(FMUstate) }?;
+    let bytes = instance.sim.save(instance.stage.code())?;
+    *slot = instance.keep_state(*slot as usize, bytes)?.cast();
+    let t = Compact(instance.sim.time());
+    instance.event(&format!("{function}: state saved at t = {t}"));
+    Ok(())
 }
 
 /// Restores a state of this instance (stage, time and everything else included).
@@ -49,27 +48,24 @@ pub(crate) unsafe fn get_state(
 /// `c` must be NULL or a live instance; `FMUstate` may be anything (it is looked up, not
 /// dereferenced).
 pub(crate) unsafe fn set_state(
-    c: fmi2Component,
-    function: &'static str,
+    instance: &mut Instance,
+    function: &str,
     FMUstate: StatePtr,
-) -> fmi2Status {
-    with_instance(c, function, masks::FMU_STATE, |instance| {
-        if FMUstate.is_null() {
-            return Err(FmuError::NullArgument("FMUstate"));
-        }
-        // A copy: the lookup borrows the instance that restore changes. Every state in the
-        // registry was made by fmi2GetFMUstate or checked by fmi2DeSerializeFMUstate, stage
-        // code included, and restore changes nothing when it fails.
-        let bytes = instance.state(FMUstate as usize)?.bytes.clone();
-        let code = instance.sim.restore(&bytes)?;
-        instance.stage = instance.stage_from_code(code)?;
-        instance.event(&format!(
-            "{function}: state restored, t = {}, stage {:?}",
-            Compact(instance.sim.time()),
-            instance.stage
-        ));
-        Ok(fmi2Status::fmi2OK)
-    })
+) -> Result<(), FmuError> {
+    if FMUstate.is_null() {
+        return Err(FmuError::NullArgument("FMUstate"));
+    }
+    // A copy: the lookup borrows the instance that restore changes. Every state in the
+    // registry was made by fmi2GetFMUstate or checked by fmi2DeSerializeFMUstate, stage
+    // code included, and restore changes nothing when it fails.
+    let bytes = instance.state(FMUstate as usize)?.bytes.clone();
+    let code = instance.sim.restore(&bytes)?;
+    instance.stage = instance.stage_from_code(code)?;
+    let (t, stage) = (Compact(instance.sim.time()), instance.stage);
+    instance.event(&format!(
+        "{function}: state restored, t = {t}, stage {stage:?}"
+    ));
+    Ok(())
 }
 
 /// Frees a state and sets `*FMUstate` to NULL. `*FMUstate` NULL is ignored; a pointer this
@@ -78,94 +74,75 @@ pub(crate) unsafe fn set_state(
 /// # Safety
 /// `FMUstate` must be NULL or valid for reads and writes of one pointer.
 pub(crate) unsafe fn free_state(
-    c: fmi2Component,
-    function: &'static str,
+    instance: &mut Instance,
+    _function: &str,
     FMUstate: *mut StatePtr,
-) -> fmi2Status {
-    with_instance(c, function, masks::FMU_STATE, |instance| {
-        if FMUstate.is_null() {
-            return Err(FmuError::NullArgument("FMUstate"));
-        }
-        // SAFETY: non-NULL and readable per the contract.
-        let state = unsafe { FMUstate.read() };
-        if state.is_null() {
-            return Ok(fmi2Status::fmi2OK);
-        }
-        instance.release_state(state as usize)?;
-        // SAFETY: non-NULL and writable per the contract.
-        unsafe { FMUstate.write(std::ptr::null_mut()) };
-        Ok(fmi2Status::fmi2OK)
-    })
+) -> Result<(), FmuError> {
+    // SAFETY: per the contract.
+    let slot = unsafe { slot(FMUstate) }?;
+    if !slot.is_null() {
+        instance.release_state(*slot as usize)?;
+        *slot = std::ptr::null_mut();
+    }
+    Ok(())
 }
 
 /// # Safety
 /// `size` must be NULL or writable.
 pub(crate) unsafe fn serialized_size(
-    c: fmi2Component,
-    function: &'static str,
+    instance: &mut Instance,
+    _function: &str,
     FMUstate: StatePtr,
     size: *mut usize,
-) -> fmi2Status {
-    with_instance(c, function, masks::FMU_STATE, |instance| {
-        let length = instance.state(FMUstate as usize)?.bytes.len();
-        // SAFETY: per the contract.
-        unsafe { write_out(size, length, "size") }?;
-        Ok(fmi2Status::fmi2OK)
-    })
+) -> Result<(), FmuError> {
+    let length = instance.state(FMUstate as usize)?.bytes.len();
+    // SAFETY: per the contract.
+    unsafe { write_out(size, length, "size") }
 }
 
 /// Copies a state's bytes; `size` must be what fmi2SerializedFMUstateSize said.
 ///
 /// # Safety
 /// `serializedState` must be NULL or writable for `size` bytes.
-pub(crate) unsafe fn serialize(
-    c: fmi2Component,
-    function: &'static str,
+pub(crate) unsafe fn serialize<B>(
+    instance: &mut Instance,
+    _function: &str,
     FMUstate: StatePtr,
-    serializedState: *mut u8,
+    serializedState: *mut B,
     size: usize,
-) -> fmi2Status {
-    with_instance(c, function, masks::FMU_STATE, |instance| {
-        let bytes = &instance.state(FMUstate as usize)?.bytes;
-        if size != bytes.len() {
-            return Err(FmuError::InvalidArgument(format!(
-                "size is {size}, but the serialized state has {} bytes \
-                 (ask fmi2SerializedFMUstateSize)",
-                bytes.len()
-            )));
-        }
-        // SAFETY: per the contract.
-        let out = unsafe { c_slice_mut(serializedState, size, "serializedState") }?;
-        out.copy_from_slice(bytes);
-        Ok(fmi2Status::fmi2OK)
-    })
+) -> Result<(), FmuError> {
+    let bytes = &instance.state(FMUstate as usize)?.bytes;
+    if size != bytes.len() {
+        return Err(FmuError::InvalidArgument(format!(
+            "size is {size}, but the serialized state has {} bytes \
+             (ask fmi2SerializedFMUstateSize)",
+            bytes.len()
+        )));
+    }
+    // SAFETY: per the contract.
+    let out = unsafe { c_slice_mut(serializedState.cast::<u8>(), size, "serializedState") }?;
+    out.copy_from_slice(bytes);
+    Ok(())
 }
 
 /// Makes a state from serialized bytes after checking them completely (format, checksum,
-/// model, a restorable model snapshot). Bytes that fail give fmi2Error and change nothing.
+/// model, a restorable model snapshot). Bytes that fail give an error and change nothing.
 ///
 /// # Safety
 /// `serializedState` must be NULL or readable for `size` bytes; `FMUstate` must be NULL or
 /// valid for reads and writes of one pointer.
-pub(crate) unsafe fn deserialize(
-    c: fmi2Component,
-    function: &'static str,
-    serializedState: *const u8,
+pub(crate) unsafe fn deserialize<B>(
+    instance: &mut Instance,
+    _function: &str,
+    serializedState: *const B,
     size: usize,
     FMUstate: *mut StatePtr,
-) -> fmi2Status {
-    with_instance(c, function, masks::FMU_STATE, |instance| {
-        if FMUstate.is_null() {
-            return Err(FmuError::NullArgument("FMUstate"));
-        }
-        // SAFETY: per the contract.
-        let bytes = unsafe { c_slice(serializedState, size, "serializedState") }?;
-        instance.stage_from_code(instance.sim.check_saved(bytes)?)?;
-        // SAFETY: non-NULL and readable per the contract.
-        let existing = unsafe { FMUstate.read() };
-        let address = instance.keep_state(existing as usize, bytes.to_vec())?;
-        // SAFETY: non-NULL and writable per the contract.
-        unsafe { FMUstate.write(address.cast()) };
-        Ok(fmi2Status::fmi2OK)
-    })
+) -> Result<(), FmuError> {
+    // SAFETY: per the contract.
+    let slot = unsafe { slot(FMUstate) }?;
+    // SAFETY: per the contract.
+    let bytes = unsafe { c_slice(serializedState.cast::<u8>(), size, "serializedState") }?;
+    instance.stage_from_code(instance.sim.check_saved(bytes)?)?;
+    *slot = instance.keep_state(*slot as usize, bytes.to_vec())?.cast();
+    Ok(())
 }

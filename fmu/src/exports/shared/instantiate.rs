@@ -66,7 +66,10 @@ fn new_instance(request: &Request<'_>) -> Result<Instance, String> {
              instantiate it for Co-Simulation"
         ));
     }
-    let logger = Logger::new(request.sink, name.to_owned());
+    let logger = Logger {
+        sink: request.sink,
+        instance_name: name.to_owned(),
+    };
     let instance = Instance::new(request.api, interface, logger, request.logging_on, sim);
     let function = request.function;
     instance.event(&format!(

@@ -13,7 +13,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 pub(crate) fn free_instance(c: fmi2Component, function: &'static str) {
     let status: fmi2Status = with_instance(c, function, masks::FREE_INSTANCE, |instance| {
         instance.event(&format!("{function}: freeing the instance"));
-        Ok(fmi2Status::fmi2OK)
+        Ok(())
     });
     // Free only what passed the stage check (FREE_INSTANCE allows every stage an instance
     // can be in); a panic there leaves the instance allocated rather than half dropped.
@@ -30,13 +30,14 @@ pub(crate) fn free_instance(c: fmi2Component, function: &'static str) {
 /// # Safety
 /// `categories` must be NULL or point to `n` C strings.
 pub(crate) unsafe fn set_debug_logging(
-    c: fmi2Component,
-    function: &'static str,
-    on: bool,
+    instance: &mut Instance,
+    function: &str,
+    on: impl Into<i32>,
     n: usize,
     categories: *const fmi2String,
-) -> fmi2Status {
-    with_instance(c, function, masks::SET_DEBUG_LOGGING, |instance| {
+) -> Result<fmi2Status, FmuError> {
+    let on = on.into() != 0;
+    {
         // SAFETY: per the function's contract.
         let names = unsafe { c_slice(categories, n, "categories[]") }?;
         if names.is_empty() {
@@ -61,7 +62,7 @@ pub(crate) unsafe fn set_debug_logging(
             worst = worst.max(instance.report(function, &error));
         }
         Ok(worst)
-    })
+    }
 }
 
 /// The experiment (fmi2SetupExperiment; fmi3EnterInitializationMode's arguments).
@@ -82,32 +83,29 @@ pub(crate) fn setup_experiment(
 
 /// The body of fmi2ExitInitializationMode and fmi3ExitInitializationMode: Co-Simulation
 /// goes to step mode, Model Exchange to event mode.
-pub(crate) fn exit_initialization_mode(c: fmi2Component, function: &'static str) -> fmi2Status {
-    with_instance(c, function, masks::EXIT_INITIALIZATION_MODE, |instance| {
-        instance.stage = match instance.interface {
-            Interface::CoSimulation => Stage::StepComplete,
-            Interface::ModelExchange => Stage::EventMode,
-        };
-        instance.event(&format!("{function}: t = {}", Compact(instance.sim.time())));
-        Ok(fmi2Status::fmi2OK)
-    })
+pub(crate) fn exit_initialization_mode(
+    instance: &mut Instance,
+    function: &str,
+) -> Result<(), FmuError> {
+    instance.stage = match instance.interface {
+        Interface::CoSimulation => Stage::StepComplete,
+        Interface::ModelExchange => Stage::EventMode,
+    };
+    instance.event(&format!("{function}: t = {}", Compact(instance.sim.time())));
+    Ok(())
 }
 
 /// The body of fmi2Terminate and fmi3Terminate.
-pub(crate) fn terminate(c: fmi2Component, function: &'static str) -> fmi2Status {
-    with_instance(c, function, masks::TERMINATE, |instance| {
-        instance.stage = Stage::Terminated;
-        instance.event(&format!("{function}: t = {}", Compact(instance.sim.time())));
-        Ok(fmi2Status::fmi2OK)
-    })
+pub(crate) fn terminate(instance: &mut Instance, function: &str) -> Result<(), FmuError> {
+    instance.stage = Stage::Terminated;
+    instance.event(&format!("{function}: t = {}", Compact(instance.sim.time())));
+    Ok(())
 }
 
 /// The body of fmi2Reset and fmi3Reset: back to the state right after instantiation.
-pub(crate) fn reset(c: fmi2Component, function: &'static str) -> fmi2Status {
-    with_instance(c, function, masks::RESET, |instance| {
-        instance.sim.reset()?;
-        instance.stage = Stage::Instantiated;
-        instance.event(&format!("{function}: back to the start values"));
-        Ok(fmi2Status::fmi2OK)
-    })
+pub(crate) fn reset(instance: &mut Instance, function: &str) -> Result<(), FmuError> {
+    instance.sim.reset()?;
+    instance.stage = Stage::Instantiated;
+    instance.event(&format!("{function}: back to the start values"));
+    Ok(())
 }

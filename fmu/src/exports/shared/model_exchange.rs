@@ -4,22 +4,23 @@
 //! refused with a log line, never a crash.
 
 use crate::error::FmuError;
-use crate::exports::guard::{with_instance, write_out};
-use crate::fmi2_types::*;
-use crate::instance::{Instance, Mask, Stage, masks};
+use crate::exports::guard::write_out;
+use crate::instance::{Instance, Stage};
 use flyloop_core::number::Compact;
 
-/// The body of a Model Exchange function that only moves the instance to `stage`.
-pub(crate) fn enter(
-    c: fmi2Component,
-    function: &'static str,
-    mask: Mask,
-    stage: Stage,
-) -> fmi2Status {
-    with_instance(c, function, mask, |instance| {
-        instance.stage = stage;
-        Ok(fmi2Status::fmi2OK)
-    })
+/// The body of fmi2EnterEventMode and fmi3EnterEventMode.
+pub(crate) fn enter_event_mode(instance: &mut Instance, _function: &str) -> Result<(), FmuError> {
+    instance.stage = Stage::EventMode;
+    Ok(())
+}
+
+/// The body of fmi2EnterContinuousTimeMode and fmi3EnterContinuousTimeMode.
+pub(crate) fn enter_continuous_time_mode(
+    instance: &mut Instance,
+    _function: &str,
+) -> Result<(), FmuError> {
+    instance.stage = Stage::ContinuousTimeMode;
+    Ok(())
 }
 
 /// The discrete changes of the event at the current time, logged as `function`'s event:
@@ -39,31 +40,28 @@ pub(crate) fn discrete_update(
 }
 
 /// The body of fmi2CompletedIntegratorStep and fmi3CompletedIntegratorStep: no step event
-/// and no termination (`no` is the version's false); an error (Error stage) once the state is
-/// not finite.
+/// and no termination (`B::default()` is the version's false); an error (Error stage) once the
+/// state is not finite.
 ///
 /// # Safety
 /// The two flags must be NULL or writable.
-pub(crate) unsafe fn completed_integrator_step<B: Copy>(
-    c: fmi2Component,
-    function: &'static str,
+pub(crate) unsafe fn completed_integrator_step<B: Copy + Default>(
+    instance: &mut Instance,
+    _function: &str,
+    _no_set_fmu_state_prior_to_current_point: B,
     enter_event_mode: *mut B,
     terminate_simulation: *mut B,
-    no: B,
-) -> fmi2Status {
-    with_instance(c, function, masks::COMPLETED_INTEGRATOR_STEP, |instance| {
-        if enter_event_mode.is_null() {
-            return Err(FmuError::NullArgument("enterEventMode"));
-        }
-        if terminate_simulation.is_null() {
-            return Err(FmuError::NullArgument("terminateSimulation"));
-        }
-        instance.sim.completed_integrator_step()?;
-        // SAFETY: both non-NULL (checked above) and writable per the contract.
-        unsafe {
-            write_out(enter_event_mode, no, "enterEventMode")?;
-            write_out(terminate_simulation, no, "terminateSimulation")?;
-        }
-        Ok(fmi2Status::fmi2OK)
-    })
+) -> Result<(), FmuError> {
+    if enter_event_mode.is_null() {
+        return Err(FmuError::NullArgument("enterEventMode"));
+    }
+    if terminate_simulation.is_null() {
+        return Err(FmuError::NullArgument("terminateSimulation"));
+    }
+    instance.sim.completed_integrator_step()?;
+    // SAFETY: both non-NULL (checked above) and writable per the contract.
+    unsafe {
+        write_out(enter_event_mode, B::default(), "enterEventMode")?;
+        write_out(terminate_simulation, B::default(), "terminateSimulation")
+    }
 }
