@@ -1,6 +1,7 @@
-//! One 20 ms env step of the Landing task (rapier2d physics, contacts, reward, termination and
-//! the 11-value observation): in flight, resting on the pad (contacts active) and with a
-//! moving platform; plus an episode reset (a new rapier world) and a whole-state save/restore.
+//! One 20 ms env step of the Landing task (physics, contacts, reward, termination and the
+//! 11-value observation): in flight (the drone integrated alone), resting on the pad (in a
+//! rapier world, contacts active) and with a moving platform; plus an episode reset and a
+//! whole-state save/restore.
 //!
 //! cargo bench -p flyloop-core --bench lander2d_step
 
