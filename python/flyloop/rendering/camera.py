@@ -109,8 +109,6 @@ class OrbitCamera:
         """On-screen radius in pixels of a sphere of radius_m at this depth."""
         return self.focal_px(height) * radius_m / max(depth, self.near)
 
-    # Interactive controls ------------------------------------------------------------------
-
     def orbit(self, d_azimuth_deg: float, d_elevation_deg: float) -> None:
         """Turn around the look-at point; elevation stays short of straight up/down."""
         self.azimuth_deg = (self.azimuth_deg + d_azimuth_deg) % 360.0
@@ -155,21 +153,15 @@ def clip_polygon_near(cam_points: np.ndarray, near: float) -> np.ndarray:
 class CameraControls:
     """Window events -> camera moves (see the module docstring)."""
 
-    def __init__(self, pg: Any, camera: OrbitCamera) -> None:
+    def __init__(self, pg: Any) -> None:
         self.pg = pg
-        self.camera = camera
         self._dragging = False
         self._held: set[int] = set()
-        self._moves = {
-            pg.K_w: (1, 0, 0),
-            pg.K_s: (-1, 0, 0),
-            pg.K_d: (0, 1, 0),
-            pg.K_a: (0, -1, 0),
-            pg.K_e: (0, 0, 1),
-            pg.K_q: (0, 0, -1),
-        }
+        keys = (pg.K_w, pg.K_s, pg.K_d, pg.K_a, pg.K_e, pg.K_q)
+        moves = ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))
+        self._moves = dict(zip(keys, moves, strict=True))
 
-    def handle(self, events: list[Any]) -> None:
+    def handle(self, camera: OrbitCamera, events: list[Any]) -> None:
         """Apply this frame's events, then one frame of movement for each key held or pressed
         in this frame (a tap shorter than a frame still moves once)."""
         pg = self.pg
@@ -182,13 +174,13 @@ class CameraControls:
             elif event.type == pg.MOUSEMOTION and self._dragging:
                 dx, dy = event.rel
                 # Dragging right turns the world right; dragging down looks from higher up.
-                self.camera.orbit(-dx * DEGREES_PER_PIXEL, dy * DEGREES_PER_PIXEL)
+                camera.orbit(-dx * DEGREES_PER_PIXEL, dy * DEGREES_PER_PIXEL)
             elif event.type == pg.MOUSEWHEEL:
-                distance = self.camera.distance * ZOOM_STEP ** float(event.y)
-                self.camera.distance = min(max(distance, MIN_DISTANCE), MAX_DISTANCE)
+                distance = camera.distance * ZOOM_STEP ** float(event.y)
+                camera.distance = min(max(distance, MIN_DISTANCE), MAX_DISTANCE)
             elif event.type == pg.KEYDOWN:
                 if event.key == pg.K_r:
-                    self.camera.reset()
+                    camera.reset()
                 elif event.key in self._moves:
                     self._held.add(event.key)
                     tapped.add(event.key)
@@ -197,10 +189,10 @@ class CameraControls:
             elif event.type == pg.WINDOWFOCUSLOST:
                 self._held.clear()
                 self._dragging = False
-        step = MOVE_FRACTION * self.camera.distance
+        step = MOVE_FRACTION * camera.distance
         for key in self._held | tapped:
             forward, right, up = self._moves[key]
-            self.camera.move(forward * step, right * step, up * step)
+            camera.move(forward * step, right * step, up * step)
 
 
 class Projector:
@@ -210,18 +202,16 @@ class Projector:
         self.camera = camera
         self.width, self.height = size
 
+    def _pixels(self, cam: np.ndarray) -> np.ndarray:
+        return self.camera.project_camera(cam, self.width, self.height)
+
     def point(self, p: np.ndarray) -> tuple[np.ndarray, float] | None:
         cam = self.camera.to_camera(p)
-        if cam[2] < self.camera.near:
-            return None
-        return self.camera.project_camera(cam, self.width, self.height), float(cam[2])
+        return None if cam[2] < self.camera.near else (self._pixels(cam), float(cam[2]))
 
     def segment(self, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
         clipped = self.camera.clip_segment(np.asarray(a, float), np.asarray(b, float))
-        if clipped is None:
-            return None
-        ends = self.camera.project_camera(np.stack(clipped), self.width, self.height)
-        return ends[0], ends[1]
+        return None if clipped is None else tuple(self._pixels(np.stack(clipped)))
 
     def segments(self, a: np.ndarray, b: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
         """Many world segments a[i]-b[i] at once: the visible, near-clipped ones in pixels."""
@@ -233,15 +223,11 @@ class Projector:
             t = np.where(da - db != 0, da / (da - db), 0.0)
         ca2 = np.where(da < 0, ca + (cb - ca) * t, ca)
         cb2 = np.where(db < 0, cb + (ca - cb) * (db / np.where(db - da != 0, db - da, 1)), cb)
-        pa = self.camera.project_camera(ca2[keep], self.width, self.height)
-        pb = self.camera.project_camera(cb2[keep], self.width, self.height)
-        return list(zip(pa, pb, strict=True))
+        return list(zip(self._pixels(ca2[keep]), self._pixels(cb2[keep]), strict=True))
 
     def polygon(self, points: np.ndarray) -> np.ndarray:
         cam = clip_polygon_near(self.camera.to_camera(points), self.camera.near)
-        if len(cam) < 3:
-            return np.zeros((0, 2))
-        return self.camera.project_camera(cam, self.width, self.height)
+        return self._pixels(cam) if len(cam) >= 3 else np.zeros((0, 2))
 
     def radius(self, radius_m: float, depth: float) -> float:
         return self.camera.pixel_radius(radius_m, depth, self.height)

@@ -14,7 +14,7 @@ import numpy as np
 
 from .. import _native
 from ..tasks import LANDING, observation_slices
-from .canvas import FlightPath, Painter, Shades, View, check_render_mode, rotate2d, vector
+from .canvas import FlightPath, Painter, Shades, View, vector
 
 SKY_TOP, SKY_BOTTOM, OUTSIDE = (196, 220, 246), (226, 238, 250), (120, 130, 145)
 GROUND, GROUND_EDGE, BOUNDS, SPAWN = (96, 148, 82), (62, 112, 58), (200, 70, 70), (178, 160, 80)
@@ -146,14 +146,10 @@ class PlaneView:
     """A uniform scale (px per metre) and the pixel (u0, v0) where world (0, 0) lands."""
 
     def __init__(self, scale: float, u0: float, v0: float) -> None:
-        if not scale > 0:
-            raise ValueError(f"scale must be > 0 px/m, got {scale}")
         self.scale, self.u0, self.v0 = float(scale), float(u0), float(v0)
 
     @classmethod
-    def fit_world(
-        cls, world_width: float, world_height: float, size: tuple[int, int], margin_px: int = 12
-    ) -> PlaneView:
+    def fit_world(cls, world_width: float, world_height: float, size, margin_px=12) -> PlaneView:
         """The world box (0, 0)-(W, H), centred, filling the frame less margin_px per side."""
         width, height = size
         usable_w, usable_h = width - 2 * margin_px, height - 2 * margin_px
@@ -180,6 +176,12 @@ class PlaneView:
         return np.stack(
             [(q[..., 0] - self.u0) / self.scale, (self.v0 - q[..., 1]) / self.scale], -1
         )
+
+
+def rotate2d(points: np.ndarray, angle: float) -> np.ndarray:
+    """Rotate (N, 2) points counter-clockwise by angle radians."""
+    c, s = math.cos(angle), math.sin(angle)
+    return np.asarray(points, dtype=float) @ np.array([[c, s], [-s, c]])
 
 
 def background(p: Painter, plane: PlaneView, s: LanderScene) -> None:
@@ -437,52 +439,36 @@ class LanderView(View):
         show_overlay: bool = True,
         show_close_up: bool = True,
     ) -> None:
-        check_render_mode(render_mode)
-        self.show_path = show_path
-        self.show_shades = show_shades
-        self.show_spawn_zone = show_spawn_zone
-        self.show_overlay = show_overlay
+        self.show_path, self.show_shades = show_path, show_shades
+        self.show_spawn_zone, self.show_overlay = show_spawn_zone, show_overlay
         self._path = FlightPath()
         self._shades = Shades(shade_distance_m)
         super().__init__(render_mode, (width, height), "flyloop - Lander2D", fps)
         self._close_up: Painter | None = None
-        if show_close_up:
-            cw, ch = CLOSE_UP_SIZE
-            if width >= 3 * cw and height >= 3 * ch:  # a small frame has no room for it
-                window = self._screen.surface.subsurface((20, 20, cw, ch))
-                self._close_up = Painter(self._screen.pg, window)
-        self._plane: PlaneView | None = None
-        self._plane_key: tuple[float, float] | None = None
+        cw, ch = CLOSE_UP_SIZE
+        if show_close_up and width >= 3 * cw and height >= 3 * ch:  # else it has no room
+            self._close_up = Painter(self._pg, self._surface.subsurface((20, 20, cw, ch)))
 
     def world_to_screen(self, scene: LanderScene, points: np.ndarray) -> np.ndarray:
         """Pixels (u, v) where world points (..., 2) in metres are drawn for this scene."""
-        return self._plane_for(scene).to_screen(points)
+        plane = PlaneView.fit_world(scene.world_width, scene.world_height, self.size)
+        return plane.to_screen(points)
 
     def reset(self) -> None:
         """Forget the flight path and shades (an env calls this from reset())."""
         self._path.clear()
-        self._shades.clear()
+        self._shades.poses.clear()
 
     def render(self, scene: LanderScene) -> np.ndarray | None:
         """Draw one frame: returns it in rgb_array mode, None in human mode."""
         if self._events(scene) is None:
             return None  # the user closed the window: nothing to draw on any more
         if self._path.update(scene.step, scene.position):
-            self._shades.clear()
+            self._shades.poses.clear()
         self._shades.update(scene.position, scene.angle)
-        self._draw(scene)
-        return self._screen.present()
-
-    def _plane_for(self, scene: LanderScene) -> PlaneView:
-        key = (scene.world_width, scene.world_height)
-        if self._plane is None or self._plane_key != key:
-            self._plane = PlaneView.fit_world(scene.world_width, scene.world_height, self.size)
-            self._plane_key = key
-        return self._plane
-
-    def _draw(self, s: LanderScene) -> None:
-        p, plane = self._painter, self._plane_for(s)
-        shade_poses = self._shades.poses if self.show_shades else []
+        s, p = scene, self._painter
+        plane = PlaneView.fit_world(s.world_width, s.world_height, self.size)
+        shade_poses = self._shades.poses if self.show_shades else ()
         path_points = self._path.points if self.show_path else np.zeros((0, 2))
         world(p, plane, s, shade_poses, path_points, spawn=self.show_spawn_zone)
         zoom = CLOSE_UP_SCALE / plane.scale
@@ -491,3 +477,4 @@ class LanderView(View):
         wind_indicator(p, s)
         if self.show_overlay:
             overlay(p, plane, s)
+        return self._present()

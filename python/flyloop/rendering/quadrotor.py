@@ -21,7 +21,7 @@ import numpy as np
 from .. import _native
 from ..tasks import observation_slices, parameter_values
 from .camera import CameraControls, OrbitCamera, Projector
-from .canvas import FlightPath, Painter, View, check_render_mode, vector
+from .canvas import FlightPath, Painter, View, vector
 
 # Rotor i sits at (forward, left) * L/sqrt(2) in the body frame: PX4 quad-X order.
 ROTOR_POSITION_SIGNS = np.array([(1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (-1.0, -1.0)])
@@ -390,7 +390,7 @@ def info_lines(scene: QuadScene) -> list[tuple[str, tuple[int, int, int]]]:
 def info_panel(p: Painter, scene: QuadScene) -> None:
     lines = info_lines(scene)
     line_h = 24
-    width = max(p.text_size(t, 21)[0] for t, _ in lines) + 28
+    width = max(p.font(21).size(t)[0] for t, _ in lines) + 28
     p.panel((12, 12, width, len(lines) * line_h + 18), PANEL)
     for i, (text, color) in enumerate(lines):
         p.text(text, (26, 22 + i * line_h), color, 21, bold=(color == BAD))
@@ -490,17 +490,7 @@ def legend(p: Painter) -> None:
         p.text(label, (x + 26, cy), TEXT, 17, "midleft")
 
 
-def controls_hint(p: Painter) -> None:
-    """Bottom centre in a window: how to move the camera."""
-    width, height = p.surface.get_size()
-    hint = "drag: rotate   wheel: zoom   W/A/S/D: move   Q/E: down/up   R: reset   Esc: close"
-    p.text(hint, (width / 2, height - 8), (90, 90, 100), 17, "midbottom")
-
-
-def default_camera(bounds_half_size: float) -> OrbitCamera:
-    """Looking at the middle of the target box from the south-west, above, the box in view."""
-    h = bounds_half_size
-    return OrbitCamera(look_at=np.array([0.0, 0.0, 0.8 * h]), distance=4.2 * h)
+HINT = "drag: rotate   wheel: zoom   W/A/S/D: move   Q/E: down/up   R: reset   Esc: close"
 
 
 class QuadrotorView(View):
@@ -527,26 +517,18 @@ class QuadrotorView(View):
         trail_steps: int = 400,
         hud: bool = True,
     ) -> None:
-        check_render_mode(render_mode)
         if not drone_scale > 0:
             raise ValueError(f"drone_scale must be > 0, got {drone_scale}")
-        self.drone_scale = float(drone_scale)
-        self.hud = hud
-        self._camera = camera
+        self.drone_scale, self.hud, self.camera = float(drone_scale), hud, camera
         self._trail = FlightPath(max(2, trail_steps))
         super().__init__(render_mode, (width, height), "flyloop - Quadrotor 3D", fps)
-        self._controls: CameraControls | None = None
-
-    @property
-    def camera(self) -> OrbitCamera | None:
-        """The camera (created at the first render from the scene's bounds if not given)."""
-        return self._camera
+        self._controls = CameraControls(self._pg)
 
     def world_to_screen(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Pixels (..., 2) of world points (..., 3) and whether each is in front of the camera."""
-        if self._camera is None:
+        if self.camera is None:
             raise RuntimeError("the camera is set up by the first render (or pass camera=...)")
-        return self._camera.project(points, *self.size)
+        return self.camera.project(points, *self.size)
 
     def reset(self) -> None:
         """Forget the trail (an env calls this from reset())."""
@@ -555,28 +537,25 @@ class QuadrotorView(View):
     def render(self, scene: QuadScene) -> np.ndarray | None:
         """Draw one frame: returns it in rgb_array mode, None in human mode."""
         events = self._events(scene)
-        if self._camera is None:
-            self._camera = default_camera(scene.bounds_half_size)
-        if self._controls is None:
-            self._controls = CameraControls(self._screen.pg, self._camera)
+        if self.camera is None:
+            # Looking at the middle of the target box from the south-west, the box in view.
+            h = scene.bounds_half_size
+            self.camera = OrbitCamera(look_at=np.array([0.0, 0.0, 0.8 * h]), distance=4.2 * h)
         if events is None:
             return None  # the user closed the window
-        self._controls.handle(events)
+        self._controls.handle(self.camera, events)
         self._trail.update(scene.step, scene.position)
-        self._draw(scene)
-        return self._screen.present()
-
-    def _draw(self, scene: QuadScene) -> None:
         p = self._painter
         p.vertical_gradient(BACKGROUND_TOP, BACKGROUND_BOTTOM)
-        projector = Projector(self._camera, self.size)
         trail = self._trail.points
-        world(p, projector, scene, trail if len(trail) else np.zeros((0, 3)), self.drone_scale)
+        world(p, Projector(self.camera, self.size), scene, trail, self.drone_scale)
         if self.hud:
             info_panel(p, scene)
             motor_bars(p, scene)
-            axis_gizmo(p, self._camera)
-            wind_dial(p, scene, self._camera)
+            axis_gizmo(p, self.camera)
+            wind_dial(p, scene, self.camera)
             legend(p)
-            if self.render_mode == "human":
-                controls_hint(p)
+            if self.render_mode == "human":  # bottom centre: how to move the camera
+                width, height = self.size
+                p.text(HINT, (width / 2, height - 8), (90, 90, 100), 17, "midbottom")
+        return self._present()
