@@ -114,11 +114,16 @@ class OrbitCamera:
         self.azimuth_deg = (self.azimuth_deg + d_azimuth_deg) % 360.0
         self.elevation_deg = _clamp_elevation(self.elevation_deg + d_elevation_deg)
 
+    def ground_axes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Unit vectors (forward, right) along the ground as the camera sees it."""
+        az = math.radians(self.azimuth_deg)
+        return np.array([math.sin(az), math.cos(az), 0.0]), np.array(
+            [math.cos(az), -math.sin(az), 0.0]
+        )
+
     def move(self, forward: float, right: float, up: float) -> None:
         """Shift the look-at point: forward/right along the ground as seen, up along +z."""
-        az = math.radians(self.azimuth_deg)
-        ground_forward = np.array([math.sin(az), math.cos(az), 0.0])
-        ground_right = np.array([math.cos(az), -math.sin(az), 0.0])
+        ground_forward, ground_right = self.ground_axes()
         self.look_at = (
             self.look_at + forward * ground_forward + right * ground_right + np.array([0, 0, up])
         )

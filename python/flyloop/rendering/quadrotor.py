@@ -30,21 +30,16 @@ ROTOR_SPIN = (-1, -1, 1, 1)
 ROTOR_NAMES = ("FR", "RL", "FL", "RR")
 GROUND, GRID, GRID_MAJOR, AXIS_X = (226, 230, 222), (188, 192, 186), (160, 165, 158), (220, 40, 40)
 AXIS_Y, AXIS_Z, BOUNDS, BODY = (30, 160, 60), (40, 90, 230), (150, 160, 200), (0, 100, 200)
-BODY_HIGHLIGHT = (110, 175, 245)
-ROTOR_CCW = (70, 200, 90)  # counter-clockwise (seen from above)
-ROTOR_CW = (235, 90, 80)  # clockwise
+BODY_HIGHLIGHT, ROTOR_CCW, ROTOR_CW = (110, 175, 245), (70, 200, 90), (235, 90, 80)
 ARM, NOSE, TARGET, TARGET_LINE = (90, 90, 95), (35, 35, 40), (0, 170, 60), (140, 140, 140)
 WAYPOINT, UP, VELOCITY, WIND = (150, 60, 200), (255, 150, 0), (230, 0, 220), (200, 0, 0)
 DROP, SHADOW, TRAIL = (128, 128, 128), (40, 40, 40), (60, 140, 220)
-
-TARGET_RADIUS_M = 0.08
-WAYPOINT_RADIUS_M = 0.06
-UP_ARROW_M = 0.5  # length of the up vector
-VELOCITY_SECONDS = 0.5  # the velocity arrow shows where the drone is in this many seconds
-WIND_M_PER_MPS = 0.12  # wind arrow length per m/s of wind
-MAX_ARROW_M = 2.0
 TEXT, PANEL, BAD, BACKGROUND_TOP = (20, 20, 30), (255, 255, 236), (200, 0, 0), (232, 238, 248)
 BACKGROUND_BOTTOM = (246, 246, 250)
+AXES = ((AXIS_X, "x E"), (AXIS_Y, "y N"), (AXIS_Z, "z"))
+TARGET_RADIUS_M, WAYPOINT_RADIUS_M, UP_ARROW_M, MAX_ARROW_M = 0.08, 0.06, 0.5, 2.0
+VELOCITY_SECONDS = 0.5  # the velocity arrow shows where the drone is in this many seconds
+WIND_M_PER_MPS = 0.12  # wind arrow length per m/s of wind
 # What a scene shows when not told: the hover task with the core's defaults.
 _HOVER = _native.describe("hover")
 _CORE = parameter_values(_HOVER)
@@ -53,13 +48,10 @@ _CORE = parameter_values(_HOVER)
 def rotation_matrix(q_wxyz: np.ndarray) -> np.ndarray:
     """The 3x3 matrix of a unit quaternion [w, x, y, z]: world = R @ body."""
     w, x, y, z = q_wxyz
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-    )
+    row_x = [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)]
+    row_y = [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)]
+    row_z = [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]
+    return np.array([row_x, row_y, row_z])
 
 
 def euler_rpy(q_wxyz: np.ndarray) -> tuple[float, float, float]:
@@ -76,21 +68,15 @@ def quaternion_from_euler(roll: float, pitch: float, yaw: float) -> np.ndarray:
     cr, sr = math.cos(roll / 2), math.sin(roll / 2)
     cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
     cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return np.array(
-        [
-            cr * cp * cy + sr * sp * sy,
-            sr * cp * cy - cr * sp * sy,
-            cr * sp * cy + sr * cp * sy,
-            cr * cp * sy - sr * sp * cy,
-        ]
-    )
+    w, x = cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy
+    y, z = cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy
+    return np.array([w, x, y, z])
 
 
 def rotor_positions_body(arm_length: float) -> np.ndarray:
     """(4, 3) rotor centres in the body frame, metres, in PX4 motor order."""
-    lever = arm_length / math.sqrt(2.0)
     out = np.zeros((4, 3))
-    out[:, :2] = ROTOR_POSITION_SIGNS * lever
+    out[:, :2] = ROTOR_POSITION_SIGNS * (arm_length / math.sqrt(2.0))
     return out
 
 
@@ -151,8 +137,9 @@ def quad_scene(
     def part(name: str, otherwise: Any) -> Any:
         return obs[at[name]] if name in at else otherwise
 
-    status = "crashed" if info.get("crashed") else ""
-    status = status or ("out of bounds" if info.get("out_of_bounds") else "")
+    status = (
+        "crashed" if info.get("crashed") else "out of bounds" if info.get("out_of_bounds") else ""
+    )
     return QuadScene(
         time_s=info["episode_time"],
         step=info["step_count"],
@@ -200,13 +187,9 @@ def _circle_points(center: np.ndarray, radius: float, axes: np.ndarray, n: int =
     return center + radius * (np.outer(np.cos(t), axes[0]) + np.outer(np.sin(t), axes[1]))
 
 
-def grid_extent(scene: QuadScene) -> float:
-    """Half side of the drawn ground grid, m: the target box and a margin, on 0.5 m lines."""
-    return math.ceil((scene.bounds_half_size * 2.0 + 1.0) * 2.0) / 2.0
-
-
 def ground(p: Painter, pr: Projector, scene: QuadScene) -> None:
-    g = grid_extent(scene)
+    # Half side g: the target box and a margin, on 0.5 m lines.
+    g = math.ceil((scene.bounds_half_size * 2.0 + 1.0) * 2.0) / 2.0
     square = np.array([[-g, -g, 0.0], [g, -g, 0.0], [g, g, 0.0], [-g, g, 0.0]])
     poly = pr.polygon(square)
     if len(poly):
@@ -225,14 +208,9 @@ def ground(p: Painter, pr: Projector, scene: QuadScene) -> None:
 
 def axes(p: Painter, pr: Projector, scene: QuadScene) -> None:
     """World axes from the origin, 1 m long, labelled."""
-    origin = np.zeros(3)
-    for axis, color, label in (
-        ((1.0, 0, 0), AXIS_X, "x E"),
-        ((0, 1.0, 0), AXIS_Y, "y N"),
-        ((0, 0, 1.0), AXIS_Z, "z"),
-    ):
-        _arrow(p, pr, origin, np.array(axis), color, 2)
-        tip = pr.point(np.array(axis) * 1.15)
+    for axis, (color, label) in zip(np.eye(3), AXES, strict=True):
+        _arrow(p, pr, np.zeros(3), axis, color, 2)
+        tip = pr.point(axis * 1.15)
         if tip is not None:
             p.text(label, tip[0], color, 18, "center", bold=True)
 
@@ -257,13 +235,6 @@ def shadow(p: Painter, pr: Projector, position: np.ndarray, radius: float) -> No
         p.translucent_polygon(ring, SHADOW, 60)
 
 
-def trail(p: Painter, pr: Projector, points: np.ndarray) -> None:
-    if len(points) < 2:
-        return
-    for a, b in pr.segments(points[:-1], points[1:]):
-        p.line(a, b, TRAIL, 2)
-
-
 def target(p: Painter, pr: Projector, scene: QuadScene) -> None:
     """The target sphere with a 3-axis crosshair, its line from the drone."""
     if scene.target is None:
@@ -271,7 +242,11 @@ def target(p: Painter, pr: Projector, scene: QuadScene) -> None:
     _line(p, pr, scene.position, scene.target, TARGET_LINE, 1)
     for axis in np.eye(3) * 0.2:
         _line(p, pr, scene.target - axis, scene.target + axis, TARGET, 2)
-    _sphere(p, pr, scene.target, TARGET_RADIUS_M, TARGET)
+    hit = pr.point(scene.target)
+    if hit is not None:
+        r = max(3.0, pr.radius(TARGET_RADIUS_M, hit[1]))
+        p.disc(hit[0], r, TARGET)
+        p.disc(hit[0] - r * 0.3, max(1.0, r * 0.3), tuple(min(255, c + 70) for c in TARGET))
 
 
 def next_waypoint(p: Painter, pr: Projector, scene: QuadScene) -> None:
@@ -284,16 +259,6 @@ def next_waypoint(p: Painter, pr: Projector, scene: QuadScene) -> None:
         r = max(4.0, pr.radius(WAYPOINT_RADIUS_M, hit[1]))
         p.ring(hit[0], r, WAYPOINT, 3)
         p.text("next", hit[0] + np.array([r + 4, -r - 4]), WAYPOINT, 17, "bottomleft")
-
-
-def _sphere(p: Painter, pr: Projector, center: np.ndarray, radius_m: float, color) -> None:
-    hit = pr.point(center)
-    if hit is None:
-        return
-    r = max(3.0, pr.radius(radius_m, hit[1]))
-    p.disc(hit[0], r, color)
-    light = tuple(min(255, c + 70) for c in color)
-    p.disc(hit[0] - r * 0.3, max(1.0, r * 0.3), light)
 
 
 def drone(p: Painter, pr: Projector, scene: QuadScene, scale: float) -> None:
@@ -347,32 +312,31 @@ def world(
         if point is not None:
             shadow(p, pr, point, radius)
     shadow(p, pr, scene.position, 0.7 * scene.arm_length * drone_scale)
-    trail(p, pr, trail_points)
-    solids = [(lambda: target(p, pr, scene), scene.target)]
-    solids.append((lambda: next_waypoint(p, pr, scene), scene.next_waypoint))
-    solids.append((lambda: drone(p, pr, scene, drone_scale), scene.position))
-    depth = [-float(pr.camera.to_camera(at)[2]) if at is not None else math.inf for _, at in solids]
-    for i in np.argsort(depth, kind="stable"):
-        solids[i][0]()
+    if len(trail_points) >= 2:
+        for a, b in pr.segments(trail_points[:-1], trail_points[1:]):
+            p.line(a, b, TRAIL, 2)
+    solids = [
+        (scene.target, lambda: target(p, pr, scene)),
+        (scene.next_waypoint, lambda: next_waypoint(p, pr, scene)),
+        (scene.position, lambda: drone(p, pr, scene, drone_scale)),
+    ]
+    depth = [math.inf if at is None else -float(pr.camera.to_camera(at)[2]) for at, _ in solids]
+    for i in np.argsort(depth, kind="stable"):  # far first
+        solids[i][1]()
 
 
 def info_lines(scene: QuadScene) -> list[tuple[str, tuple[int, int, int]]]:
     """The info panel's text: time, step, distance, height, speed, wind, attitude, reward."""
     roll, pitch, yaw = (math.degrees(a) for a in euler_rpy(scene.quaternion))
     distance = (
-        f"{np.linalg.norm(scene.target - scene.position):.2f} m"
-        if scene.target is not None
-        else "-"
+        "-" if scene.target is None else f"{np.linalg.norm(scene.target - scene.position):.2f} m"
     )
     reward = "-" if scene.reward is None else f"{scene.reward:+.3f}"
+    speed, wind = np.linalg.norm(scene.velocity), np.linalg.norm(scene.wind)
     lines = [
         (f"Time {scene.time_s:.2f} s    Step {scene.step}", TEXT),
         (f"Distance {distance}    Height {scene.position[2]:.2f} m", TEXT),
-        (
-            f"Speed {np.linalg.norm(scene.velocity):.2f} m/s    "
-            f"Wind {np.linalg.norm(scene.wind):.2f} m/s",
-            TEXT,
-        ),
+        (f"Speed {speed:.2f} m/s    Wind {wind:.2f} m/s", TEXT),
         (f"Roll {roll:+.1f}°  Pitch {pitch:+.1f}°  Yaw {yaw:+.1f}°", TEXT),
     ]
     if scene.episode_return is not None:
@@ -424,10 +388,9 @@ def axis_gizmo(p: Painter, camera: OrbitCamera) -> None:
     right, up, forward = camera.basis()
     p.disc(origin, 50, (250, 250, 250), (180, 180, 180), 1)
     items = []
-    for axis, color, label in ((0, AXIS_X, "X"), (1, AXIS_Y, "Y"), (2, AXIS_Z, "Z")):
-        unit = np.eye(3)[axis]
+    for unit, (color, label) in zip(np.eye(3), AXES, strict=True):
         tip = origin + np.array([unit @ right, -(unit @ up)]) * 36
-        items.append((float(unit @ forward), tip, color, label))
+        items.append((float(unit @ forward), tip, color, label[0].upper()))
     for _, tip, color, label in sorted(items, key=lambda item: -item[0]):
         p.arrow(origin, tip, color, 3, head_px=8)
         direction = tip - origin
@@ -444,9 +407,7 @@ def wind_dial(p: Painter, scene: QuadScene, camera: OrbitCamera) -> None:
     center = np.array([width - 70.0, 72.0])
     radius = 44.0
     p.disc(center, radius, (255, 255, 255), (0, 0, 0), 2)
-    az = math.radians(camera.azimuth_deg)
-    ground_right = np.array([math.cos(az), -math.sin(az), 0.0])
-    ground_forward = np.array([math.sin(az), math.cos(az), 0.0])
+    ground_forward, ground_right = camera.ground_axes()
     dial = np.array([scene.wind @ ground_right, -(scene.wind @ ground_forward)])
     speed = float(np.linalg.norm(scene.wind))
     horizontal = float(np.hypot(*dial))
