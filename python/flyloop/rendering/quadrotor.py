@@ -187,44 +187,6 @@ def _circle_points(center: np.ndarray, radius: float, axes: np.ndarray, n: int =
     return center + radius * (np.outer(np.cos(t), axes[0]) + np.outer(np.sin(t), axes[1]))
 
 
-def ground(p: Painter, pr: Projector, scene: QuadScene) -> None:
-    # Half side g: the target box and a margin, on 0.5 m lines.
-    g = math.ceil((scene.bounds_half_size * 2.0 + 1.0) * 2.0) / 2.0
-    square = np.array([[-g, -g, 0.0], [g, -g, 0.0], [g, g, 0.0], [-g, g, 0.0]])
-    poly = pr.polygon(square)
-    if len(poly):
-        p.polygon(poly, GROUND)
-    ticks = np.arange(-g, g + 1e-9, 0.5)
-    n = len(ticks)
-    zeros, lo, hi = np.zeros(n), np.full(n, -g), np.full(n, g)
-    starts = np.concatenate([np.stack([ticks, lo, zeros], 1), np.stack([lo, ticks, zeros], 1)])
-    ends = np.concatenate([np.stack([ticks, hi, zeros], 1), np.stack([hi, ticks, zeros], 1)])
-    major = np.concatenate([np.arange(n) % 2 == 0] * 2)
-    for is_major in (False, True):  # minor lines first, the metre lines over them
-        pick = major == is_major
-        for a, b in pr.segments(starts[pick], ends[pick]):
-            p.line(a, b, GRID_MAJOR if is_major else GRID, 1)
-
-
-def axes(p: Painter, pr: Projector, scene: QuadScene) -> None:
-    """World axes from the origin, 1 m long, labelled."""
-    for axis, (color, label) in zip(np.eye(3), AXES, strict=True):
-        _arrow(p, pr, np.zeros(3), axis, color, 2)
-        tip = pr.point(axis * 1.15)
-        if tip is not None:
-            p.text(label, tip[0], color, 18, "center", bold=True)
-
-
-def bounds(p: Painter, pr: Projector, scene: QuadScene) -> None:
-    """Wireframe of the target box: x, y in [-h, h], z in [0, 2h]."""
-    h = scene.bounds_half_size
-    corners = [np.array([x, y, z]) for z in (0.0, 2 * h) for x in (-h, h) for y in (-h, h)]
-    for i, a in enumerate(corners):
-        for b in corners[i + 1 :]:
-            if np.count_nonzero(np.abs(a - b) > 1e-9) == 1:  # an edge, not a diagonal
-                _dashed(p, pr, a, b, BOUNDS, 1)
-
-
 def shadow(p: Painter, pr: Projector, position: np.ndarray, radius: float) -> None:
     """A soft dark disc on the ground under a point, and a dashed drop line to it."""
     foot = np.array([position[0], position[1], 0.0])
@@ -301,24 +263,46 @@ def drone(p: Painter, pr: Projector, scene: QuadScene, scale: float) -> None:
         p.disc(hub[0] - r * 0.28, max(1.0, r * 0.32), BODY_HIGHLIGHT)
 
 
-def world(
-    p: Painter, pr: Projector, scene: QuadScene, trail_points: np.ndarray, drone_scale: float
-) -> None:
+def world(p: Painter, pr: Projector, scene: QuadScene, trail: np.ndarray, scale: float) -> None:
     """The whole 3D scene, back to front."""
-    ground(p, pr, scene)
-    axes(p, pr, scene)
-    bounds(p, pr, scene)
+    # The ground and its grid on 0.5 m lines, wide enough for the target box and a margin.
+    g = math.ceil((scene.bounds_half_size * 2.0 + 1.0) * 2.0) / 2.0
+    poly = pr.polygon(np.array([[-g, -g, 0.0], [g, -g, 0.0], [g, g, 0.0], [-g, g, 0.0]]))
+    if len(poly):
+        p.polygon(poly, GROUND)
+    ticks = np.arange(-g, g + 1e-9, 0.5)
+    n = len(ticks)
+    zeros, lo, hi = np.zeros(n), np.full(n, -g), np.full(n, g)
+    starts = np.concatenate([np.stack([ticks, lo, zeros], 1), np.stack([lo, ticks, zeros], 1)])
+    ends = np.concatenate([np.stack([ticks, hi, zeros], 1), np.stack([hi, ticks, zeros], 1)])
+    major = np.concatenate([np.arange(n) % 2 == 0] * 2)
+    for is_major in (False, True):  # minor lines first, the metre lines over them
+        pick = major == is_major
+        for a, b in pr.segments(starts[pick], ends[pick]):
+            p.line(a, b, GRID_MAJOR if is_major else GRID, 1)
+    for axis, (color, label) in zip(np.eye(3), AXES, strict=True):
+        _arrow(p, pr, np.zeros(3), axis, color, 2)
+        tip = pr.point(axis * 1.15)
+        if tip is not None:
+            p.text(label, tip[0], color, 18, "center", bold=True)
+    # The target box's wireframe: x, y in [-h, h], z in [0, 2h].
+    h = scene.bounds_half_size
+    corners = [np.array([x, y, z]) for z in (0.0, 2 * h) for x in (-h, h) for y in (-h, h)]
+    for i, a in enumerate(corners):
+        for b in corners[i + 1 :]:
+            if np.count_nonzero(np.abs(a - b) > 1e-9) == 1:  # an edge, not a diagonal
+                _dashed(p, pr, a, b, BOUNDS, 1)
     for point, radius in ((scene.target, 0.1), (scene.next_waypoint, 0.07)):
         if point is not None:
             shadow(p, pr, point, radius)
-    shadow(p, pr, scene.position, 0.7 * scene.arm_length * drone_scale)
-    if len(trail_points) >= 2:
-        for a, b in pr.segments(trail_points[:-1], trail_points[1:]):
+    shadow(p, pr, scene.position, 0.7 * scene.arm_length * scale)
+    if len(trail) >= 2:
+        for a, b in pr.segments(trail[:-1], trail[1:]):
             p.line(a, b, TRAIL, 2)
     solids = [
         (scene.target, lambda: target(p, pr, scene)),
         (scene.next_waypoint, lambda: next_waypoint(p, pr, scene)),
-        (scene.position, lambda: drone(p, pr, scene, drone_scale)),
+        (scene.position, lambda: drone(p, pr, scene, scale)),
     ]
     depth = [math.inf if at is None else -float(pr.camera.to_camera(at)[2]) for at, _ in solids]
     for i in np.argsort(depth, kind="stable"):  # far first
