@@ -64,13 +64,10 @@ class OrbitCamera:
         frame projects thousands of points through the same pose."""
         key = (self.azimuth_deg, self.elevation_deg, self.distance, *self.look_at.tolist())
         if self._cache_key != key:
-            az = math.radians(self.azimuth_deg)
-            el = math.radians(self.elevation_deg)
+            az, el = math.radians(self.azimuth_deg), math.radians(self.elevation_deg)
             sa, ca, se, ce = math.sin(az), math.cos(az), math.sin(el), math.cos(el)
-            forward = (sa * ce, ca * ce, -se)
-            right = (ca, -sa, 0.0)
-            up = (sa * se, ca * se, ce)  # right x forward
-            rows = np.array([right, up, forward])
+            # Rows right, up (= right x forward), forward.
+            rows = np.array([(ca, -sa, 0.0), (sa * se, ca * se, ce), (sa * ce, ca * ce, -se)])
             self._cache = (rows, self.look_at - rows[2] * self.distance)
             self._cache_key = key
         return self._cache
@@ -117,16 +114,13 @@ class OrbitCamera:
     def ground_axes(self) -> tuple[np.ndarray, np.ndarray]:
         """Unit vectors (forward, right) along the ground as the camera sees it."""
         az = math.radians(self.azimuth_deg)
-        return np.array([math.sin(az), math.cos(az), 0.0]), np.array(
-            [math.cos(az), -math.sin(az), 0.0]
-        )
+        forward = np.array([math.sin(az), math.cos(az), 0.0])
+        return forward, np.array([forward[1], -forward[0], 0.0])
 
     def move(self, forward: float, right: float, up: float) -> None:
         """Shift the look-at point: forward/right along the ground as seen, up along +z."""
-        ground_forward, ground_right = self.ground_axes()
-        self.look_at = (
-            self.look_at + forward * ground_forward + right * ground_right + np.array([0, 0, up])
-        )
+        ahead, aside = self.ground_axes()
+        self.look_at = self.look_at + forward * ahead + right * aside + np.array([0, 0, up])
 
     def reset(self) -> None:
         """Back to the pose the camera was created with."""

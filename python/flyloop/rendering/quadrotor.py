@@ -104,9 +104,7 @@ class QuadScene:
     extras: tuple[tuple[str, str], ...] = ()  # more (label, text) lines for the info panel
 
     def __post_init__(self) -> None:
-        for name in ("position", "velocity", "body_rates", "wind"):
-            setattr(self, name, vector(getattr(self, name)))
-        for name in ("target", "next_waypoint"):
+        for name in ("position", "velocity", "body_rates", "wind", "target", "next_waypoint"):
             if getattr(self, name) is not None:
                 setattr(self, name, vector(getattr(self, name)))
         q = vector(self.quaternion)
@@ -247,14 +245,13 @@ def drone(p: Painter, pr: Projector, scene: QuadScene, scale: float) -> None:
         if len(level) and scene.motors[i] > 0.02:
             p.translucent_polygon(level, rotor_color(int(i)), 170)
     _arrow(p, pr, pos, rot[:, 2] * UP_ARROW_M, UP, 3)
-    speed = float(np.linalg.norm(scene.velocity))
-    if speed > 0.05:
-        length = min(speed * VELOCITY_SECONDS, MAX_ARROW_M)
-        _arrow(p, pr, pos, scene.velocity / speed * length, VELOCITY, 3)
-    wind = float(np.linalg.norm(scene.wind))
-    if wind > 0.05:
-        length = min(wind * WIND_M_PER_MPS, MAX_ARROW_M)
-        _arrow(p, pr, pos, scene.wind / wind * length, WIND, 2)
+    for vec, m_per_unit, color, width in (
+        (scene.velocity, VELOCITY_SECONDS, VELOCITY, 3),
+        (scene.wind, WIND_M_PER_MPS, WIND, 2),
+    ):
+        size = float(np.linalg.norm(vec))
+        if size > 0.05:
+            _arrow(p, pr, pos, vec / size * min(size * m_per_unit, MAX_ARROW_M), color, width)
     _line(p, pr, pos, pos + rot[:, 0] * arm * 0.8, NOSE, 4)
     hub = pr.point(pos)
     if hub is not None:
@@ -324,9 +321,8 @@ def info_lines(scene: QuadScene) -> list[tuple[str, tuple[int, int, int]]]:
         (f"Roll {roll:+.1f}°  Pitch {pitch:+.1f}°  Yaw {yaw:+.1f}°", TEXT),
     ]
     if scene.episode_return is not None:
-        lines.append((f"Reward {reward}    Return {scene.episode_return:.2f}", TEXT))
-    else:
-        lines.append((f"Reward {reward}", TEXT))
+        reward += f"    Return {scene.episode_return:.2f}"
+    lines.append((f"Reward {reward}", TEXT))
     if scene.waypoints_reached is not None:
         lines.append((f"Waypoints reached {scene.waypoints_reached}", TEXT))
     if scene.status:
