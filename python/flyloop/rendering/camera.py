@@ -1,27 +1,20 @@
-"""The quadrotor view's 3D camera, pure numpy: a perspective orbit camera, its window
-controls, and a Projector (the camera bound to a frame size, near-plane clipped).
+"""The quadrotor view's 3D camera, pure numpy: a perspective orbit camera and a Projector
+(the camera bound to a frame size, near-plane clipped).
 
 ``azimuth_deg`` is the compass direction the camera looks toward (0 = north/+y, 90 = east/+x);
 ``elevation_deg`` is how far it looks down from the horizon. Camera space: x right, y up,
 z (depth) forward. Screen: pixels, origin top-left, v downward; ``fov_deg`` is the vertical
-field of view. Controls: mouse drag orbits, wheel zooms, W/A/S/D move along the ground, Q/E
-down/up, R resets; held keys are tracked from KEYDOWN/KEYUP events (not
-pygame.key.get_pressed) so the same events drive it in a test as from a person.
+field of view.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
 MAX_ELEVATION_DEG = 89.0
-DEGREES_PER_PIXEL = 0.3
-MOVE_FRACTION = 0.012  # per frame, of the camera distance
-ZOOM_STEP = 0.9
-MIN_DISTANCE, MAX_DISTANCE = 0.5, 200.0
 
 
 @dataclass(eq=False)
@@ -147,51 +140,6 @@ def clip_polygon_near(cam_points: np.ndarray, near: float) -> np.ndarray:
         elif da >= 0:
             out.append(a + (b - a) * (da / (da - db)))
     return np.array(out) if out else np.zeros((0, 3))
-
-
-class CameraControls:
-    """Window events -> camera moves (see the module docstring)."""
-
-    def __init__(self, pg: Any) -> None:
-        self.pg = pg
-        self._dragging = False
-        self._held: set[int] = set()
-        keys = (pg.K_w, pg.K_s, pg.K_d, pg.K_a, pg.K_e, pg.K_q)
-        moves = ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))
-        self._moves = dict(zip(keys, moves, strict=True))
-
-    def handle(self, camera: OrbitCamera, events: list[Any]) -> None:
-        """Apply this frame's events, then one frame of movement for each key held or pressed
-        in this frame (a tap shorter than a frame still moves once)."""
-        pg = self.pg
-        tapped: set[int] = set()
-        for event in events:
-            if event.type == pg.MOUSEBUTTONDOWN and event.button == 1:
-                self._dragging = True
-            elif event.type == pg.MOUSEBUTTONUP and event.button == 1:
-                self._dragging = False
-            elif event.type == pg.MOUSEMOTION and self._dragging:
-                dx, dy = event.rel
-                # Dragging right turns the world right; dragging down looks from higher up.
-                camera.orbit(-dx * DEGREES_PER_PIXEL, dy * DEGREES_PER_PIXEL)
-            elif event.type == pg.MOUSEWHEEL:
-                distance = camera.distance * ZOOM_STEP ** float(event.y)
-                camera.distance = min(max(distance, MIN_DISTANCE), MAX_DISTANCE)
-            elif event.type == pg.KEYDOWN:
-                if event.key == pg.K_r:
-                    camera.reset()
-                elif event.key in self._moves:
-                    self._held.add(event.key)
-                    tapped.add(event.key)
-            elif event.type == pg.KEYUP:
-                self._held.discard(event.key)
-            elif event.type == pg.WINDOWFOCUSLOST:
-                self._held.clear()
-                self._dragging = False
-        step = MOVE_FRACTION * camera.distance
-        for key in self._held | tapped:
-            forward, right, up = self._moves[key]
-            camera.move(forward * step, right * step, up * step)
 
 
 class Projector:

@@ -1,12 +1,13 @@
 """The quadrotor view (tasks Hover and Waypoints): its scene, the 3D world drawn through an
 orbit camera, the overlays (info panel, motor bars, axis gizmo, wind dial, legend) and
-QuadrotorView.
+QuadrotorView with its window controls.
 
 Frames as the core: world ENU (x east, y north, z up), body FLU (x forward, y left, z up),
 quaternion [w, x, y, z] rotating body to world; motors in PX4's quad-X order (0 front-right,
 1 rear-left, 2 front-left, 3 rear-right). The world is drawn with a painter's algorithm: the
 ground and lines first, then solid things far to near, the drone's hub last (its pixels are
-what tests track).
+what tests track). The window's held keys are tracked from KEYDOWN/KEYUP events (not
+pygame.key.get_pressed) so the same events drive the camera in a test as from a person.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import numpy as np
 
 from .. import _native
 from ..tasks import observation_slices, parameter_values
-from .camera import CameraControls, OrbitCamera, Projector
+from .camera import OrbitCamera, Projector
 from .canvas import FlightPath, Painter, View, vector
 
 # Rotor i sits at (forward, left) * L/sqrt(2) in the body frame: PX4 quad-X order.
@@ -40,6 +41,8 @@ AXES = ((AXIS_X, "x E"), (AXIS_Y, "y N"), (AXIS_Z, "z"))
 TARGET_RADIUS_M, WAYPOINT_RADIUS_M, UP_ARROW_M, MAX_ARROW_M = 0.08, 0.06, 0.5, 2.0
 VELOCITY_SECONDS = 0.5  # the velocity arrow shows where the drone is in this many seconds
 WIND_M_PER_MPS = 0.12  # wind arrow length per m/s of wind
+DEGREES_PER_PIXEL, ZOOM_STEP, MIN_DISTANCE, MAX_DISTANCE = 0.3, 0.9, 0.5, 200.0
+MOVE_FRACTION = 0.012  # per frame, of the camera distance
 # What a scene shows when not told: the hover task with the core's defaults.
 _HOVER = _native.describe("hover")
 _CORE = parameter_values(_HOVER)
@@ -463,7 +466,12 @@ class QuadrotorView(View):
         self.drone_scale, self.hud, self.camera = float(drone_scale), hud, camera
         self._trail = FlightPath(max(2, trail_steps))
         super().__init__(render_mode, (width, height), "flyloop - Quadrotor 3D", fps)
-        self._controls = CameraControls(self._pg)
+        pg = self._pg
+        keys = (pg.K_w, pg.K_s, pg.K_d, pg.K_a, pg.K_e, pg.K_q)
+        moves = ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))
+        self._moves = dict(zip(keys, moves, strict=True))
+        self._held: set[int] = set()
+        self._dragging = False
 
     def world_to_screen(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Pixels (..., 2) of world points (..., 3) and whether each is in front of the camera."""
@@ -475,6 +483,39 @@ class QuadrotorView(View):
         """Forget the trail (an env calls this from reset())."""
         self._trail.clear()
 
+    def _steer(self, camera: OrbitCamera, events: list[Any]) -> None:
+        """Apply this frame's events, then one frame of movement for each key held or pressed
+        in this frame (a tap shorter than a frame still moves once)."""
+        pg = self._pg
+        tapped: set[int] = set()
+        for event in events:
+            if event.type == pg.MOUSEBUTTONDOWN and event.button == 1:
+                self._dragging = True
+            elif event.type == pg.MOUSEBUTTONUP and event.button == 1:
+                self._dragging = False
+            elif event.type == pg.MOUSEMOTION and self._dragging:
+                dx, dy = event.rel
+                # Dragging right turns the world right; dragging down looks from higher up.
+                camera.orbit(-dx * DEGREES_PER_PIXEL, dy * DEGREES_PER_PIXEL)
+            elif event.type == pg.MOUSEWHEEL:
+                distance = camera.distance * ZOOM_STEP ** float(event.y)
+                camera.distance = min(max(distance, MIN_DISTANCE), MAX_DISTANCE)
+            elif event.type == pg.KEYDOWN:
+                if event.key == pg.K_r:
+                    camera.reset()
+                elif event.key in self._moves:
+                    self._held.add(event.key)
+                    tapped.add(event.key)
+            elif event.type == pg.KEYUP:
+                self._held.discard(event.key)
+            elif event.type == pg.WINDOWFOCUSLOST:
+                self._held.clear()
+                self._dragging = False
+        step = MOVE_FRACTION * camera.distance
+        for key in self._held | tapped:
+            forward, right, up = self._moves[key]
+            camera.move(forward * step, right * step, up * step)
+
     def render(self, scene: QuadScene) -> np.ndarray | None:
         """Draw one frame: returns it in rgb_array mode, None in human mode."""
         events = self._events(scene)
@@ -484,7 +525,7 @@ class QuadrotorView(View):
             self.camera = OrbitCamera(look_at=np.array([0.0, 0.0, 0.8 * h]), distance=4.2 * h)
         if events is None:
             return None  # the user closed the window
-        self._controls.handle(self.camera, events)
+        self._steer(self.camera, events)
         self._trail.update(scene.step, scene.position)
         p = self._painter
         p.vertical_gradient(BACKGROUND_TOP, BACKGROUND_BOTTOM)
