@@ -104,9 +104,14 @@ class Painter:
         if length < 1e-6:
             return
         n = max(1, int(length / (2 * dash_px)))
+        # Rounded in one go: a long dashed line has hundreds of dashes.
         ends = a_ + np.outer(np.arange(2 * n) / (2 * n), b_ - a_)
+        ends = np.clip(ends, -_LIMIT, _LIMIT).round().astype(int).tolist()
         for i in range(0, 2 * n, 2):
-            self.line(ends[i], ends[i + 1], color, width)
+            if width <= 1:
+                self.pg.draw.aaline(self.surface, color, ends[i], ends[i + 1])
+            else:
+                self.pg.draw.line(self.surface, color, ends[i], ends[i + 1], width)
 
     def arrow(self, start: Point, end: Point, color: Color, width: int, head_px=11.0) -> None:
         """A line from start to end with a filled triangular head at end."""

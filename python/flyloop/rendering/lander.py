@@ -1,6 +1,6 @@
 """The Lander2D view (task Landing): its scene, the plane (metres to pixels), the picture
-(one function per element, drawn in that order) and LanderView. World metres, x right, y up,
-angles counter-clockwise.
+(the world back to front, a close-up, the wind dial and the text panel) and LanderView.
+World metres, x right, y up, angles counter-clockwise.
 """
 
 from __future__ import annotations
