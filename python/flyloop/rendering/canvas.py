@@ -252,7 +252,7 @@ class View:
         self._pg = pg = import_pygame(render_mode)
         pg.font.init()
         if render_mode == "human":
-            if _window_owner is not None and _window_owner.is_open:
+            if _window_owner is not None:
                 raise RuntimeError(
                     "another human-mode view already owns the pygame window of this process; "
                     "close it first (pygame shows one window per process)"
@@ -309,8 +309,7 @@ class View:
         global _window_owner
         if self.is_open and self.render_mode == "human":
             self._pg.display.quit()
-            if _window_owner is self:
-                _window_owner = None
+            _window_owner = None  # an open human view is the owner: no second one can open
         self.is_open = False
 
     def close(self) -> None:
