@@ -103,11 +103,22 @@ class Painter:
         length = float(np.hypot(*(b_ - a_)))
         if length < 1e-6:
             return
-        n = max(1, int(length / (2 * dash_px)))
+        n = max(1, int(length / (2 * dash_px)))  # dash j covers t in [j / n, (j + 0.5) / n]
+        # Only the dashes near the frame: a far-off state's line would ask for billions.
+        t0, t1 = 0.0, 1.0
+        for axis, side in enumerate(self.surface.get_size()):
+            lo, hi, d = -16 - a_[axis], side + 16 - a_[axis], b_[axis] - a_[axis]
+            if d == 0 and not lo <= 0 <= hi:
+                return
+            if d != 0:
+                t0, t1 = max(t0, min(lo / d, hi / d)), min(t1, max(lo / d, hi / d))
+        if t0 > t1:
+            return
+        first, last = max(0, int(t0 * n) - 1), min(n, int(t1 * n) + 2)
         # Rounded in one go: a long dashed line has hundreds of dashes.
-        ends = a_ + np.outer(np.arange(2 * n) / (2 * n), b_ - a_)
+        ends = a_ + np.outer(np.arange(2 * first, 2 * last) / (2 * n), b_ - a_)
         ends = np.clip(ends, -_LIMIT, _LIMIT).round().astype(int).tolist()
-        for i in range(0, 2 * n, 2):
+        for i in range(0, len(ends), 2):
             if width <= 1:
                 self.pg.draw.aaline(self.surface, color, ends[i], ends[i + 1])
             else:
@@ -145,8 +156,13 @@ class Painter:
     def translucent_polygon(self, points: Sequence[Point], color: Color, alpha: int) -> None:
         """A polygon blended over what is drawn (shades of past poses)."""
         pts = np.array([_px(p) for p in points])
-        lo = pts.min(axis=0)
-        size = pts.max(axis=0) - lo + 1
+        # The layer spans only the polygon's part of the frame (and a margin, where pygame's
+        # clipping leaves its marks): a vertex far off screen (a shadow seen from a turned
+        # camera) would otherwise ask for gigabytes.
+        lo = np.maximum(pts.min(axis=0), -8)
+        size = np.minimum(pts.max(axis=0), np.array(self.surface.get_size()) + 8) - lo + 1
+        if np.any(size <= 0):
+            return
         layer = self.pg.Surface((int(size[0]), int(size[1])), self.pg.SRCALPHA)
         self.pg.draw.polygon(layer, (*color, alpha), [tuple(p - lo) for p in pts])
         self.surface.blit(layer, (int(lo[0]), int(lo[1])))
