@@ -125,7 +125,6 @@ class Painter:
                 self.pg.draw.line(self.surface, color, ends[i], ends[i + 1], width)
 
     def arrow(self, start: Point, end: Point, color: Color, width: int, head_px=11.0) -> None:
-        """A line from start to end with a filled triangular head at end."""
         s, e = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
         d = e - s
         length = float(np.hypot(*d))
@@ -154,7 +153,6 @@ class Painter:
             self.pg.draw.polygon(self.surface, outline, pts, width)
 
     def translucent_polygon(self, points: Sequence[Point], color: Color, alpha: int) -> None:
-        """A polygon blended over what is drawn (shades of past poses)."""
         pts = np.array([_px(p) for p in points])
         # The layer spans only the polygon's part of the frame (and a margin, where pygame's
         # clipping leaves its marks): a vertex far off screen (a shadow seen from a turned
@@ -168,7 +166,6 @@ class Painter:
         self.surface.blit(layer, (int(lo[0]), int(lo[1])))
 
     def panel(self, rect: tuple[int, int, int, int], fill: Color) -> None:
-        """A translucent rounded box for HUD text."""
         x, y, w, h = rect
         layer = self.pg.Surface((w, h), self.pg.SRCALPHA)
         self.pg.draw.rect(layer, (*fill, 215), (0, 0, w, h), border_radius=6)
@@ -181,7 +178,6 @@ class Painter:
         self.surface.blit(image, image.get_rect(**{anchor: _px(at)}))
 
     def bar(self, rect: tuple[int, int, int, int], fraction: float, color: Color) -> None:
-        """A horizontal gauge: grey track, `fraction` of it filled, dark outline."""
         fraction = min(max(fraction, 0.0), 1.0)
         self.pg.draw.rect(self.surface, (210, 210, 210), rect)
         filled = (rect[0], rect[1], round(rect[2] * fraction), rect[3])
@@ -190,7 +186,6 @@ class Painter:
 
 
 def vector(value: Any) -> np.ndarray:
-    """`value` as a flat float64 array (a copy)."""
     return np.array(value, dtype=float).reshape(-1)
 
 
