@@ -267,3 +267,30 @@ def test_headless_rgb_array_uses_the_dummy_driver_without_clobbering_a_choice():
         check=True,
     )
     assert run.stdout.strip() == "offscreen (120, 160, 3)"
+
+
+FAR_PROBE = """
+import resource
+resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))
+from flyloop.rendering import QuadrotorView, QuadScene
+v = QuadrotorView("rgb_array", width=641, height=479)
+v.render(QuadScene(time_s=0, step=0, position=(0, 0, 1), velocity=(0, 0, 0),
+                   quaternion=(1, 0, 0, 0)))
+v.camera.orbit(100, 40)
+f = v.render(QuadScene(time_s=1, step=1, position=(1e6, -1e6, 1e6), velocity=(0, 0, 0),
+                       quaternion=(1, 0, 0, 0), target=(1e5, 0, 0)))
+print(f.shape)
+"""
+
+
+def test_a_far_state_seen_from_a_turned_camera_draws_in_bounded_memory():
+    # The drop line and shadow of a drone 1e6 m away reach far off screen; sized by the
+    # state, their dashes and translucent layer would need ~20 GB.
+    run = subprocess.run(
+        [sys.executable, "-c", FAR_PROBE],
+        env=_env_without_display(),
+        capture_output=True,
+        text=True,
+    )
+    assert run.returncode == 0, run.stderr[-800:]
+    assert run.stdout.strip() == "(479, 641, 3)"

@@ -1,27 +1,20 @@
-"""The quadrotor view's 3D camera, pure numpy: a perspective orbit camera, its window
-controls, and a Projector (the camera bound to a frame size, near-plane clipped).
+"""The quadrotor view's 3D camera, pure numpy: a perspective orbit camera and a Projector
+(the camera bound to a frame size, near-plane clipped).
 
 ``azimuth_deg`` is the compass direction the camera looks toward (0 = north/+y, 90 = east/+x);
 ``elevation_deg`` is how far it looks down from the horizon. Camera space: x right, y up,
 z (depth) forward. Screen: pixels, origin top-left, v downward; ``fov_deg`` is the vertical
-field of view. Controls: mouse drag orbits, wheel zooms, W/A/S/D move along the ground, Q/E
-down/up, R resets; held keys are tracked from KEYDOWN/KEYUP events (not
-pygame.key.get_pressed) so the same events drive it in a test as from a person.
+field of view.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
 MAX_ELEVATION_DEG = 89.0
-DEGREES_PER_PIXEL = 0.3
-MOVE_FRACTION = 0.012  # per frame, of the camera distance
-ZOOM_STEP = 0.9
-MIN_DISTANCE, MAX_DISTANCE = 0.5, 200.0
 
 
 @dataclass(eq=False)
@@ -64,13 +57,10 @@ class OrbitCamera:
         frame projects thousands of points through the same pose."""
         key = (self.azimuth_deg, self.elevation_deg, self.distance, *self.look_at.tolist())
         if self._cache_key != key:
-            az = math.radians(self.azimuth_deg)
-            el = math.radians(self.elevation_deg)
+            az, el = math.radians(self.azimuth_deg), math.radians(self.elevation_deg)
             sa, ca, se, ce = math.sin(az), math.cos(az), math.sin(el), math.cos(el)
-            forward = (sa * ce, ca * ce, -se)
-            right = (ca, -sa, 0.0)
-            up = (sa * se, ca * se, ce)  # right x forward
-            rows = np.array([right, up, forward])
+            # Rows right, up (= right x forward), forward.
+            rows = np.array([(ca, -sa, 0.0), (sa * se, ca * se, ce), (sa * ce, ca * ce, -se)])
             self._cache = (rows, self.look_at - rows[2] * self.distance)
             self._cache_key = key
         return self._cache
@@ -109,21 +99,21 @@ class OrbitCamera:
         """On-screen radius in pixels of a sphere of radius_m at this depth."""
         return self.focal_px(height) * radius_m / max(depth, self.near)
 
-    # Interactive controls ------------------------------------------------------------------
-
     def orbit(self, d_azimuth_deg: float, d_elevation_deg: float) -> None:
         """Turn around the look-at point; elevation stays short of straight up/down."""
         self.azimuth_deg = (self.azimuth_deg + d_azimuth_deg) % 360.0
         self.elevation_deg = _clamp_elevation(self.elevation_deg + d_elevation_deg)
 
+    def ground_axes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Unit vectors (forward, right) along the ground as the camera sees it."""
+        az = math.radians(self.azimuth_deg)
+        forward = np.array([math.sin(az), math.cos(az), 0.0])
+        return forward, np.array([forward[1], -forward[0], 0.0])
+
     def move(self, forward: float, right: float, up: float) -> None:
         """Shift the look-at point: forward/right along the ground as seen, up along +z."""
-        az = math.radians(self.azimuth_deg)
-        ground_forward = np.array([math.sin(az), math.cos(az), 0.0])
-        ground_right = np.array([math.cos(az), -math.sin(az), 0.0])
-        self.look_at = (
-            self.look_at + forward * ground_forward + right * ground_right + np.array([0, 0, up])
-        )
+        ahead, aside = self.ground_axes()
+        self.look_at = self.look_at + forward * ahead + right * aside + np.array([0, 0, up])
 
     def reset(self) -> None:
         """Back to the pose the camera was created with."""
@@ -152,57 +142,6 @@ def clip_polygon_near(cam_points: np.ndarray, near: float) -> np.ndarray:
     return np.array(out) if out else np.zeros((0, 3))
 
 
-class CameraControls:
-    """Window events -> camera moves (see the module docstring)."""
-
-    def __init__(self, pg: Any, camera: OrbitCamera) -> None:
-        self.pg = pg
-        self.camera = camera
-        self._dragging = False
-        self._held: set[int] = set()
-        self._moves = {
-            pg.K_w: (1, 0, 0),
-            pg.K_s: (-1, 0, 0),
-            pg.K_d: (0, 1, 0),
-            pg.K_a: (0, -1, 0),
-            pg.K_e: (0, 0, 1),
-            pg.K_q: (0, 0, -1),
-        }
-
-    def handle(self, events: list[Any]) -> None:
-        """Apply this frame's events, then one frame of movement for each key held or pressed
-        in this frame (a tap shorter than a frame still moves once)."""
-        pg = self.pg
-        tapped: set[int] = set()
-        for event in events:
-            if event.type == pg.MOUSEBUTTONDOWN and event.button == 1:
-                self._dragging = True
-            elif event.type == pg.MOUSEBUTTONUP and event.button == 1:
-                self._dragging = False
-            elif event.type == pg.MOUSEMOTION and self._dragging:
-                dx, dy = event.rel
-                # Dragging right turns the world right; dragging down looks from higher up.
-                self.camera.orbit(-dx * DEGREES_PER_PIXEL, dy * DEGREES_PER_PIXEL)
-            elif event.type == pg.MOUSEWHEEL:
-                distance = self.camera.distance * ZOOM_STEP ** float(event.y)
-                self.camera.distance = min(max(distance, MIN_DISTANCE), MAX_DISTANCE)
-            elif event.type == pg.KEYDOWN:
-                if event.key == pg.K_r:
-                    self.camera.reset()
-                elif event.key in self._moves:
-                    self._held.add(event.key)
-                    tapped.add(event.key)
-            elif event.type == pg.KEYUP:
-                self._held.discard(event.key)
-            elif event.type == pg.WINDOWFOCUSLOST:
-                self._held.clear()
-                self._dragging = False
-        step = MOVE_FRACTION * self.camera.distance
-        for key in self._held | tapped:
-            forward, right, up = self._moves[key]
-            self.camera.move(forward * step, right * step, up * step)
-
-
 class Projector:
     """A camera bound to a frame size: world points to pixels, near-plane clipped."""
 
@@ -210,18 +149,16 @@ class Projector:
         self.camera = camera
         self.width, self.height = size
 
+    def _pixels(self, cam: np.ndarray) -> np.ndarray:
+        return self.camera.project_camera(cam, self.width, self.height)
+
     def point(self, p: np.ndarray) -> tuple[np.ndarray, float] | None:
         cam = self.camera.to_camera(p)
-        if cam[2] < self.camera.near:
-            return None
-        return self.camera.project_camera(cam, self.width, self.height), float(cam[2])
+        return None if cam[2] < self.camera.near else (self._pixels(cam), float(cam[2]))
 
     def segment(self, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
         clipped = self.camera.clip_segment(np.asarray(a, float), np.asarray(b, float))
-        if clipped is None:
-            return None
-        ends = self.camera.project_camera(np.stack(clipped), self.width, self.height)
-        return ends[0], ends[1]
+        return None if clipped is None else tuple(self._pixels(np.stack(clipped)))
 
     def segments(self, a: np.ndarray, b: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
         """Many world segments a[i]-b[i] at once: the visible, near-clipped ones in pixels."""
@@ -233,15 +170,11 @@ class Projector:
             t = np.where(da - db != 0, da / (da - db), 0.0)
         ca2 = np.where(da < 0, ca + (cb - ca) * t, ca)
         cb2 = np.where(db < 0, cb + (ca - cb) * (db / np.where(db - da != 0, db - da, 1)), cb)
-        pa = self.camera.project_camera(ca2[keep], self.width, self.height)
-        pb = self.camera.project_camera(cb2[keep], self.width, self.height)
-        return list(zip(pa, pb, strict=True))
+        return list(zip(self._pixels(ca2[keep]), self._pixels(cb2[keep]), strict=True))
 
     def polygon(self, points: np.ndarray) -> np.ndarray:
         cam = clip_polygon_near(self.camera.to_camera(points), self.camera.near)
-        if len(cam) < 3:
-            return np.zeros((0, 2))
-        return self.camera.project_camera(cam, self.width, self.height)
+        return self._pixels(cam) if len(cam) >= 3 else np.zeros((0, 2))
 
     def radius(self, radius_m: float, depth: float) -> float:
         return self.camera.pixel_radius(radius_m, depth, self.height)

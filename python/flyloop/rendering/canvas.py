@@ -1,5 +1,6 @@
-"""What both views draw with: a Screen (an off-screen surface for "rgb_array" or a window for
-"human"), a Painter (2D primitives over it) and the per-episode history (flight path, shades).
+"""What both views draw with: View (the frame: an off-screen surface for "rgb_array" or the
+window for "human"), Painter (2D primitives over a surface) and the per-episode history
+(flight path, shades).
 
 pygame is imported by `import_pygame`, on a view's first use, so `import flyloop.rendering`
 stays free of it. Coordinates are float pixels, clamped to a range pygame accepts (a
@@ -8,7 +9,6 @@ blown-up state would give huge integers).
 
 from __future__ import annotations
 
-import math
 import os
 import sys
 from collections import deque
@@ -19,24 +19,22 @@ import numpy as np
 
 RENDER_MODES = ("human", "rgb_array")
 Color = tuple[int, int, int]
+Point = Sequence[float]
 _LIMIT = 30_000.0
 # DejaVu Sans renders crisper than pygame's bundled font at HUD sizes; this factor makes a
 # requested size look about as large in both, so layouts hold whichever one is found.
 _DEJAVU_SCALE = 0.68
 _font_files: dict[bool, str | None] = {}
 # pygame drives one window per process; a second human view would silently steal it.
-_window_owner: Screen | None = None
-
-
-def _has_display() -> bool:
-    if sys.platform in ("win32", "darwin"):
-        return True
-    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+_window_owner: View | None = None
 
 
 def import_pygame(render_mode: str) -> Any:
     """pygame, with SDL told to draw off-screen when there is no display for rgb_array."""
-    if render_mode == "rgb_array" and not _has_display():
+    has_display = sys.platform in ("win32", "darwin") or bool(
+        os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+    )
+    if render_mode == "rgb_array" and not has_display:
         os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
     os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
     import pygame
@@ -44,99 +42,7 @@ def import_pygame(render_mode: str) -> Any:
     return pygame
 
 
-def check_render_mode(render_mode: object) -> str:
-    if render_mode not in RENDER_MODES:
-        raise ValueError(
-            f"render_mode must be one of {RENDER_MODES}, got {render_mode!r} "
-            "(with render_mode None an env needs no view at all)"
-        )
-    return str(render_mode)
-
-
-class Screen:
-    """A pygame surface of `size` pixels, shown in a window in human mode."""
-
-    def __init__(self, render_mode: str, size: tuple[int, int], caption: str, fps: float) -> None:
-        global _window_owner
-        self.render_mode = check_render_mode(render_mode)
-        width, height = int(size[0]), int(size[1])
-        if width < 64 or height < 64:
-            raise ValueError(f"the frame must be at least 64 x 64 pixels, got {width} x {height}")
-        if fps < 0:
-            raise ValueError(f"fps must be >= 0 (0 = as fast as possible), got {fps}")
-        self.size = (width, height)
-        self.fps = float(fps)
-        self.pg = import_pygame(self.render_mode)
-        self.pg.font.init()
-        self.clock = None
-        if self.render_mode == "human":
-            if _window_owner is not None and _window_owner.is_open:
-                raise RuntimeError(
-                    "another human-mode view already owns the pygame window of this process; "
-                    "close it first (pygame shows one window per process)"
-                )
-            try:
-                self.pg.display.init()
-                self.surface = self.pg.display.set_mode(self.size)
-            except self.pg.error as exc:
-                raise RuntimeError(
-                    f"render_mode='human' needs a display ({exc}); run under a desktop or "
-                    "xvfb-run, or use render_mode='rgb_array' headless"
-                ) from exc
-            self.pg.display.set_caption(caption)
-            self.clock = self.pg.time.Clock()
-            _window_owner = self
-        else:
-            self.surface = self.pg.Surface(self.size)
-        self.is_open = True
-
-    def poll_events(self) -> list[Any]:
-        """This frame's window events (human mode); the window closes on QUIT or Escape."""
-        if self.render_mode != "human" or not self.is_open:
-            return []
-        events = self.pg.event.get()
-        for event in events:
-            is_escape = event.type == self.pg.KEYDOWN and event.key == self.pg.K_ESCAPE
-            if event.type == self.pg.QUIT or is_escape:
-                self.close()
-                break
-        return events
-
-    def present(self) -> np.ndarray | None:
-        """Show the frame (human, paced to fps) or return it as (H, W, 3) uint8."""
-        if self.render_mode == "human":
-            self.pg.display.flip()
-            if self.clock is not None and self.fps > 0:
-                self.clock.tick(self.fps)
-            return None
-        # One copy, already row-major (H, W, 3); the frame never aliases the surface.
-        width, height = self.size
-        data = self.pg.image.tobytes(self.surface, "RGB")
-        return np.frombuffer(data, dtype=np.uint8).reshape(height, width, 3).copy()
-
-    def close(self) -> None:
-        """Close the window (human mode). Safe to call more than once."""
-        global _window_owner
-        if not self.is_open:
-            return
-        self.is_open = False
-        if self.render_mode == "human":
-            self.pg.display.quit()
-            if _window_owner is self:
-                _window_owner = None
-
-
-def _font_file(pg: Any, bold: bool) -> str | None:
-    if bold not in _font_files:
-        try:
-            found = pg.font.match_font("dejavusans", bold=bold)
-        except Exception:  # font discovery shells out to fc-list; any failure = bundled font
-            found = None
-        _font_files[bold] = found
-    return _font_files[bold]
-
-
-def _px(point: Sequence[float]) -> tuple[int, int]:
+def _px(point: Point) -> tuple[int, int]:
     x = min(max(float(point[0]), -_LIMIT), _LIMIT)
     y = min(max(float(point[1]), -_LIMIT), _LIMIT)
     return round(x), round(y)
@@ -151,16 +57,19 @@ class Painter:
 
     def font(self, size: int, bold: bool = False) -> Any:
         """A font whose capitals are about size * 0.45 px tall (pygame's default font scale)."""
-        key = (size, bold)
-        if key not in self._fonts:
-            path = _font_file(self.pg, bold)
-            if path is None:
+        if (size, bold) not in self._fonts:
+            if bold not in _font_files:
+                try:
+                    _font_files[bold] = self.pg.font.match_font("dejavusans", bold=bold)
+                except Exception:  # font discovery shells out to fc-list; failure = bundled font
+                    _font_files[bold] = None
+            if _font_files[bold] is None:
                 font = self.pg.font.Font(None, size)  # pygame's bundled font
                 font.set_bold(bold)
             else:
-                font = self.pg.font.Font(path, round(size * _DEJAVU_SCALE))
-            self._fonts[key] = font
-        return self._fonts[key]
+                font = self.pg.font.Font(_font_files[bold], round(size * _DEJAVU_SCALE))
+            self._fonts[size, bold] = font
+        return self._fonts[size, bold]
 
     def vertical_gradient(self, top: Color, bottom: Color) -> None:
         """Fill with a top-to-bottom gradient (drawn once per size and colours, then blitted)."""
@@ -176,52 +85,46 @@ class Painter:
             self._gradient = (key, layer)
         self.surface.blit(self._gradient[1], (0, 0))
 
-    def line(self, a: Sequence[float], b: Sequence[float], color: Color, width: int = 1) -> None:
+    def line(self, a: Point, b: Point, color: Color, width: int = 1) -> None:
         if width <= 1:
             self.pg.draw.aaline(self.surface, color, _px(a), _px(b))
         else:
             self.pg.draw.line(self.surface, color, _px(a), _px(b), width)
 
     def polyline(self, points: np.ndarray, color: Color, width: int = 1) -> None:
-        if len(points) < 2:
-            return
         pts = [_px(p) for p in points]
         if width <= 1:
             self.pg.draw.aalines(self.surface, color, False, pts)
         else:
             self.pg.draw.lines(self.surface, color, False, pts, width)
 
-    def dashed_line(
-        self,
-        a: Sequence[float],
-        b: Sequence[float],
-        color: Color,
-        width: int = 1,
-        dash_px: float = 6.0,
-    ) -> None:
+    def dashed_line(self, a: Point, b: Point, color: Color, width: int, dash_px: float) -> None:
         a_, b_ = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
         length = float(np.hypot(*(b_ - a_)))
         if length < 1e-6:
             return
-        n = max(1, int(length / (2 * dash_px)))
-        t = np.arange(2 * n) / (2 * n)
-        ends = np.clip(a_ + np.outer(t, b_ - a_), -_LIMIT, _LIMIT).round().astype(int).tolist()
-        draw = self.pg.draw
-        for i in range(0, 2 * n, 2):
+        n = max(1, int(length / (2 * dash_px)))  # dash j covers t in [j / n, (j + 0.5) / n]
+        # Only the dashes near the frame: a far-off state's line would ask for billions.
+        t0, t1 = 0.0, 1.0
+        for axis, side in enumerate(self.surface.get_size()):
+            lo, hi, d = -16 - a_[axis], side + 16 - a_[axis], b_[axis] - a_[axis]
+            if d == 0 and not lo <= 0 <= hi:
+                return
+            if d != 0:
+                t0, t1 = max(t0, min(lo / d, hi / d)), min(t1, max(lo / d, hi / d))
+        if t0 > t1:
+            return
+        first, last = max(0, int(t0 * n) - 1), min(n, int(t1 * n) + 2)
+        # Rounded in one go: a long dashed line has hundreds of dashes.
+        ends = a_ + np.outer(np.arange(2 * first, 2 * last) / (2 * n), b_ - a_)
+        ends = np.clip(ends, -_LIMIT, _LIMIT).round().astype(int).tolist()
+        for i in range(0, len(ends), 2):
             if width <= 1:
-                draw.aaline(self.surface, color, ends[i], ends[i + 1])
+                self.pg.draw.aaline(self.surface, color, ends[i], ends[i + 1])
             else:
-                draw.line(self.surface, color, ends[i], ends[i + 1], width)
+                self.pg.draw.line(self.surface, color, ends[i], ends[i + 1], width)
 
-    def arrow(
-        self,
-        start: Sequence[float],
-        end: Sequence[float],
-        color: Color,
-        width: int = 3,
-        head_px: float = 11.0,
-    ) -> None:
-        """A line from start to end with a filled triangular head at end."""
+    def arrow(self, start: Point, end: Point, color: Color, width: int, head_px=11.0) -> None:
         s, e = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
         d = e - s
         length = float(np.hypot(*d))
@@ -234,96 +137,56 @@ class Painter:
         n = np.array([-u[1], u[0]]) * head * 0.5
         self.polygon([e, base + n, base - n], color)
 
-    def disc(
-        self,
-        center: Sequence[float],
-        radius: float,
-        color: Color,
-        outline: Color | None = None,
-        outline_width: int = 1,
-    ) -> None:
+    def disc(self, center: Point, radius: float, color: Color, outline=None, width=1) -> None:
         c, r = _px(center), max(1, round(radius))
         self.pg.draw.circle(self.surface, color, c, r)
         if outline is not None:
-            self.pg.draw.circle(self.surface, outline, c, r, outline_width)
+            self.pg.draw.circle(self.surface, outline, c, r, width)
 
-    def ring(self, center: Sequence[float], radius: float, color: Color, width: int = 2) -> None:
+    def ring(self, center: Point, radius: float, color: Color, width: int) -> None:
         self.pg.draw.circle(self.surface, color, _px(center), max(1, round(radius)), width)
 
-    def polygon(
-        self,
-        points: Sequence[Sequence[float]],
-        color: Color,
-        outline: Color | None = None,
-        outline_width: int = 1,
-    ) -> None:
+    def polygon(self, points: Sequence[Point], color: Color, outline=None, width=1) -> None:
         pts = [_px(p) for p in points]
         self.pg.draw.polygon(self.surface, color, pts)
         if outline is not None:
-            self.pg.draw.polygon(self.surface, outline, pts, outline_width)
+            self.pg.draw.polygon(self.surface, outline, pts, width)
 
-    def translucent_polygon(
-        self, points: Sequence[Sequence[float]], color: Color, alpha: int
-    ) -> None:
-        """A polygon blended over what is drawn (shades of past poses)."""
+    def translucent_polygon(self, points: Sequence[Point], color: Color, alpha: int) -> None:
         pts = np.array([_px(p) for p in points])
-        lo = pts.min(axis=0)
-        size = pts.max(axis=0) - lo + 1
+        # The layer spans only the polygon's part of the frame (and a margin, where pygame's
+        # clipping leaves its marks): a vertex far off screen (a shadow seen from a turned
+        # camera) would otherwise ask for gigabytes.
+        lo = np.maximum(pts.min(axis=0), -8)
+        size = np.minimum(pts.max(axis=0), np.array(self.surface.get_size()) + 8) - lo + 1
+        if np.any(size <= 0):
+            return
         layer = self.pg.Surface((int(size[0]), int(size[1])), self.pg.SRCALPHA)
         self.pg.draw.polygon(layer, (*color, alpha), [tuple(p - lo) for p in pts])
         self.surface.blit(layer, (int(lo[0]), int(lo[1])))
 
-    def panel(
-        self,
-        rect: tuple[int, int, int, int],
-        fill: Color,
-        alpha: int = 215,
-        border: Color = (60, 60, 70),
-    ) -> None:
-        """A translucent rounded box for HUD text."""
+    def panel(self, rect: tuple[int, int, int, int], fill: Color) -> None:
         x, y, w, h = rect
         layer = self.pg.Surface((w, h), self.pg.SRCALPHA)
-        self.pg.draw.rect(layer, (*fill, alpha), (0, 0, w, h), border_radius=6)
+        self.pg.draw.rect(layer, (*fill, 215), (0, 0, w, h), border_radius=6)
         self.surface.blit(layer, (x, y))
-        self.pg.draw.rect(self.surface, border, rect, 1, border_radius=6)
+        self.pg.draw.rect(self.surface, (60, 60, 70), rect, 1, border_radius=6)
 
-    def text(
-        self,
-        text: str,
-        pos: Sequence[float],
-        color: Color,
-        size: int = 20,
-        anchor: str = "topleft",
-        bold: bool = False,
-    ) -> tuple[int, int]:
-        """Draw text with its `anchor` (a pygame Rect attribute) at pos; returns its size."""
-        image = self.font(size, bold).render(text, True, color)
-        rect = image.get_rect(**{anchor: _px(pos)})
-        self.surface.blit(image, rect)
-        return rect.width, rect.height
-
-    def text_size(self, text: str, size: int = 20, bold: bool = False) -> tuple[int, int]:
-        return self.font(size, bold).size(text)
+    def text(self, s: str, at: Point, color: Color, size: int, anchor="topleft", bold=False):
+        """Draw s with its `anchor` (a pygame Rect attribute) at `at`."""
+        image = self.font(size, bold).render(s, True, color)
+        self.surface.blit(image, image.get_rect(**{anchor: _px(at)}))
 
     def bar(self, rect: tuple[int, int, int, int], fraction: float, color: Color) -> None:
-        """A horizontal gauge: grey track, `fraction` of it filled, dark outline."""
         fraction = min(max(fraction, 0.0), 1.0)
         self.pg.draw.rect(self.surface, (210, 210, 210), rect)
-        self.pg.draw.rect(
-            self.surface, color, (rect[0], rect[1], round(rect[2] * fraction), rect[3])
-        )
+        filled = (rect[0], rect[1], round(rect[2] * fraction), rect[3])
+        self.pg.draw.rect(self.surface, color, filled)
         self.pg.draw.rect(self.surface, (10, 10, 20), rect, 1)
 
 
 def vector(value: Any) -> np.ndarray:
-    """`value` as a flat float64 array (a copy)."""
     return np.array(value, dtype=float).reshape(-1)
-
-
-def rotate2d(points: np.ndarray, angle: float) -> np.ndarray:
-    """Rotate (N, 2) points counter-clockwise by angle radians."""
-    c, s = math.cos(angle), math.sin(angle)
-    return np.asarray(points, dtype=float) @ np.array([[c, s], [-s, c]])
 
 
 class FlightPath:
@@ -367,50 +230,64 @@ class Shades:
         if not spacing_m > 0:
             raise ValueError(f"shade spacing must be > 0 m, got {spacing_m}")
         self.spacing_m = float(spacing_m)
-        self._poses: deque[tuple[float, float, float]] = deque(maxlen=max_shades)
+        self.poses: deque[tuple[float, float, float]] = deque(maxlen=max_shades)
 
     def update(self, position: np.ndarray, angle: float) -> None:
         x, y = float(position[0]), float(position[1])
-        if self._poses:
-            lx, ly, _ = self._poses[-1]
+        if self.poses:
+            lx, ly, _ = self.poses[-1]
             if np.hypot(x - lx, y - ly) <= self.spacing_m:
                 return
-        self._poses.append((x, y, float(angle)))
-
-    def clear(self) -> None:
-        self._poses.clear()
-
-    @property
-    def poses(self) -> list[tuple[float, float, float]]:
-        """(x m, y m, angle rad) of each shade, oldest first."""
-        return list(self._poses)
+        self.poses.append((x, y, float(angle)))
 
 
 class View:
-    """What both views share: a Screen and its Painter, the scene type they draw, closing.
-    pygame is imported by the constructor, not before."""
+    """What both views share: the frame (shown in a window in human mode) and its Painter,
+    the scene type they draw, closing. pygame is imported by the constructor, not before."""
 
-    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 50}
     SCENE: type
 
     def __init__(self, render_mode: str, size: tuple[int, int], caption: str, fps: float) -> None:
-        self.render_mode = check_render_mode(render_mode)
-        self._screen = Screen(render_mode, size, caption, fps)
-        self._painter = Painter(self._screen.pg, self._screen.surface)
-        self._closed = False
-
-    @property
-    def size(self) -> tuple[int, int]:
-        """(width, height) in pixels."""
-        return self._screen.size
-
-    @property
-    def is_open(self) -> bool:
-        """False once closed, by close() or by the user closing the window."""
-        return self._screen.is_open
+        global _window_owner
+        if render_mode not in RENDER_MODES:
+            raise ValueError(
+                f"render_mode must be one of {RENDER_MODES}, got {render_mode!r} "
+                "(with render_mode None an env needs no view at all)"
+            )
+        width, height = int(size[0]), int(size[1])
+        if width < 64 or height < 64:
+            raise ValueError(f"the frame must be at least 64 x 64 pixels, got {width} x {height}")
+        if fps < 0:
+            raise ValueError(f"fps must be >= 0 (0 = as fast as possible), got {fps}")
+        self.render_mode, self.size, self.fps = render_mode, (width, height), float(fps)
+        self._pg = pg = import_pygame(render_mode)
+        pg.font.init()
+        if render_mode == "human":
+            if _window_owner is not None:
+                raise RuntimeError(
+                    "another human-mode view already owns the pygame window of this process; "
+                    "close it first (pygame shows one window per process)"
+                )
+            try:
+                pg.display.init()
+                self._surface = pg.display.set_mode(self.size)
+            except pg.error as exc:
+                raise RuntimeError(
+                    f"render_mode='human' needs a display ({exc}); run under a desktop or "
+                    "xvfb-run, or use render_mode='rgb_array' headless"
+                ) from exc
+            pg.display.set_caption(caption)
+            self._clock = pg.time.Clock()
+            _window_owner = self
+        else:
+            self._surface = pg.Surface(self.size)
+        self._painter = Painter(pg, self._surface)
+        # is_open turns False also when the user closes the window; _closed only by close().
+        self.is_open, self._closed = True, False
 
     def _events(self, scene: Any) -> list[Any] | None:
-        """This frame's window events; None when the user closed the window."""
+        """This frame's window events; None when the user closed the window (on QUIT or
+        Escape)."""
         name = type(self).__name__
         if self._closed:
             raise RuntimeError(f"this {name} is closed; create a new one to render again")
@@ -418,10 +295,35 @@ class View:
             raise TypeError(
                 f"{name}.render needs a {self.SCENE.__name__}, got {type(scene).__name__}"
             )
-        events = self._screen.poll_events()
-        return events if self._screen.is_open else None
+        if self.render_mode != "human" or not self.is_open:
+            return [] if self.is_open else None
+        pg = self._pg
+        events = pg.event.get()
+        for event in events:
+            if event.type == pg.QUIT or (event.type == pg.KEYDOWN and event.key == pg.K_ESCAPE):
+                self._shut()
+                return None
+        return events
+
+    def _present(self) -> np.ndarray | None:
+        """Show the frame (human, paced to fps) or return it as (H, W, 3) uint8."""
+        if self.render_mode == "human":
+            self._pg.display.flip()
+            if self.fps > 0:
+                self._clock.tick(self.fps)
+            return None
+        # One copy, already row-major (H, W, 3); the frame never aliases the surface.
+        data = self._pg.image.tobytes(self._surface, "RGB")
+        return np.frombuffer(data, dtype=np.uint8).reshape(self.size[1], self.size[0], 3).copy()
+
+    def _shut(self) -> None:
+        global _window_owner
+        if self.is_open and self.render_mode == "human":
+            self._pg.display.quit()
+            _window_owner = None  # an open human view is the owner: no second one can open
+        self.is_open = False
 
     def close(self) -> None:
         """Close the window (if any). Safe to call more than once."""
         self._closed = True
-        self._screen.close()
+        self._shut()

@@ -1,6 +1,6 @@
 """The Lander2D view (task Landing): its scene, the plane (metres to pixels), the picture
-(one function per element, drawn in that order) and LanderView. World metres, x right, y up,
-angles counter-clockwise.
+(the world back to front, a close-up, the wind dial and the text panel) and LanderView.
+World metres, x right, y up, angles counter-clockwise.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import numpy as np
 
 from .. import _native
 from ..tasks import LANDING, observation_slices
-from .canvas import FlightPath, Painter, Shades, View, check_render_mode, rotate2d, vector
+from .canvas import FlightPath, Painter, Shades, View, vector
 
 SKY_TOP, SKY_BOTTOM, OUTSIDE = (196, 220, 246), (226, 238, 250), (120, 130, 145)
 GROUND, GROUND_EDGE, BOUNDS, SPAWN = (96, 148, 82), (62, 112, 58), (200, 70, 70), (178, 160, 80)
@@ -29,9 +29,8 @@ CLOSE_UP_SCALE = 48.0  # px per metre: a 1 m drone is 48 px wide
 # What the scene shows when not told: the Landing task's defaults, read from the core.
 _CORE = LANDING.defaults
 # Where a moving platform's vx / platform_speed sits in the observation (the core's layout).
-_PLATFORM_VX = observation_slices(_native.describe("landing", {"moving_platform": 1.0}))[
-    "platform_velocity"
-].start
+_MOVING = _native.describe("landing", {"moving_platform": 1.0})
+_PLATFORM_VX = observation_slices(_MOVING)["platform_velocity"].start
 _OUTCOMES = (
     ("lost_control", "lost control"),
     ("out_of_bounds", "out of bounds"),
@@ -146,14 +145,10 @@ class PlaneView:
     """A uniform scale (px per metre) and the pixel (u0, v0) where world (0, 0) lands."""
 
     def __init__(self, scale: float, u0: float, v0: float) -> None:
-        if not scale > 0:
-            raise ValueError(f"scale must be > 0 px/m, got {scale}")
         self.scale, self.u0, self.v0 = float(scale), float(u0), float(v0)
 
     @classmethod
-    def fit_world(
-        cls, world_width: float, world_height: float, size: tuple[int, int], margin_px: int = 12
-    ) -> PlaneView:
+    def fit_world(cls, world_width: float, world_height: float, size, margin_px=12) -> PlaneView:
         """The world box (0, 0)-(W, H), centred, filling the frame less margin_px per side."""
         width, height = size
         usable_w, usable_h = width - 2 * margin_px, height - 2 * margin_px
@@ -182,66 +177,10 @@ class PlaneView:
         )
 
 
-def background(p: Painter, plane: PlaneView, s: LanderScene) -> None:
-    """Grey outside the world, a sky gradient (by altitude) inside it."""
-    p.surface.fill(OUTSIDE)
-    width, height = p.surface.get_size()
-    (u0, v_top), (u1, v_bottom) = plane.to_screen(
-        np.array([[0.0, s.world_height], [s.world_width, 0.0]])
-    )
-    left, right = max(0, round(u0)), min(width, round(u1))
-    top, bottom = max(0, round(v_top)), min(height, round(v_bottom))
-    span = max(1.0, v_bottom - v_top)
-    for v in range(top, bottom, 4):
-        t = (v - v_top) / span
-        color = tuple(round(a + (b - a) * t) for a, b in zip(SKY_TOP, SKY_BOTTOM, strict=True))
-        p.pg.draw.rect(p.surface, color, (left, v, right - left, min(4, bottom - v)))
-
-
-def ground(p: Painter, plane: PlaneView, s: LanderScene) -> None:
-    top_left = plane.to_screen((0.0, s.ground_height))
-    bottom_right = plane.to_screen((s.world_width, 0.0))
-    rect = (*top_left, *(bottom_right - top_left))
-    p.pg.draw.rect(p.surface, GROUND, tuple(round(x) for x in rect))
-    p.line(top_left, (bottom_right[0], top_left[1]), GROUND_EDGE, 4)
-
-
-def bounds(p: Painter, plane: PlaneView, s: LanderScene) -> None:
-    w, h = s.world_width, s.world_height
-    corners = plane.to_screen(np.array([[0, 0], [w, 0], [w, h], [0, h], [0, 0]], dtype=float))
-    for a, b in zip(corners[:-1], corners[1:], strict=True):
-        p.dashed_line(a, b, BOUNDS, 2, dash_px=8)
-
-
-def spawn_zone(p: Painter, plane: PlaneView, s: LanderScene) -> None:
-    r = s.spawn_half_range
-    if r <= 0:
-        return
-    cx, cy = s.spawn_center
-    lo = plane.to_screen((cx - r, cy + r))
-    hi = plane.to_screen((cx + r, cy - r))
-    p.pg.draw.rect(p.surface, SPAWN, (*np.round(lo), *np.round(hi - lo)), 1)
-    p.text("spawn zone", (lo[0] + 4, lo[1] + 3), SPAWN, 16)
-
-
-def platform(p: Painter, plane: PlaneView, s: LanderScene) -> None:
-    half = s.platform_width / 2.0
-    x0, x1 = s.platform_x - half, s.platform_x + half
-    y0, y1 = s.ground_height, s.ground_height + s.platform_height
-    box = plane.to_screen(np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]))
-    p.polygon(box, PLATFORM, PLATFORM_EDGE, 2)
-    p.line(box[3], box[2], PLATFORM_TOP, 3)
-    if abs(s.platform_vx) > 1e-6:
-        mid = plane.to_screen((s.platform_x, y0 - 0.6))
-        tip = mid + np.array(
-            [math.copysign(min(30.0, 12 + 8 * abs(s.platform_vx)), s.platform_vx), 0]
-        )
-        p.arrow(mid, tip, PLATFORM_EDGE, 2, head_px=7)
-
-
-def path(p: Painter, plane: PlaneView, points: np.ndarray) -> None:
-    if len(points) >= 2:
-        p.polyline(plane.to_screen(points), PATH, 1)
+def rotate2d(points: np.ndarray, angle: float) -> np.ndarray:
+    """Rotate (N, 2) points counter-clockwise by angle radians."""
+    c, s = math.cos(angle), math.sin(angle)
+    return np.asarray(points, dtype=float) @ np.array([[c, s], [-s, c]])
 
 
 def _drone_parts(s: LanderScene, x: float, y: float, angle: float) -> list[np.ndarray]:
@@ -252,45 +191,6 @@ def _drone_parts(s: LanderScene, x: float, y: float, angle: float) -> list[np.nd
     square = np.array([[-h / 2, -h / 2], [h / 2, -h / 2], [h / 2, h / 2], [-h / 2, h / 2]])
     parts = [frame, square + [-motor_x, 0.0], square + [motor_x, 0.0]]
     return [rotate2d(part, angle) + [x, y] for part in parts]
-
-
-def shades(p: Painter, plane: PlaneView, s: LanderScene, poses: list) -> None:
-    for x, y, angle in poses:
-        for part in _drone_parts(s, x, y, angle):
-            p.translucent_polygon(plane.to_screen(part), SHADE, 95)
-
-
-def sensor_line(p: Painter, plane: PlaneView, s: LanderScene, label: bool = True) -> None:
-    a = plane.to_screen(s.position)
-    b = plane.to_screen(s.platform_top)
-    p.dashed_line(a, b, SENSOR, 2, dash_px=7)
-    p.disc(b, 4, SENSOR)
-    if not label:
-        return
-    mid = (a + b) / 2.0
-    p.text(f"{s.distance_to_platform:.1f} m", (mid[0] + 8, mid[1]), SENSOR, 18, "midleft", True)
-
-
-def drone(p: Painter, plane: PlaneView, s: LanderScene) -> None:
-    x, y = s.position
-    frame, left, right = _drone_parts(s, x, y, s.angle)
-    for part, color in ((frame, FRAME), (left, MOTOR), (right, MOTOR)):
-        p.polygon(plane.to_screen(part), color, OUTLINE, 1)
-
-
-def thrust_bars(
-    p: Painter, plane: PlaneView, s: LanderScene, full_px: float = THRUST_BAR_PX
-) -> None:
-    """Over each motor, along the body's +y: grey = max thrust, red = this step's thrust."""
-    motor_x = (s.drone_width - s.drone_height) / 2.0
-    up = rotate2d(np.array([[0.0, 1.0]]), s.angle)[0] * np.array([1.0, -1.0])  # screen v down
-    for side, thrust in ((-1.0, s.thrust[0]), (1.0, s.thrust[1])):
-        attach = rotate2d(np.array([[side * motor_x, s.drone_height / 2]]), s.angle)[0]
-        start = plane.to_screen(attach + s.position)
-        fraction = min(max(thrust / s.max_thrust, 0.0), 1.0)
-        p.line(start, start + up * full_px, THRUST_TRACK, 3)
-        if fraction > 0:
-            p.line(start, start + up * full_px * fraction, THRUST, 3)
 
 
 def wind_indicator(p: Painter, s: LanderScene) -> None:
@@ -366,39 +266,79 @@ def overlay(p: Painter, plane: PlaneView, s: LanderScene) -> None:
             p.text(text, (x, rect[1] + pad + i * line_h), color, 19, bold=(c == 0 and i == 1))
     bar_x = rect[0] + pad + 2 * col_w + 120
     for i, thrust in enumerate(s.thrust):
-        p.bar(
-            (bar_x, rect[1] + pad + (i + 1) * line_h + 2, col_w - 130, 11),
-            thrust / s.max_thrust,
-            THRUST,
-        )
+        bar = (bar_x, rect[1] + pad + (i + 1) * line_h + 2, col_w - 130, 11)
+        p.bar(bar, thrust / s.max_thrust, THRUST)
     fraction = s.battery / s.initial_battery
     fill = GOOD if fraction > 0.3 else (230, 150, 0) if fraction > 0.1 else BAD
     p.bar((rect[0] + pad + 175, rect[1] + pad + 2, col_w - 190, 11), fraction, fill)
 
 
-def world(
-    p: Painter,
-    plane: PlaneView,
-    s: LanderScene,
-    shade_poses: list,
-    path_points: np.ndarray,
-    *,
-    spawn: bool = True,
-    labels: bool = True,
-    thrust_px: float = THRUST_BAR_PX,
-) -> None:
-    """Everything that lives in world coordinates, back to front."""
-    background(p, plane, s)
-    if spawn:
-        spawn_zone(p, plane, s)
-    ground(p, plane, s)
-    bounds(p, plane, s)
-    shades(p, plane, s, shade_poses)
-    path(p, plane, path_points)
-    platform(p, plane, s)
-    sensor_line(p, plane, s, label=labels)
-    drone(p, plane, s)
-    thrust_bars(p, plane, s, thrust_px)
+def world(p: Painter, plane: PlaneView, s: LanderScene, poses, path, spawn, close_up) -> None:
+    """Everything that lives in world coordinates, back to front; a close-up has no distance
+    label and longer thrust bars."""
+    # Grey outside the world, a sky gradient (by altitude) inside it.
+    p.surface.fill(OUTSIDE)
+    width, height = p.surface.get_size()
+    corners = np.array([[0.0, s.world_height], [s.world_width, 0.0]])
+    (u0, v_top), (u1, v_bottom) = plane.to_screen(corners)
+    left, right = max(0, round(u0)), min(width, round(u1))
+    top, bottom = max(0, round(v_top)), min(height, round(v_bottom))
+    for v in range(top, bottom, 4):
+        t = (v - v_top) / max(1.0, v_bottom - v_top)
+        color = tuple(round(a + (b - a) * t) for a, b in zip(SKY_TOP, SKY_BOTTOM, strict=True))
+        p.pg.draw.rect(p.surface, color, (left, v, right - left, min(4, bottom - v)))
+    r = s.spawn_half_range
+    if spawn and r > 0:
+        lo = plane.to_screen((s.spawn_center[0] - r, s.spawn_center[1] + r))
+        hi = plane.to_screen((s.spawn_center[0] + r, s.spawn_center[1] - r))
+        p.pg.draw.rect(p.surface, SPAWN, (*np.round(lo), *np.round(hi - lo)), 1)
+        p.text("spawn zone", (lo[0] + 4, lo[1] + 3), SPAWN, 16)
+    top_left = plane.to_screen((0.0, s.ground_height))
+    bottom_right = plane.to_screen((s.world_width, 0.0))
+    rect = (*top_left, *(bottom_right - top_left))
+    p.pg.draw.rect(p.surface, GROUND, tuple(round(x) for x in rect))
+    p.line(top_left, (bottom_right[0], top_left[1]), GROUND_EDGE, 4)
+    w, h = s.world_width, s.world_height
+    edges = plane.to_screen(np.array([[0, 0], [w, 0], [w, h], [0, h], [0, 0]], dtype=float))
+    for a, b in zip(edges[:-1], edges[1:], strict=True):
+        p.dashed_line(a, b, BOUNDS, 2, dash_px=8)
+    for x, y, angle in poses:
+        for part in _drone_parts(s, x, y, angle):
+            p.translucent_polygon(plane.to_screen(part), SHADE, 95)
+    if len(path) >= 2:
+        p.polyline(plane.to_screen(path), PATH, 1)
+    # The platform, with an arrow under it when it moves.
+    half = s.platform_width / 2.0
+    x0, x1 = s.platform_x - half, s.platform_x + half
+    y0, y1 = s.ground_height, s.ground_height + s.platform_height
+    box = plane.to_screen(np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]))
+    p.polygon(box, PLATFORM, PLATFORM_EDGE, 2)
+    p.line(box[3], box[2], PLATFORM_TOP, 3)
+    if abs(s.platform_vx) > 1e-6:
+        mid = plane.to_screen((s.platform_x, y0 - 0.6))
+        length = math.copysign(min(30.0, 12 + 8 * abs(s.platform_vx)), s.platform_vx)
+        p.arrow(mid, mid + np.array([length, 0]), PLATFORM_EDGE, 2, head_px=7)
+    # The sensor line from the drone to the platform's top centre.
+    a, b = plane.to_screen(s.position), plane.to_screen(s.platform_top)
+    p.dashed_line(a, b, SENSOR, 2, dash_px=7)
+    p.disc(b, 4, SENSOR)
+    if not close_up:
+        mid = (a + b) / 2.0
+        p.text(f"{s.distance_to_platform:.1f} m", (mid[0] + 8, mid[1]), SENSOR, 18, "midleft", True)
+    frame, left, right = _drone_parts(s, s.position[0], s.position[1], s.angle)
+    for part, color in ((frame, FRAME), (left, MOTOR), (right, MOTOR)):
+        p.polygon(plane.to_screen(part), color, OUTLINE, 1)
+    # Over each motor, along the body's +y: grey = max thrust, red = this step's thrust.
+    full_px = 70 if close_up else THRUST_BAR_PX
+    motor_x = (s.drone_width - s.drone_height) / 2.0
+    up = rotate2d(np.array([[0.0, 1.0]]), s.angle)[0] * np.array([1.0, -1.0])  # screen v down
+    for side, thrust in ((-1.0, s.thrust[0]), (1.0, s.thrust[1])):
+        attach = rotate2d(np.array([[side * motor_x, s.drone_height / 2]]), s.angle)[0]
+        start = plane.to_screen(attach + s.position)
+        p.line(start, start + up * full_px, THRUST_TRACK, 3)
+        fraction = min(max(thrust / s.max_thrust, 0.0), 1.0)
+        if fraction > 0:
+            p.line(start, start + up * full_px * fraction, THRUST, 3)
 
 
 def close_up(
@@ -409,7 +349,7 @@ def close_up(
     # The drone sits a little low so its thrust bars fit above it.
     center = np.array(s.position) + np.array([0.0, 0.12 * height / CLOSE_UP_SCALE])
     plane = PlaneView.centred_on(center, CLOSE_UP_SCALE, (width, height))
-    world(p, plane, s, shade_poses, path_points, spawn=False, labels=False, thrust_px=70)
+    world(p, plane, s, shade_poses, path_points, spawn=False, close_up=True)
     p.pg.draw.rect(p.surface, (40, 40, 50), (0, 0, width, height), 2)
     p.text(f"close-up ×{zoom:.0f}", (8, 6), TEXT, 18, bold=True)
 
@@ -437,57 +377,42 @@ class LanderView(View):
         show_overlay: bool = True,
         show_close_up: bool = True,
     ) -> None:
-        check_render_mode(render_mode)
-        self.show_path = show_path
-        self.show_shades = show_shades
-        self.show_spawn_zone = show_spawn_zone
-        self.show_overlay = show_overlay
+        self.show_path, self.show_shades = show_path, show_shades
+        self.show_spawn_zone, self.show_overlay = show_spawn_zone, show_overlay
         self._path = FlightPath()
         self._shades = Shades(shade_distance_m)
         super().__init__(render_mode, (width, height), "flyloop - Lander2D", fps)
         self._close_up: Painter | None = None
-        if show_close_up:
-            cw, ch = CLOSE_UP_SIZE
-            if width >= 3 * cw and height >= 3 * ch:  # a small frame has no room for it
-                window = self._screen.surface.subsurface((20, 20, cw, ch))
-                self._close_up = Painter(self._screen.pg, window)
-        self._plane: PlaneView | None = None
-        self._plane_key: tuple[float, float] | None = None
+        cw, ch = CLOSE_UP_SIZE
+        if show_close_up and width >= 3 * cw and height >= 3 * ch:  # else it has no room
+            self._close_up = Painter(self._pg, self._surface.subsurface((20, 20, cw, ch)))
 
     def world_to_screen(self, scene: LanderScene, points: np.ndarray) -> np.ndarray:
         """Pixels (u, v) where world points (..., 2) in metres are drawn for this scene."""
-        return self._plane_for(scene).to_screen(points)
+        plane = PlaneView.fit_world(scene.world_width, scene.world_height, self.size)
+        return plane.to_screen(points)
 
     def reset(self) -> None:
         """Forget the flight path and shades (an env calls this from reset())."""
         self._path.clear()
-        self._shades.clear()
+        self._shades.poses.clear()
 
     def render(self, scene: LanderScene) -> np.ndarray | None:
         """Draw one frame: returns it in rgb_array mode, None in human mode."""
         if self._events(scene) is None:
             return None  # the user closed the window: nothing to draw on any more
         if self._path.update(scene.step, scene.position):
-            self._shades.clear()
+            self._shades.poses.clear()
         self._shades.update(scene.position, scene.angle)
-        self._draw(scene)
-        return self._screen.present()
-
-    def _plane_for(self, scene: LanderScene) -> PlaneView:
-        key = (scene.world_width, scene.world_height)
-        if self._plane is None or self._plane_key != key:
-            self._plane = PlaneView.fit_world(scene.world_width, scene.world_height, self.size)
-            self._plane_key = key
-        return self._plane
-
-    def _draw(self, s: LanderScene) -> None:
-        p, plane = self._painter, self._plane_for(s)
-        shade_poses = self._shades.poses if self.show_shades else []
+        s, p = scene, self._painter
+        plane = PlaneView.fit_world(s.world_width, s.world_height, self.size)
+        shade_poses = self._shades.poses if self.show_shades else ()
         path_points = self._path.points if self.show_path else np.zeros((0, 2))
-        world(p, plane, s, shade_poses, path_points, spawn=self.show_spawn_zone)
+        world(p, plane, s, shade_poses, path_points, self.show_spawn_zone, close_up=False)
         zoom = CLOSE_UP_SCALE / plane.scale
         if self._close_up is not None and zoom >= 1.5:  # in a small world it adds nothing
             close_up(self._close_up, s, shade_poses, path_points, zoom)
         wind_indicator(p, s)
         if self.show_overlay:
             overlay(p, plane, s)
+        return self._present()

@@ -1,12 +1,13 @@
 """The quadrotor view (tasks Hover and Waypoints): its scene, the 3D world drawn through an
 orbit camera, the overlays (info panel, motor bars, axis gizmo, wind dial, legend) and
-QuadrotorView.
+QuadrotorView with its window controls.
 
 Frames as the core: world ENU (x east, y north, z up), body FLU (x forward, y left, z up),
 quaternion [w, x, y, z] rotating body to world; motors in PX4's quad-X order (0 front-right,
 1 rear-left, 2 front-left, 3 rear-right). The world is drawn with a painter's algorithm: the
 ground and lines first, then solid things far to near, the drone's hub last (its pixels are
-what tests track).
+what tests track). The window's held keys are tracked from KEYDOWN/KEYUP events (not
+pygame.key.get_pressed) so the same events drive the camera in a test as from a person.
 """
 
 from __future__ import annotations
@@ -20,8 +21,8 @@ import numpy as np
 
 from .. import _native
 from ..tasks import observation_slices, parameter_values
-from .camera import CameraControls, OrbitCamera, Projector
-from .canvas import FlightPath, Painter, View, check_render_mode, vector
+from .camera import OrbitCamera, Projector
+from .canvas import FlightPath, Painter, View, vector
 
 # Rotor i sits at (forward, left) * L/sqrt(2) in the body frame: PX4 quad-X order.
 ROTOR_POSITION_SIGNS = np.array([(1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (-1.0, -1.0)])
@@ -30,21 +31,18 @@ ROTOR_SPIN = (-1, -1, 1, 1)
 ROTOR_NAMES = ("FR", "RL", "FL", "RR")
 GROUND, GRID, GRID_MAJOR, AXIS_X = (226, 230, 222), (188, 192, 186), (160, 165, 158), (220, 40, 40)
 AXIS_Y, AXIS_Z, BOUNDS, BODY = (30, 160, 60), (40, 90, 230), (150, 160, 200), (0, 100, 200)
-BODY_HIGHLIGHT = (110, 175, 245)
-ROTOR_CCW = (70, 200, 90)  # counter-clockwise (seen from above)
-ROTOR_CW = (235, 90, 80)  # clockwise
+BODY_HIGHLIGHT, ROTOR_CCW, ROTOR_CW = (110, 175, 245), (70, 200, 90), (235, 90, 80)
 ARM, NOSE, TARGET, TARGET_LINE = (90, 90, 95), (35, 35, 40), (0, 170, 60), (140, 140, 140)
 WAYPOINT, UP, VELOCITY, WIND = (150, 60, 200), (255, 150, 0), (230, 0, 220), (200, 0, 0)
 DROP, SHADOW, TRAIL = (128, 128, 128), (40, 40, 40), (60, 140, 220)
-
-TARGET_RADIUS_M = 0.08
-WAYPOINT_RADIUS_M = 0.06
-UP_ARROW_M = 0.5  # length of the up vector
-VELOCITY_SECONDS = 0.5  # the velocity arrow shows where the drone is in this many seconds
-WIND_M_PER_MPS = 0.12  # wind arrow length per m/s of wind
-MAX_ARROW_M = 2.0
 TEXT, PANEL, BAD, BACKGROUND_TOP = (20, 20, 30), (255, 255, 236), (200, 0, 0), (232, 238, 248)
 BACKGROUND_BOTTOM = (246, 246, 250)
+AXES = ((AXIS_X, "x E"), (AXIS_Y, "y N"), (AXIS_Z, "z"))
+TARGET_RADIUS_M, WAYPOINT_RADIUS_M, UP_ARROW_M, MAX_ARROW_M = 0.08, 0.06, 0.5, 2.0
+VELOCITY_SECONDS = 0.5  # the velocity arrow shows where the drone is in this many seconds
+WIND_M_PER_MPS = 0.12  # wind arrow length per m/s of wind
+DEGREES_PER_PIXEL, ZOOM_STEP, MIN_DISTANCE, MAX_DISTANCE = 0.3, 0.9, 0.5, 200.0
+MOVE_FRACTION = 0.012  # per frame, of the camera distance
 # What a scene shows when not told: the hover task with the core's defaults.
 _HOVER = _native.describe("hover")
 _CORE = parameter_values(_HOVER)
@@ -53,13 +51,10 @@ _CORE = parameter_values(_HOVER)
 def rotation_matrix(q_wxyz: np.ndarray) -> np.ndarray:
     """The 3x3 matrix of a unit quaternion [w, x, y, z]: world = R @ body."""
     w, x, y, z = q_wxyz
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-    )
+    row_x = [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)]
+    row_y = [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)]
+    row_z = [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]
+    return np.array([row_x, row_y, row_z])
 
 
 def euler_rpy(q_wxyz: np.ndarray) -> tuple[float, float, float]:
@@ -76,21 +71,15 @@ def quaternion_from_euler(roll: float, pitch: float, yaw: float) -> np.ndarray:
     cr, sr = math.cos(roll / 2), math.sin(roll / 2)
     cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
     cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return np.array(
-        [
-            cr * cp * cy + sr * sp * sy,
-            sr * cp * cy - cr * sp * sy,
-            cr * sp * cy + sr * cp * sy,
-            cr * cp * sy - sr * sp * cy,
-        ]
-    )
+    w, x = cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy
+    y, z = cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy
+    return np.array([w, x, y, z])
 
 
 def rotor_positions_body(arm_length: float) -> np.ndarray:
     """(4, 3) rotor centres in the body frame, metres, in PX4 motor order."""
-    lever = arm_length / math.sqrt(2.0)
     out = np.zeros((4, 3))
-    out[:, :2] = ROTOR_POSITION_SIGNS * lever
+    out[:, :2] = ROTOR_POSITION_SIGNS * (arm_length / math.sqrt(2.0))
     return out
 
 
@@ -118,9 +107,7 @@ class QuadScene:
     extras: tuple[tuple[str, str], ...] = ()  # more (label, text) lines for the info panel
 
     def __post_init__(self) -> None:
-        for name in ("position", "velocity", "body_rates", "wind"):
-            setattr(self, name, vector(getattr(self, name)))
-        for name in ("target", "next_waypoint"):
+        for name in ("position", "velocity", "body_rates", "wind", "target", "next_waypoint"):
             if getattr(self, name) is not None:
                 setattr(self, name, vector(getattr(self, name)))
         q = vector(self.quaternion)
@@ -151,8 +138,9 @@ def quad_scene(
     def part(name: str, otherwise: Any) -> Any:
         return obs[at[name]] if name in at else otherwise
 
-    status = "crashed" if info.get("crashed") else ""
-    status = status or ("out of bounds" if info.get("out_of_bounds") else "")
+    status = (
+        "crashed" if info.get("crashed") else "out of bounds" if info.get("out_of_bounds") else ""
+    )
     return QuadScene(
         time_s=info["episode_time"],
         step=info["step_count"],
@@ -200,53 +188,6 @@ def _circle_points(center: np.ndarray, radius: float, axes: np.ndarray, n: int =
     return center + radius * (np.outer(np.cos(t), axes[0]) + np.outer(np.sin(t), axes[1]))
 
 
-def grid_extent(scene: QuadScene) -> float:
-    """Half side of the drawn ground grid, m: the target box and a margin, on 0.5 m lines."""
-    return math.ceil((scene.bounds_half_size * 2.0 + 1.0) * 2.0) / 2.0
-
-
-def ground(p: Painter, pr: Projector, scene: QuadScene) -> None:
-    g = grid_extent(scene)
-    square = np.array([[-g, -g, 0.0], [g, -g, 0.0], [g, g, 0.0], [-g, g, 0.0]])
-    poly = pr.polygon(square)
-    if len(poly):
-        p.polygon(poly, GROUND)
-    ticks = np.arange(-g, g + 1e-9, 0.5)
-    n = len(ticks)
-    zeros, lo, hi = np.zeros(n), np.full(n, -g), np.full(n, g)
-    starts = np.concatenate([np.stack([ticks, lo, zeros], 1), np.stack([lo, ticks, zeros], 1)])
-    ends = np.concatenate([np.stack([ticks, hi, zeros], 1), np.stack([hi, ticks, zeros], 1)])
-    major = np.concatenate([np.arange(n) % 2 == 0] * 2)
-    for is_major in (False, True):  # minor lines first, the metre lines over them
-        pick = major == is_major
-        for a, b in pr.segments(starts[pick], ends[pick]):
-            p.line(a, b, GRID_MAJOR if is_major else GRID, 1)
-
-
-def axes(p: Painter, pr: Projector, scene: QuadScene) -> None:
-    """World axes from the origin, 1 m long, labelled."""
-    origin = np.zeros(3)
-    for axis, color, label in (
-        ((1.0, 0, 0), AXIS_X, "x E"),
-        ((0, 1.0, 0), AXIS_Y, "y N"),
-        ((0, 0, 1.0), AXIS_Z, "z"),
-    ):
-        _arrow(p, pr, origin, np.array(axis), color, 2)
-        tip = pr.point(np.array(axis) * 1.15)
-        if tip is not None:
-            p.text(label, tip[0], color, 18, "center", bold=True)
-
-
-def bounds(p: Painter, pr: Projector, scene: QuadScene) -> None:
-    """Wireframe of the target box: x, y in [-h, h], z in [0, 2h]."""
-    h = scene.bounds_half_size
-    corners = [np.array([x, y, z]) for z in (0.0, 2 * h) for x in (-h, h) for y in (-h, h)]
-    for i, a in enumerate(corners):
-        for b in corners[i + 1 :]:
-            if np.count_nonzero(np.abs(a - b) > 1e-9) == 1:  # an edge, not a diagonal
-                _dashed(p, pr, a, b, BOUNDS, 1)
-
-
 def shadow(p: Painter, pr: Projector, position: np.ndarray, radius: float) -> None:
     """A soft dark disc on the ground under a point, and a dashed drop line to it."""
     foot = np.array([position[0], position[1], 0.0])
@@ -257,13 +198,6 @@ def shadow(p: Painter, pr: Projector, position: np.ndarray, radius: float) -> No
         p.translucent_polygon(ring, SHADOW, 60)
 
 
-def trail(p: Painter, pr: Projector, points: np.ndarray) -> None:
-    if len(points) < 2:
-        return
-    for a, b in pr.segments(points[:-1], points[1:]):
-        p.line(a, b, TRAIL, 2)
-
-
 def target(p: Painter, pr: Projector, scene: QuadScene) -> None:
     """The target sphere with a 3-axis crosshair, its line from the drone."""
     if scene.target is None:
@@ -271,7 +205,11 @@ def target(p: Painter, pr: Projector, scene: QuadScene) -> None:
     _line(p, pr, scene.position, scene.target, TARGET_LINE, 1)
     for axis in np.eye(3) * 0.2:
         _line(p, pr, scene.target - axis, scene.target + axis, TARGET, 2)
-    _sphere(p, pr, scene.target, TARGET_RADIUS_M, TARGET)
+    hit = pr.point(scene.target)
+    if hit is not None:
+        r = max(3.0, pr.radius(TARGET_RADIUS_M, hit[1]))
+        p.disc(hit[0], r, TARGET)
+        p.disc(hit[0] - r * 0.3, max(1.0, r * 0.3), tuple(min(255, c + 70) for c in TARGET))
 
 
 def next_waypoint(p: Painter, pr: Projector, scene: QuadScene) -> None:
@@ -284,16 +222,6 @@ def next_waypoint(p: Painter, pr: Projector, scene: QuadScene) -> None:
         r = max(4.0, pr.radius(WAYPOINT_RADIUS_M, hit[1]))
         p.ring(hit[0], r, WAYPOINT, 3)
         p.text("next", hit[0] + np.array([r + 4, -r - 4]), WAYPOINT, 17, "bottomleft")
-
-
-def _sphere(p: Painter, pr: Projector, center: np.ndarray, radius_m: float, color) -> None:
-    hit = pr.point(center)
-    if hit is None:
-        return
-    r = max(3.0, pr.radius(radius_m, hit[1]))
-    p.disc(hit[0], r, color)
-    light = tuple(min(255, c + 70) for c in color)
-    p.disc(hit[0] - r * 0.3, max(1.0, r * 0.3), light)
 
 
 def drone(p: Painter, pr: Projector, scene: QuadScene, scale: float) -> None:
@@ -320,14 +248,13 @@ def drone(p: Painter, pr: Projector, scene: QuadScene, scale: float) -> None:
         if len(level) and scene.motors[i] > 0.02:
             p.translucent_polygon(level, rotor_color(int(i)), 170)
     _arrow(p, pr, pos, rot[:, 2] * UP_ARROW_M, UP, 3)
-    speed = float(np.linalg.norm(scene.velocity))
-    if speed > 0.05:
-        length = min(speed * VELOCITY_SECONDS, MAX_ARROW_M)
-        _arrow(p, pr, pos, scene.velocity / speed * length, VELOCITY, 3)
-    wind = float(np.linalg.norm(scene.wind))
-    if wind > 0.05:
-        length = min(wind * WIND_M_PER_MPS, MAX_ARROW_M)
-        _arrow(p, pr, pos, scene.wind / wind * length, WIND, 2)
+    for vec, m_per_unit, color, width in (
+        (scene.velocity, VELOCITY_SECONDS, VELOCITY, 3),
+        (scene.wind, WIND_M_PER_MPS, WIND, 2),
+    ):
+        size = float(np.linalg.norm(vec))
+        if size > 0.05:
+            _arrow(p, pr, pos, vec / size * min(size * m_per_unit, MAX_ARROW_M), color, width)
     _line(p, pr, pos, pos + rot[:, 0] * arm * 0.8, NOSE, 4)
     hub = pr.point(pos)
     if hub is not None:
@@ -336,49 +263,69 @@ def drone(p: Painter, pr: Projector, scene: QuadScene, scale: float) -> None:
         p.disc(hub[0] - r * 0.28, max(1.0, r * 0.32), BODY_HIGHLIGHT)
 
 
-def world(
-    p: Painter, pr: Projector, scene: QuadScene, trail_points: np.ndarray, drone_scale: float
-) -> None:
+def world(p: Painter, pr: Projector, scene: QuadScene, trail: np.ndarray, scale: float) -> None:
     """The whole 3D scene, back to front."""
-    ground(p, pr, scene)
-    axes(p, pr, scene)
-    bounds(p, pr, scene)
+    # The ground and its grid on 0.5 m lines, wide enough for the target box and a margin.
+    g = math.ceil((scene.bounds_half_size * 2.0 + 1.0) * 2.0) / 2.0
+    poly = pr.polygon(np.array([[-g, -g, 0.0], [g, -g, 0.0], [g, g, 0.0], [-g, g, 0.0]]))
+    if len(poly):
+        p.polygon(poly, GROUND)
+    ticks = np.arange(-g, g + 1e-9, 0.5)
+    n = len(ticks)
+    zeros, lo, hi = np.zeros(n), np.full(n, -g), np.full(n, g)
+    starts = np.concatenate([np.stack([ticks, lo, zeros], 1), np.stack([lo, ticks, zeros], 1)])
+    ends = np.concatenate([np.stack([ticks, hi, zeros], 1), np.stack([hi, ticks, zeros], 1)])
+    major = np.concatenate([np.arange(n) % 2 == 0] * 2)
+    for is_major in (False, True):  # minor lines first, the metre lines over them
+        pick = major == is_major
+        for a, b in pr.segments(starts[pick], ends[pick]):
+            p.line(a, b, GRID_MAJOR if is_major else GRID, 1)
+    for axis, (color, label) in zip(np.eye(3), AXES, strict=True):
+        _arrow(p, pr, np.zeros(3), axis, color, 2)
+        tip = pr.point(axis * 1.15)
+        if tip is not None:
+            p.text(label, tip[0], color, 18, "center", bold=True)
+    # The target box's wireframe: x, y in [-h, h], z in [0, 2h].
+    h = scene.bounds_half_size
+    corners = [np.array([x, y, z]) for z in (0.0, 2 * h) for x in (-h, h) for y in (-h, h)]
+    for i, a in enumerate(corners):
+        for b in corners[i + 1 :]:
+            if np.count_nonzero(np.abs(a - b) > 1e-9) == 1:  # an edge, not a diagonal
+                _dashed(p, pr, a, b, BOUNDS, 1)
     for point, radius in ((scene.target, 0.1), (scene.next_waypoint, 0.07)):
         if point is not None:
             shadow(p, pr, point, radius)
-    shadow(p, pr, scene.position, 0.7 * scene.arm_length * drone_scale)
-    trail(p, pr, trail_points)
-    solids = [(lambda: target(p, pr, scene), scene.target)]
-    solids.append((lambda: next_waypoint(p, pr, scene), scene.next_waypoint))
-    solids.append((lambda: drone(p, pr, scene, drone_scale), scene.position))
-    depth = [-float(pr.camera.to_camera(at)[2]) if at is not None else math.inf for _, at in solids]
-    for i in np.argsort(depth, kind="stable"):
-        solids[i][0]()
+    shadow(p, pr, scene.position, 0.7 * scene.arm_length * scale)
+    if len(trail) >= 2:
+        for a, b in pr.segments(trail[:-1], trail[1:]):
+            p.line(a, b, TRAIL, 2)
+    solids = [
+        (scene.target, lambda: target(p, pr, scene)),
+        (scene.next_waypoint, lambda: next_waypoint(p, pr, scene)),
+        (scene.position, lambda: drone(p, pr, scene, scale)),
+    ]
+    depth = [math.inf if at is None else -float(pr.camera.to_camera(at)[2]) for at, _ in solids]
+    for i in np.argsort(depth, kind="stable"):  # far first
+        solids[i][1]()
 
 
 def info_lines(scene: QuadScene) -> list[tuple[str, tuple[int, int, int]]]:
     """The info panel's text: time, step, distance, height, speed, wind, attitude, reward."""
     roll, pitch, yaw = (math.degrees(a) for a in euler_rpy(scene.quaternion))
     distance = (
-        f"{np.linalg.norm(scene.target - scene.position):.2f} m"
-        if scene.target is not None
-        else "-"
+        "-" if scene.target is None else f"{np.linalg.norm(scene.target - scene.position):.2f} m"
     )
     reward = "-" if scene.reward is None else f"{scene.reward:+.3f}"
+    speed, wind = np.linalg.norm(scene.velocity), np.linalg.norm(scene.wind)
     lines = [
         (f"Time {scene.time_s:.2f} s    Step {scene.step}", TEXT),
         (f"Distance {distance}    Height {scene.position[2]:.2f} m", TEXT),
-        (
-            f"Speed {np.linalg.norm(scene.velocity):.2f} m/s    "
-            f"Wind {np.linalg.norm(scene.wind):.2f} m/s",
-            TEXT,
-        ),
+        (f"Speed {speed:.2f} m/s    Wind {wind:.2f} m/s", TEXT),
         (f"Roll {roll:+.1f}°  Pitch {pitch:+.1f}°  Yaw {yaw:+.1f}°", TEXT),
     ]
     if scene.episode_return is not None:
-        lines.append((f"Reward {reward}    Return {scene.episode_return:.2f}", TEXT))
-    else:
-        lines.append((f"Reward {reward}", TEXT))
+        reward += f"    Return {scene.episode_return:.2f}"
+    lines.append((f"Reward {reward}", TEXT))
     if scene.waypoints_reached is not None:
         lines.append((f"Waypoints reached {scene.waypoints_reached}", TEXT))
     if scene.status:
@@ -390,7 +337,7 @@ def info_lines(scene: QuadScene) -> list[tuple[str, tuple[int, int, int]]]:
 def info_panel(p: Painter, scene: QuadScene) -> None:
     lines = info_lines(scene)
     line_h = 24
-    width = max(p.text_size(t, 21)[0] for t, _ in lines) + 28
+    width = max(p.font(21).size(t)[0] for t, _ in lines) + 28
     p.panel((12, 12, width, len(lines) * line_h + 18), PANEL)
     for i, (text, color) in enumerate(lines):
         p.text(text, (26, 22 + i * line_h), color, 21, bold=(color == BAD))
@@ -424,10 +371,9 @@ def axis_gizmo(p: Painter, camera: OrbitCamera) -> None:
     right, up, forward = camera.basis()
     p.disc(origin, 50, (250, 250, 250), (180, 180, 180), 1)
     items = []
-    for axis, color, label in ((0, AXIS_X, "X"), (1, AXIS_Y, "Y"), (2, AXIS_Z, "Z")):
-        unit = np.eye(3)[axis]
+    for unit, (color, label) in zip(np.eye(3), AXES, strict=True):
         tip = origin + np.array([unit @ right, -(unit @ up)]) * 36
-        items.append((float(unit @ forward), tip, color, label))
+        items.append((float(unit @ forward), tip, color, label[0].upper()))
     for _, tip, color, label in sorted(items, key=lambda item: -item[0]):
         p.arrow(origin, tip, color, 3, head_px=8)
         direction = tip - origin
@@ -444,9 +390,7 @@ def wind_dial(p: Painter, scene: QuadScene, camera: OrbitCamera) -> None:
     center = np.array([width - 70.0, 72.0])
     radius = 44.0
     p.disc(center, radius, (255, 255, 255), (0, 0, 0), 2)
-    az = math.radians(camera.azimuth_deg)
-    ground_right = np.array([math.cos(az), -math.sin(az), 0.0])
-    ground_forward = np.array([math.sin(az), math.cos(az), 0.0])
+    ground_forward, ground_right = camera.ground_axes()
     dial = np.array([scene.wind @ ground_right, -(scene.wind @ ground_forward)])
     speed = float(np.linalg.norm(scene.wind))
     horizontal = float(np.hypot(*dial))
@@ -490,17 +434,7 @@ def legend(p: Painter) -> None:
         p.text(label, (x + 26, cy), TEXT, 17, "midleft")
 
 
-def controls_hint(p: Painter) -> None:
-    """Bottom centre in a window: how to move the camera."""
-    width, height = p.surface.get_size()
-    hint = "drag: rotate   wheel: zoom   W/A/S/D: move   Q/E: down/up   R: reset   Esc: close"
-    p.text(hint, (width / 2, height - 8), (90, 90, 100), 17, "midbottom")
-
-
-def default_camera(bounds_half_size: float) -> OrbitCamera:
-    """Looking at the middle of the target box from the south-west, above, the box in view."""
-    h = bounds_half_size
-    return OrbitCamera(look_at=np.array([0.0, 0.0, 0.8 * h]), distance=4.2 * h)
+HINT = "drag: rotate   wheel: zoom   W/A/S/D: move   Q/E: down/up   R: reset   Esc: close"
 
 
 class QuadrotorView(View):
@@ -527,56 +461,83 @@ class QuadrotorView(View):
         trail_steps: int = 400,
         hud: bool = True,
     ) -> None:
-        check_render_mode(render_mode)
         if not drone_scale > 0:
             raise ValueError(f"drone_scale must be > 0, got {drone_scale}")
-        self.drone_scale = float(drone_scale)
-        self.hud = hud
-        self._camera = camera
+        self.drone_scale, self.hud, self.camera = float(drone_scale), hud, camera
         self._trail = FlightPath(max(2, trail_steps))
         super().__init__(render_mode, (width, height), "flyloop - Quadrotor 3D", fps)
-        self._controls: CameraControls | None = None
-
-    @property
-    def camera(self) -> OrbitCamera | None:
-        """The camera (created at the first render from the scene's bounds if not given)."""
-        return self._camera
+        pg = self._pg
+        keys = (pg.K_w, pg.K_s, pg.K_d, pg.K_a, pg.K_e, pg.K_q)
+        moves = ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))
+        self._moves = dict(zip(keys, moves, strict=True))
+        self._held: set[int] = set()
+        self._dragging = False
 
     def world_to_screen(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Pixels (..., 2) of world points (..., 3) and whether each is in front of the camera."""
-        if self._camera is None:
+        if self.camera is None:
             raise RuntimeError("the camera is set up by the first render (or pass camera=...)")
-        return self._camera.project(points, *self.size)
+        return self.camera.project(points, *self.size)
 
     def reset(self) -> None:
         """Forget the trail (an env calls this from reset())."""
         self._trail.clear()
 
+    def _steer(self, camera: OrbitCamera, events: list[Any]) -> None:
+        """Apply this frame's events, then one frame of movement for each key held or pressed
+        in this frame (a tap shorter than a frame still moves once)."""
+        pg = self._pg
+        tapped: set[int] = set()
+        for event in events:
+            if event.type == pg.MOUSEBUTTONDOWN and event.button == 1:
+                self._dragging = True
+            elif event.type == pg.MOUSEBUTTONUP and event.button == 1:
+                self._dragging = False
+            elif event.type == pg.MOUSEMOTION and self._dragging:
+                dx, dy = event.rel
+                # Dragging right turns the world right; dragging down looks from higher up.
+                camera.orbit(-dx * DEGREES_PER_PIXEL, dy * DEGREES_PER_PIXEL)
+            elif event.type == pg.MOUSEWHEEL:
+                distance = camera.distance * ZOOM_STEP ** float(event.y)
+                camera.distance = min(max(distance, MIN_DISTANCE), MAX_DISTANCE)
+            elif event.type == pg.KEYDOWN:
+                if event.key == pg.K_r:
+                    camera.reset()
+                elif event.key in self._moves:
+                    self._held.add(event.key)
+                    tapped.add(event.key)
+            elif event.type == pg.KEYUP:
+                self._held.discard(event.key)
+            elif event.type == pg.WINDOWFOCUSLOST:
+                self._held.clear()
+                self._dragging = False
+        step = MOVE_FRACTION * camera.distance
+        for key in self._held | tapped:
+            forward, right, up = self._moves[key]
+            camera.move(forward * step, right * step, up * step)
+
     def render(self, scene: QuadScene) -> np.ndarray | None:
         """Draw one frame: returns it in rgb_array mode, None in human mode."""
         events = self._events(scene)
-        if self._camera is None:
-            self._camera = default_camera(scene.bounds_half_size)
-        if self._controls is None:
-            self._controls = CameraControls(self._screen.pg, self._camera)
+        if self.camera is None:
+            # Looking at the middle of the target box from the south-west, the box in view.
+            h = scene.bounds_half_size
+            self.camera = OrbitCamera(look_at=np.array([0.0, 0.0, 0.8 * h]), distance=4.2 * h)
         if events is None:
             return None  # the user closed the window
-        self._controls.handle(events)
+        self._steer(self.camera, events)
         self._trail.update(scene.step, scene.position)
-        self._draw(scene)
-        return self._screen.present()
-
-    def _draw(self, scene: QuadScene) -> None:
         p = self._painter
         p.vertical_gradient(BACKGROUND_TOP, BACKGROUND_BOTTOM)
-        projector = Projector(self._camera, self.size)
         trail = self._trail.points
-        world(p, projector, scene, trail if len(trail) else np.zeros((0, 3)), self.drone_scale)
+        world(p, Projector(self.camera, self.size), scene, trail, self.drone_scale)
         if self.hud:
             info_panel(p, scene)
             motor_bars(p, scene)
-            axis_gizmo(p, self._camera)
-            wind_dial(p, scene, self._camera)
+            axis_gizmo(p, self.camera)
+            wind_dial(p, scene, self.camera)
             legend(p)
-            if self.render_mode == "human":
-                controls_hint(p)
+            if self.render_mode == "human":  # bottom centre: how to move the camera
+                width, height = self.size
+                p.text(HINT, (width / 2, height - 8), (90, 90, 100), 17, "midbottom")
+        return self._present()

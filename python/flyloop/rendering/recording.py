@@ -1,8 +1,7 @@
 """Save rgb_array frames as a GIF (Pillow) or a video (ffmpeg from imageio-ffmpeg).
 
 gymnasium's own `gymnasium.wrappers.RecordVideo` also works with flyloop's envs in
-render_mode="rgb_array" (it needs moviepy); these helpers need neither gymnasium's wrapper
-nor moviepy.
+render_mode="rgb_array" (it needs moviepy); these helpers need neither.
 """
 
 from __future__ import annotations
@@ -17,19 +16,6 @@ import numpy as np
 VIDEO_SUFFIXES = (".mp4", ".mkv", ".mov", ".avi", ".webm")
 
 
-def _checked(frames: Iterable[np.ndarray]) -> list[np.ndarray]:
-    out = [np.asarray(f) for f in frames]
-    if not out:
-        raise ValueError("no frames to save")
-    shape = out[0].shape
-    for i, f in enumerate(out):
-        if f.ndim != 3 or f.shape[2] != 3 or f.dtype != np.uint8:
-            raise ValueError(f"frame {i} must be (H, W, 3) uint8, got {f.shape} {f.dtype}")
-        if f.shape != shape:
-            raise ValueError(f"frame {i} is {f.shape}, the first frame is {shape}")
-    return out
-
-
 def save_video(frames: Iterable[np.ndarray], path: str | Path, fps: float = 30.0) -> Path:
     """Write frames ((H, W, 3) uint8, all one size) to path; the suffix picks the format:
     .gif (Pillow) or .mp4/.mkv/.mov/.avi/.webm (imageio-ffmpeg's bundled ffmpeg)."""
@@ -39,12 +25,16 @@ def save_video(frames: Iterable[np.ndarray], path: str | Path, fps: float = 30.0
     suffix = path.suffix.lower()
     if suffix != ".gif" and suffix not in VIDEO_SUFFIXES:
         raise ValueError(f"unsupported file type {suffix!r}: use .gif or one of {VIDEO_SUFFIXES}")
-    checked = _checked(frames)
+    frames = [np.asarray(f) for f in frames]
+    if not frames:
+        raise ValueError("no frames to save")
+    for i, f in enumerate(frames):
+        if f.ndim != 3 or f.shape[2] != 3 or f.dtype != np.uint8:
+            raise ValueError(f"frame {i} must be (H, W, 3) uint8, got {f.shape} {f.dtype}")
+        if f.shape != frames[0].shape:
+            raise ValueError(f"frame {i} is {f.shape}, the first frame is {frames[0].shape}")
     path.parent.mkdir(parents=True, exist_ok=True)
-    if suffix == ".gif":
-        _save_gif(checked, path, fps)
-    else:
-        _save_ffmpeg(checked, path, fps)
+    (_save_gif if suffix == ".gif" else _save_ffmpeg)(frames, path, fps)
     return path
 
 
@@ -87,12 +77,9 @@ def _save_ffmpeg(frames: list[np.ndarray], path: Path, fps: float) -> None:
     height, width = frames[0].shape[:2]
     # H.264 in yuv420p needs even sides: pad by one edge pixel rather than rescale.
     pad_h, pad_w = height % 2, width % 2
+    size = (width + pad_w, height + pad_h)
     writer = imageio_ffmpeg.write_frames(
-        str(path),
-        (width + pad_w, height + pad_h),
-        fps=fps,
-        macro_block_size=1,
-        ffmpeg_log_level="error",
+        str(path), size, fps=fps, macro_block_size=1, ffmpeg_log_level="error"
     )
     writer.send(None)
     try:
