@@ -76,8 +76,6 @@ class Config:
     # end of the return (True) with the time remaining (1 - step / max_steps) as an extra
     # input of the value function only (the policy's inputs stay the env's observation).
     time_limit_terminal: bool = False
-    # Weight of the policy's entropy (summed over its Gaussian's coordinates) in the loss.
-    entropy_coef: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -117,7 +115,8 @@ LANDER = Config(
 # step 999), so hovering until the time limit cost little more than landing late; training
 # seeds found the landing late or lost it again (held-out 23.5 / 99 / 100 % at 7M, 87 / 78 /
 # 57.5 % at 10M). With the time limit terminal and the time remaining as the critic's input
-# (the policy's inputs unchanged), seeds 0, 1 and 2 land SEE_DOCS (docs/training.md).
+# (the policy's inputs unchanged), seeds 0, 1 and 2 land 99.5 / 100 / 95.5 % of their
+# held-out episodes after 7M env steps (docs/training.md).
 LANDER_MOVING = replace(LANDER, epochs=5, minibatches=16, lr_end=0.0, time_limit_terminal=True)
 
 TASKS: dict[str, Task] = {
@@ -456,8 +455,6 @@ def update(
             policy_loss = -torch.min(ratio * a, ratio.clamp(1 - cfg.clip, 1 + cfg.clip) * a).mean()
             value_loss = (model.value(critic_obs[idx]).squeeze(-1) - ret[idx]).pow(2).mean()
             loss = policy_loss + cfg.value_coef * value_loss
-            if cfg.entropy_coef:
-                loss = loss - cfg.entropy_coef * d.entropy().sum(-1).mean()
             optimiser.zero_grad()
             loss.backward()
             nn.utils.clip_grad_norm_(model.parameters(), cfg.max_grad_norm)
