@@ -74,7 +74,11 @@ class SavedRun:
         obs_size, act_size = state["mu.0.weight"].shape[1], state["log_std"].shape[0]
         config = self.summary["config"]
         basis = config.get("action_basis", "motors")
-        self.model = ActorCritic(obs_size, act_size, config["hidden"], basis=basis)
+        # The critic's extra input (the time remaining) when the run was timed.
+        extra = int(config.get("time_limit_terminal", False))
+        self.model = ActorCritic(
+            obs_size, act_size, config["hidden"], basis=basis, value_extra=extra
+        )
         self.model.load_state_dict(state)
         self.model.eval()
         self.norm = RunningNorm(obs_size)

@@ -85,7 +85,8 @@ def test_fast_ppo_short_lander_run_beats_random_actions(tmp_path):
 @pytest.mark.training
 def test_fast_ppo_lander_learns_the_same_over_the_sitl_as_in_process(tmp_path, sitl_binary):
     """As for hover, with the moving pad's settings (reward scale, minibatches, the learning
-    rate falling to 0, the Gaussian over collective and differential thrust; 8 updates): both
+    rate falling to 0, the Gaussian over collective and differential thrust, the time limit
+    terminal with the time remaining as the critic's input; 8 updates): both
     backends give the same updates and the same held-out evaluation."""
     done = run_script(
         TRAIN / "fast_ppo.py",
@@ -98,6 +99,7 @@ def test_fast_ppo_lander_learns_the_same_over_the_sitl_as_in_process(tmp_path, s
     assert native["env_steps"] == sitl["env_steps"] == 16_384
     assert native["config"] == sitl["config"] and native["config"]["reward_scale"] < 1.0
     assert native["config"]["action_basis"] == "collective" and native["config"]["lr_end"] == 0.0
+    assert native["config"]["time_limit_terminal"] is True
     strip = [{k: v for k, v in r.items() if k != "wall_s"} for r in native["rows"]]
     assert len(strip) == 8
     assert strip == [{k: v for k, v in r.items() if k != "wall_s"} for r in sitl["rows"]]

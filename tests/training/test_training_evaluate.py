@@ -141,15 +141,18 @@ def test_training_continues_from_a_saved_run_with_a_decaying_learning_rate(tmp_p
 def test_evaluate_loads_a_fast_ppo_run(tmp_path):
     """evaluate.py loads fast_ppo.py's folder (policy.pt, summary.json): the same deterministic
     policy on the same seeded episodes as fast_ppo.py's own held-out evaluation (a batched
-    forward pass there, one observation at a time here: floats may differ in the last bits)."""
+    forward pass there, one observation at a time here: floats may differ in the last bits).
+    The moving pad's run: its critic has the time remaining as an extra input."""
     done = run_script(
         TRAIN / "fast_ppo.py",
-        *("--env", "lander", "--timesteps", "16384", "--num-envs", "16"),
+        *("--env", "lander_moving", "--timesteps", "16384", "--num-envs", "16"),
         *("--eval-episodes", "4", "--out", str(tmp_path), "--no-progress-bar"),
     )
     assert done.returncode == 0, done.stderr[-3000:]
     run = tmp_path / "native"
-    own = json.loads((run / "summary.json").read_text())["evaluation"]
+    saved = json.loads((run / "summary.json").read_text())
+    assert saved["config"]["time_limit_terminal"] is True
+    own = saved["evaluation"]
     stdout, result = evaluate_cli(run, tmp_path, episodes=4)
     assert "success rate" in stdout
     assert result["env_id"] == "flyloop/Lander2D-v1" and result["first_seed"] == own["seed"]
