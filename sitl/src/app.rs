@@ -2,8 +2,7 @@
 //! A library function so the binary and the Python wheel's `flyloop-sitl` command share it.
 
 use crate::cli::{Args, GcsTarget, ListFormat};
-use crate::config::{self, ConfigError};
-use crate::px4::config::Px4Config;
+use crate::config::{self, AutopilotVehicle, ConfigError};
 use crate::px4::server::Pacing;
 use crate::px4::session::{Session, SessionOptions};
 use crate::px4::track::Track;
@@ -115,13 +114,13 @@ fn describe_frame(task: TaskKind, config: &TaskConfig) -> Result<String, ParamEr
 /// a signal.
 fn start_px4(args: Args) -> Result<(), StartError> {
     quadrotor_only(&args, "--px4")?;
-    let mut config = vehicle_config(&args)?;
-    config.sensors.home_latitude = args.home.latitude_deg;
-    config.sensors.home_longitude = args.home.longitude_deg;
-    config.sensors.home_altitude = args.home.altitude_m;
+    let mut vehicle = vehicle_config(&args)?;
+    vehicle.sensors.home_latitude = args.home.latitude_deg;
+    vehicle.sensors.home_longitude = args.home.longitude_deg;
+    vehicle.sensors.home_altitude = args.home.altitude_m;
     let step_us = (args.px4_step * 1e6).round() as u64;
     let mut session = Session::new(&SessionOptions {
-        config,
+        vehicle,
         step_us,
         seed: args.seed,
     })?;
@@ -192,19 +191,19 @@ fn track(args: &Args) -> Result<Option<Track>, StartError> {
 }
 
 /// The vehicle of the autopilot modes: `--config`, else the Iris preset.
-fn vehicle_config(args: &Args) -> Result<Px4Config, StartError> {
+fn vehicle_config(args: &Args) -> Result<AutopilotVehicle, StartError> {
     Ok(match &args.config {
-        Some(path) => config::read(path, Px4Config::parse)?,
-        None => Px4Config::iris(),
+        Some(path) => config::load_autopilot_vehicle(path)?,
+        None => AutopilotVehicle::iris(),
     })
 }
 
 /// ArduPilot mode: the vehicle, the UDP socket, then ArduPilot's frames until a signal.
 fn start_ardupilot(args: Args) -> Result<(), StartError> {
     quadrotor_only(&args, "--ardupilot")?;
-    let config = vehicle_config(&args)?;
+    let vehicle = vehicle_config(&args)?;
     let mut session = ardupilot::session::Session::new(&ardupilot::session::SessionOptions {
-        config,
+        vehicle,
         seed: args.seed,
     })?;
     if let Some(track) = track(&args)? {

@@ -59,7 +59,8 @@ pub struct Args {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
 
-    /// Parameter file (flat TOML: the model's and the task's parameters by name).
+    /// Parameter file (flat TOML of parameters by name: the model's and the task's, or with
+    /// --px4 / --ardupilot the vehicle's quadrotor and sensor parameters).
     #[arg(long)]
     pub config: Option<PathBuf>,
 

@@ -3,8 +3,8 @@
 
 use super::packet::{self, MAX_PWM, PacketError, ServoFrame};
 use super::reply::{self, State};
+use crate::config::AutopilotVehicle;
 use crate::kinematics::{attitude_ned, enu_to_ned, flu_to_frd};
-use crate::px4::config::Px4Config;
 use crate::px4::track::Track;
 use flyloop_core::ParamError;
 use flyloop_core::quadrotor::Quadrotor;
@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 #[derive(Debug, Clone)]
 pub struct SessionOptions {
     /// The vehicle and its sensors (the IMU's noise and bias; ArduPilot models the rest).
-    pub config: Px4Config,
+    pub vehicle: AutopilotVehicle,
     /// Seed of the vehicle's and the IMU's random generators.
     pub seed: u64,
 }
@@ -139,7 +139,7 @@ pub enum Outcome {
 impl Session {
     /// The vehicle at rest on its landing gear at home, facing north.
     pub fn new(options: &SessionOptions) -> Result<Self, ParamError> {
-        let c = &options.config;
+        let c = &options.vehicle;
         let quad = Quadrotor::standing(c.quadrotor.clone(), options.seed)?;
         let sensors = Sensors::new(c.sensors.clone(), options.seed)?;
         Ok(Session {

@@ -1,9 +1,9 @@
 //! One vehicle flown by one PX4 connection, without sockets: bytes from PX4 in, bytes for PX4
 //! out. The server feeds it; tests drive it directly.
 
-use super::config::Px4Config;
 use super::messages;
 use super::track::Track;
+use crate::config::AutopilotVehicle;
 use crate::kinematics::{Home, Kinematics};
 use crate::stats::Stats;
 use crate::telemetry;
@@ -20,7 +20,7 @@ const SIMULATOR_SYSTEM: u8 = 1;
 /// What a session is built from.
 #[derive(Debug, Clone)]
 pub struct SessionOptions {
-    pub config: Px4Config,
+    pub vehicle: AutopilotVehicle,
     /// Physics step per controls message, µs (PX4 expects 4000).
     pub step_us: u64,
     /// Seed of the vehicle's and the sensors' random generators.
@@ -54,7 +54,7 @@ pub struct Session {
 impl Session {
     /// The vehicle at rest on its landing gear at the origin, facing north.
     pub fn new(options: &SessionOptions) -> Result<Self, ParamError> {
-        let c = &options.config;
+        let c = &options.vehicle;
         let mut quad = Quadrotor::standing(c.quadrotor.clone(), options.seed)?;
         // One step with the motors off: the state PX4's first controls meet.
         quad.step(options.step_us.max(1) as f64 * 1e-6);
