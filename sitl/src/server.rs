@@ -7,6 +7,8 @@ use crate::wire;
 use std::future::pending;
 use std::io;
 use std::net::SocketAddr;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 use tokio::net::UdpSocket;
 use tokio::signal::unix::{SignalKind, signal};
@@ -72,6 +74,38 @@ impl Shutdown {
 /// How long a blocking receive of the autopilot modes waits before it looks at its stop flag
 /// again.
 pub(crate) const STOP_POLL: std::time::Duration = std::time::Duration::from_millis(100);
+
+/// Runs `work` on a thread of its own (the autopilot modes' blocking socket loops) until it
+/// returns; a signal meanwhile sets the stop flag `work` watches. `beside` runs again and
+/// again while waiting (PX4 mode refuses second connections there). Returns what `work`
+/// returned and whether a signal came: a signal taken while `work` was ending on its own is
+/// still a stop (e.g. PX4 closing the socket must not swallow it). `thread` names the thread
+/// in the error if it panicked.
+pub(crate) async fn on_stoppable_thread<T: Send + 'static>(
+    thread: &str,
+    shutdown: &mut Shutdown,
+    work: impl FnOnce(&AtomicBool) -> T + Send + 'static,
+    mut beside: impl AsyncFnMut(),
+) -> io::Result<(T, bool)> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let mut worker = tokio::task::spawn_blocking(move || work(&flag));
+    let mut stopping = false;
+    loop {
+        tokio::select! {
+            biased;
+            joined = &mut worker => match joined {
+                Ok(done) => return Ok((done, stopping)),
+                Err(e) => return Err(io::Error::other(format!("{thread} failed: {e}"))),
+            },
+            _ = shutdown.signalled(), if !stopping => {
+                stop.store(true, Ordering::Relaxed);
+                stopping = true;
+            }
+            () = beside() => {}
+        }
+    }
+}
 
 /// Whether a blocking receive's error only means "nothing yet, try again".
 pub(crate) fn is_retry(kind: io::ErrorKind) -> bool {
