@@ -209,27 +209,45 @@ impl Session {
     /// A datagram from `from`.
     pub fn receive(&mut self, bytes: &[u8], from: SocketAddr) -> Outcome {
         self.stats.datagrams += 1;
-        let frame = match packet::parse(bytes) {
-            Ok(frame) => frame,
-            Err(e) => {
-                let kind = match e {
-                    PacketError::Length(_) => {
-                        self.stats.bad_length += 1;
-                        Kind::Length
-                    }
-                    PacketError::Magic { .. } => {
-                        self.stats.bad_magic += 1;
-                        Kind::Magic
-                    }
-                    PacketError::FrameRate => {
-                        self.stats.bad_frame_rate += 1;
-                        Kind::FrameRate
-                    }
-                };
-                self.log_once(kind, format_args!("datagram from {from} skipped: {e}"));
-                return Outcome::Skipped;
+        let Some(frame) = self.servo_frame(bytes, from) else {
+            return Outcome::Skipped;
+        };
+        if !self.is_new_frame(&frame, from) {
+            return Outcome::Repeated;
+        }
+        self.step(&frame);
+        self.last = Some((frame.frame_count, from));
+        Outcome::Stepped
+    }
+
+    /// The datagram's servo frame; `None` for bad input (counted by kind, logged once).
+    fn servo_frame(&mut self, bytes: &[u8], from: SocketAddr) -> Option<ServoFrame> {
+        let e = match packet::parse(bytes) {
+            Ok(frame) => return Some(frame),
+            Err(e) => e,
+        };
+        let kind = match e {
+            PacketError::Length(_) => {
+                self.stats.bad_length += 1;
+                Kind::Length
+            }
+            PacketError::Magic { .. } => {
+                self.stats.bad_magic += 1;
+                Kind::Magic
+            }
+            PacketError::FrameRate => {
+                self.stats.bad_frame_rate += 1;
+                Kind::FrameRate
             }
         };
+        self.log_once(kind, format_args!("datagram from {from} skipped: {e}"));
+        None
+    }
+
+    /// Whether `frame` is a new one to step; false for the last frame again (counted). The
+    /// first frame connects an ArduPilot; a frame count that went back is a restarted one
+    /// (the vehicle reset, a new connection); one that skipped ahead is a gap (counted).
+    fn is_new_frame(&mut self, frame: &ServoFrame, from: SocketAddr) -> bool {
         match self.last {
             None => {
                 tracing::info!(%from, frame_count = frame.frame_count, frame_rate = frame.frame_rate, "ArduPilot connected: lockstep");
@@ -238,7 +256,7 @@ impl Session {
             Some((count, peer)) if frame.frame_count == count && peer == from => {
                 self.stats.repeats += 1;
                 tracing::debug!(frame_count = count, "frame repeated: answered again");
-                return Outcome::Repeated;
+                return false;
             }
             Some((count, peer)) if frame.frame_count <= count => {
                 tracing::warn!(
@@ -264,9 +282,7 @@ impl Session {
             }
             Some(_) => {}
         }
-        self.step(&frame);
-        self.last = Some((frame.frame_count, from));
-        Outcome::Stepped
+        true
     }
 
     /// A new ArduPilot: counted, and a new connection number in the track.
