@@ -5,7 +5,7 @@ use crate::cli::{Args, GcsTarget, ListFormat};
 use crate::config::{self, AutopilotVehicle, ConfigError};
 use crate::px4::server::Pacing;
 use crate::px4::session::{Session, SessionOptions};
-use crate::px4::track::Track;
+use crate::track::Track;
 use crate::server::{self, GcsLink};
 use crate::sim::{Sim, SimOptions};
 use crate::{ardupilot, px4};
@@ -125,7 +125,7 @@ fn start_px4(args: Args) -> Result<(), StartError> {
         seed: args.seed,
     })?;
     if let Some(track) = track(&args)? {
-        session.set_track(track);
+        session.track.set(track);
     }
     let listener =
         std::net::TcpListener::bind(args.px4_listen).map_err(|source| StartError::Bind {
@@ -207,7 +207,7 @@ fn start_ardupilot(args: Args) -> Result<(), StartError> {
         seed: args.seed,
     })?;
     if let Some(track) = track(&args)? {
-        session.set_track(track);
+        session.track.set(track);
     }
     let socket =
         std::net::UdpSocket::bind(args.ardupilot_listen).map_err(|source| StartError::Bind {

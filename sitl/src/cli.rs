@@ -122,7 +122,7 @@ pub struct Args {
 
     /// PX4 and ArduPilot modes: simulation time between two rows of the track, µs (4000 =
     /// every PX4 step).
-    #[arg(long, default_value_t = crate::px4::track::TRACK_INTERVAL_US, value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long, default_value_t = crate::track::TRACK_INTERVAL_US, value_parser = clap::value_parser!(u64).range(1..))]
     pub track_interval_us: u64,
 
     /// Print the task's parameters and exit: `table` (MAVLink ids, names, ranges, defaults;

@@ -12,7 +12,8 @@
 //! - [`config`]: the parameter file of every mode (the task's, or the autopilot modes' vehicle),
 //! - [`px4`]: PX4 mode, flyloop as PX4's simulator over TCP,
 //! - [`ardupilot`]: ArduPilot mode, flyloop as ArduPilot's JSON physics backend over UDP,
-//! - [`pacer`]: the wall-clock pacer of both autopilot modes.
+//! - [`pacer`]: the wall-clock pacer of both autopilot modes,
+//! - [`track`]: their ground-truth track file (`--track`).
 
 pub mod app;
 pub mod ardupilot;
@@ -32,5 +33,6 @@ pub mod starter_config;
 pub mod stats;
 pub mod task_frame;
 pub mod telemetry;
+pub mod track;
 pub mod vehicle;
 pub mod wire;

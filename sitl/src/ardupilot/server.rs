@@ -28,7 +28,7 @@ pub async fn run(
     socket.set_read_timeout(Some(STOP_POLL))?;
     let work = move |stop: &AtomicBool| {
         serve(&mut session, &socket, pacing, stop);
-        session.flush_track();
+        session.track.flush();
         session
     };
     let (session, _) = on_stoppable_thread("ArduPilot thread", &mut shutdown, work, async || {
@@ -76,7 +76,7 @@ fn serve(session: &mut Session, socket: &UdpSocket, pacing: Pacing, stop: &Atomi
                         "no servo packet from ArduPilot for {:.1} s: stopped or killed? The vehicle holds; a restarted ArduPilot resets it",
                         SILENCE.as_secs_f64()
                     );
-                    session.flush_track();
+                    session.track.flush();
                 }
             }
             Err(e) => {

@@ -5,7 +5,8 @@ use super::packet::{self, MAX_PWM, PacketError, ServoFrame};
 use super::reply::{self, State};
 use crate::config::AutopilotVehicle;
 use crate::kinematics::{attitude_ned, enu_to_ned, flu_to_frd};
-use crate::px4::track::Track;
+use crate::stats::us_per;
+use crate::track::SessionTrack;
 use flyloop_core::ParamError;
 use flyloop_core::quadrotor::Quadrotor;
 use flyloop_core::sensors::Sensors;
@@ -61,13 +62,6 @@ impl Counters {
 
 impl fmt::Display for Counters {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let per = |d: Duration, n: u64| {
-            if n == 0 {
-                0.0
-            } else {
-                d.as_secs_f64() * 1e6 / n as f64
-            }
-        };
         write!(
             f,
             "datagrams={} steps={} repeats={} connections={} gaps={} bad_length={} bad_magic={} \
@@ -84,8 +78,8 @@ impl fmt::Display for Counters {
             self.absurd_pwm,
             self.non_finite,
             self.io_errors,
-            per(self.handling, self.datagrams),
-            per(self.physics, self.steps),
+            us_per(self.handling, self.datagrams),
+            us_per(self.physics, self.steps),
         )
     }
 }
@@ -121,7 +115,8 @@ pub struct Session {
     reply: Vec<u8>,
     /// Kinds of bad input already logged.
     logged: u8,
-    track: Option<Track>,
+    /// Ground-truth CSV (`--track`), if any.
+    pub track: SessionTrack,
     pub stats: Counters,
 }
 
@@ -150,30 +145,9 @@ impl Session {
             last: None,
             reply: Vec::with_capacity(512),
             logged: 0,
-            track: None,
+            track: SessionTrack::default(),
             stats: Counters::default(),
         })
-    }
-
-    /// Writes the ground truth to `track` from now on (a new `connection` number per
-    /// ArduPilot).
-    pub fn set_track(&mut self, track: Track) {
-        self.track = Some(track);
-    }
-
-    /// Writes out buffered track rows.
-    pub fn flush_track(&mut self) {
-        if let Some(track) = &mut self.track {
-            let result = track.flush();
-            self.track_result(result);
-        }
-    }
-
-    fn track_result(&mut self, result: std::io::Result<()>) {
-        if let Err(e) = result {
-            tracing::error!(error = %e, "writing the track failed: track stopped");
-            self.track = None;
-        }
     }
 
     /// Physics time of the last reply, µs.
@@ -288,10 +262,7 @@ impl Session {
     /// A new ArduPilot: counted, and a new connection number in the track.
     fn connect(&mut self) {
         self.stats.connections += 1;
-        if let Some(track) = &mut self.track {
-            let result = track.connect();
-            self.track_result(result);
-        }
+        self.track.connect();
     }
 
     /// The vehicle and IMU back to their start state, physics time to 0.
@@ -354,11 +325,7 @@ impl Session {
             );
         }
         reply::write(&mut self.reply, &state);
-        let time_us = self.time_us;
-        if let Some(track) = &mut self.track {
-            let result = track.record(time_us, &self.quad);
-            self.track_result(result);
-        }
+        self.track.record(self.time_us, &self.quad);
     }
 
     /// The body rates without noise, FRD (for tests).

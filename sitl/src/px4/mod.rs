@@ -24,10 +24,8 @@
 //!
 //! - [`messages`]: HIL_SENSOR / HIL_GPS from the core's sensor readings,
 //! - [`session`]: one vehicle flown by one PX4 connection, without sockets,
-//! - [`server`]: the TCP listener, the pacing and the connection life cycle,
-//! - [`track`]: the ground-truth track file (`--track`).
+//! - [`server`]: the TCP listener, the pacing and the connection life cycle.
 
 pub mod messages;
 pub mod server;
 pub mod session;
-pub mod track;

@@ -95,7 +95,7 @@ async fn connection(
 ) -> io::Result<(Session, End)> {
     let work = move |stop: &AtomicBool| {
         let end = serve(&mut session, stream, pacing, stop);
-        session.flush_track();
+        session.track.flush();
         (session, end)
     };
     let refuse_second = async || {

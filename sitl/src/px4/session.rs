@@ -2,11 +2,11 @@
 //! out. The server feeds it; tests drive it directly.
 
 use super::messages;
-use super::track::Track;
 use crate::config::AutopilotVehicle;
 use crate::kinematics::{Home, Kinematics};
 use crate::stats::Stats;
 use crate::telemetry;
+use crate::track::SessionTrack;
 use crate::wire::{Encoder, StreamDecoder};
 use flyloop_core::ParamError;
 use flyloop_core::quadrotor::Quadrotor;
@@ -47,7 +47,7 @@ pub struct Session {
     decoder: StreamDecoder,
     encoder: Encoder,
     /// Ground-truth CSV (`--track`), if any.
-    track: Option<Track>,
+    pub track: SessionTrack,
     pub stats: Stats,
 }
 
@@ -77,7 +77,7 @@ impl Session {
             gps_epoch_us: 0,
             decoder: StreamDecoder::default(),
             encoder: Encoder::default(),
-            track: None,
+            track: SessionTrack::default(),
             stats: Stats::default(),
         })
     }
@@ -94,32 +94,8 @@ impl Session {
         self.next_state_us = 0;
         self.gps_epoch_us = gps_epoch_us;
         self.decoder.clear();
-        if let Some(track) = &mut self.track {
-            let result = track.connect();
-            self.track_result(result);
-        }
+        self.track.connect();
         self.emit(out);
-    }
-
-    /// Writes the ground truth to `track` from now on.
-    pub fn set_track(&mut self, track: Track) {
-        self.track = Some(track);
-    }
-
-    /// Writes out buffered track rows (on disconnect and shutdown).
-    pub fn flush_track(&mut self) {
-        if let Some(track) = &mut self.track {
-            let result = track.flush();
-            self.track_result(result);
-        }
-    }
-
-    /// A failed track write is logged once and ends the track; the flight goes on.
-    fn track_result(&mut self, result: std::io::Result<()>) {
-        if let Err(e) = result {
-            tracing::error!(error = %e, "writing the track failed: track stopped");
-            self.track = None;
-        }
     }
 
     /// Whether PX4 drives the steps (its first controls have arrived).
@@ -230,10 +206,7 @@ impl Session {
         let reading = self.sensors.sample(&self.quad, dt);
         let sensor = messages::hil_sensor(&reading, self.time_us);
         self.encoder.push(out, SIMULATOR_SYSTEM, &sensor);
-        if let Some(track) = &mut self.track {
-            let result = track.record(self.time_us, &self.quad);
-            self.track_result(result);
-        }
+        self.track.record(self.time_us, &self.quad);
         if let Some(fix) = self.sensors.gps(&self.quad, self.time_us as f64 * 1e-6) {
             let stamp = self.gps_epoch_us + (fix.measured_at * 1e6).round() as u64;
             self.encoder
