@@ -51,7 +51,7 @@ pub async fn run(
         };
         connections += 1;
         tracing::info!(%peer, connection = connections, "PX4 connected");
-        let Some(stream) = blocking(stream, peer) else {
+        let Some(stream) = blocking_stream(stream, peer) else {
             continue;
         };
         let end;
@@ -74,7 +74,7 @@ pub async fn run(
 
 /// The accepted stream for the connection thread's blocking calls; `None` (logged) if the
 /// socket refuses.
-fn blocking(stream: tokio::net::TcpStream, peer: SocketAddr) -> Option<TcpStream> {
+fn blocking_stream(stream: tokio::net::TcpStream, peer: SocketAddr) -> Option<TcpStream> {
     let stream = stream.into_std().and_then(|s| {
         s.set_nonblocking(false)?;
         Ok(s)

@@ -101,10 +101,8 @@ impl Sim {
                 self.stats.refused_requests += 1;
                 tracing::debug!(error = %e, "reset refused");
                 for i in targets {
-                    let denied = MavResult::MAV_RESULT_DENIED;
-                    self.ack(link, out, i, header, c.command, denied);
-                    let text = format!("reset refused: {e}");
-                    self.push_text(link, out, i, MavSeverity::MAV_SEVERITY_ERROR, &text);
+                    let why = format!("reset refused: {e}");
+                    self.refuse_reset(link, out, i, header, MavResult::MAV_RESULT_DENIED, &why);
                 }
             }
         }
@@ -140,6 +138,8 @@ impl Sim {
         }
     }
 
+    /// Resets vehicle `i` with `seed` and acknowledges it; the peer that asked (controller
+    /// link) gets the new state as a step's reply carries it.
     fn reset_vehicle(
         &mut self,
         link: Link,
@@ -162,12 +162,24 @@ impl Sim {
             }
             Err(e) => {
                 self.stats.refused_requests += 1;
-                let failed = MavResult::MAV_RESULT_FAILED;
-                self.ack(link, out, i, header, RESET_COMMAND, failed);
-                let text = format!("reset failed: {e}");
-                self.push_text(link, out, i, MavSeverity::MAV_SEVERITY_ERROR, &text);
+                let why = format!("reset failed: {e}");
+                self.refuse_reset(link, out, i, header, MavResult::MAV_RESULT_FAILED, &why);
             }
         }
+    }
+
+    /// A reset vehicle `i` did not do: acknowledged with `result`, and `why` as an error text.
+    fn refuse_reset(
+        &mut self,
+        link: Link,
+        out: &mut Vec<u8>,
+        i: usize,
+        header: MavHeader,
+        result: MavResult,
+        why: &str,
+    ) {
+        self.ack(link, out, i, header, RESET_COMMAND, result);
+        self.push_text(link, out, i, MavSeverity::MAV_SEVERITY_ERROR, why);
     }
 
     /// SET_MESSAGE_INTERVAL: on the controller link it chooses what the sending peer gets
