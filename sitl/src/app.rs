@@ -2,13 +2,12 @@
 //! A library function so the binary and the Python wheel's `flyloop-sitl` command share it.
 
 use crate::cli::{Args, GcsTarget, ListFormat};
-use crate::config::{self, ConfigError};
-use crate::px4::config::Px4Config;
+use crate::config::{self, AutopilotVehicle, ConfigError};
 use crate::px4::server::Pacing;
 use crate::px4::session::{Session, SessionOptions};
-use crate::px4::track::Track;
 use crate::server::{self, GcsLink};
 use crate::sim::{Sim, SimOptions};
+use crate::track::Track;
 use crate::{ardupilot, px4};
 use crate::{param_table, starter_config, task_frame};
 use clap::Parser;
@@ -72,25 +71,13 @@ fn bind(link: &'static str, addr: SocketAddr) -> Result<std::net::UdpSocket, Sta
 fn describe_frame(task: TaskKind, config: &TaskConfig) -> Result<String, ParamError> {
     let t = TaskInstance::build(task, config)?;
     let n = t.observation_size();
+    let info = task_frame::info_layout(&t);
+    let values = task_frame::HEADER_LEN + n + info.iter().map(|e| e.2).sum::<usize>();
     let mut out = format!(
-        "task frame of `{}` (DEBUG_FLOAT_ARRAY name \"{}\", {} values over {} array(s) of {})\n",
-        task.frame_name(),
-        task.frame_name(),
-        task_frame::HEADER_LEN
-            + n
-            + task_frame::info_layout(&t)
-                .iter()
-                .map(|e| e.2)
-                .sum::<usize>(),
-        1 + (task_frame::HEADER_LEN
-            + n
-            + task_frame::info_layout(&t)
-                .iter()
-                .map(|e| e.2)
-                .sum::<usize>()
-            - 1)
-            / task_frame::ARRAY_LEN,
-        task_frame::ARRAY_LEN
+        "task frame of `{name}` (DEBUG_FLOAT_ARRAY name \"{name}\", {values} values over {} array(s) of {})\n",
+        values.div_ceil(task_frame::ARRAY_LEN),
+        task_frame::ARRAY_LEN,
+        name = task.frame_name(),
     );
     out.push_str("0 reward\n1 terminated\n2 truncated\n3 step\n4 n_obs\n5 n_info\n");
     out.push_str(&format!(
@@ -98,7 +85,7 @@ fn describe_frame(task: TaskKind, config: &TaskConfig) -> Result<String, ParamEr
         task_frame::HEADER_LEN,
         task_frame::HEADER_LEN + n
     ));
-    for (name, at, count) in task_frame::info_layout(&t) {
+    for (name, at, count) in info {
         if count == 1 {
             out.push_str(&format!("{at} info.{name}\n"));
         } else {
@@ -115,18 +102,18 @@ fn describe_frame(task: TaskKind, config: &TaskConfig) -> Result<String, ParamEr
 /// a signal.
 fn start_px4(args: Args) -> Result<(), StartError> {
     quadrotor_only(&args, "--px4")?;
-    let mut config = vehicle_config(&args)?;
-    config.sensors.home_latitude = args.home.latitude_deg;
-    config.sensors.home_longitude = args.home.longitude_deg;
-    config.sensors.home_altitude = args.home.altitude_m;
+    let mut vehicle = vehicle_config(&args)?;
+    vehicle.sensors.home_latitude = args.home.latitude_deg;
+    vehicle.sensors.home_longitude = args.home.longitude_deg;
+    vehicle.sensors.home_altitude = args.home.altitude_m;
     let step_us = (args.px4_step * 1e6).round() as u64;
     let mut session = Session::new(&SessionOptions {
-        config,
+        vehicle,
         step_us,
         seed: args.seed,
     })?;
     if let Some(track) = track(&args)? {
-        session.set_track(track);
+        session.track.set(track);
     }
     let listener =
         std::net::TcpListener::bind(args.px4_listen).map_err(|source| StartError::Bind {
@@ -141,23 +128,45 @@ fn start_px4(args: Args) -> Result<(), StartError> {
         "flyloop-sitl ready px4={listen} mode=px4 model=quadrotor step_us={step_us} speed_factor={speed} seed={}",
         args.seed
     );
+    let pacing = Pacing {
+        speed_factor: speed,
+    };
+    serve_until_signal(
+        |shutdown| {
+            let listener = tokio::net::TcpListener::from_std(listener)?;
+            Ok(async move {
+                Ok(px4::server::run(session, listener, pacing, shutdown)
+                    .await?
+                    .stats)
+            })
+        },
+        || {
+            println!("{ready}");
+            tracing::info!(%listen, speed_factor = speed, "flyloop-sitl waiting for PX4");
+        },
+    )
+}
+
+/// Runs a mode's server on one thread until a signal. `server` makes its future from the
+/// bound sockets inside the runtime; `announce` says the SITL is ready once the sockets and
+/// the signal handlers are in place (so an early signal still stops it cleanly). The counters
+/// the server returns are logged at the stop.
+fn serve_until_signal<F, S>(
+    server: impl FnOnce(server::Shutdown) -> std::io::Result<F>,
+    announce: impl FnOnce(),
+) -> Result<(), StartError>
+where
+    F: Future<Output = std::io::Result<S>>,
+    S: std::fmt::Display,
+{
     let runtime = single_thread_runtime()?;
-    let session = runtime.block_on(async move {
+    let stats = runtime.block_on(async move {
         let shutdown = server::Shutdown::install()?;
-        let listener = tokio::net::TcpListener::from_std(listener)?;
-        println!("{ready}");
-        tracing::info!(%listen, speed_factor = speed, "flyloop-sitl waiting for PX4");
-        px4::server::run(
-            session,
-            listener,
-            Pacing {
-                speed_factor: speed,
-            },
-            shutdown,
-        )
-        .await
+        let serving = server(shutdown)?;
+        announce();
+        serving.await
     })?;
-    tracing::info!("stopped: {}", session.stats);
+    tracing::info!("stopped: {stats}");
     Ok(())
 }
 
@@ -192,23 +201,23 @@ fn track(args: &Args) -> Result<Option<Track>, StartError> {
 }
 
 /// The vehicle of the autopilot modes: `--config`, else the Iris preset.
-fn vehicle_config(args: &Args) -> Result<Px4Config, StartError> {
+fn vehicle_config(args: &Args) -> Result<AutopilotVehicle, StartError> {
     Ok(match &args.config {
-        Some(path) => config::read(path, Px4Config::parse)?,
-        None => Px4Config::iris(),
+        Some(path) => config::load_autopilot_vehicle(path)?,
+        None => AutopilotVehicle::iris(),
     })
 }
 
 /// ArduPilot mode: the vehicle, the UDP socket, then ArduPilot's frames until a signal.
 fn start_ardupilot(args: Args) -> Result<(), StartError> {
     quadrotor_only(&args, "--ardupilot")?;
-    let config = vehicle_config(&args)?;
+    let vehicle = vehicle_config(&args)?;
     let mut session = ardupilot::session::Session::new(&ardupilot::session::SessionOptions {
-        config,
+        vehicle,
         seed: args.seed,
     })?;
     if let Some(track) = track(&args)? {
-        session.set_track(track);
+        session.track.set(track);
     }
     let socket =
         std::net::UdpSocket::bind(args.ardupilot_listen).map_err(|source| StartError::Bind {
@@ -222,23 +231,19 @@ fn start_ardupilot(args: Args) -> Result<(), StartError> {
         "flyloop-sitl ready ardupilot={listen} mode=ardupilot model=quadrotor speed_factor={speed} seed={}",
         args.seed
     );
-    let runtime = single_thread_runtime()?;
-    let session = runtime.block_on(async move {
-        let shutdown = server::Shutdown::install()?;
-        println!("{ready}");
-        tracing::info!(%listen, speed_factor = speed, "flyloop-sitl waiting for ArduPilot");
-        ardupilot::server::run(
-            session,
-            socket,
-            Pacing {
-                speed_factor: speed,
-            },
-            shutdown,
-        )
-        .await
-    })?;
-    tracing::info!("stopped: {}", session.stats);
-    Ok(())
+    let pacing = Pacing {
+        speed_factor: speed,
+    };
+    serve_until_signal(
+        |shutdown| {
+            let serving = ardupilot::server::run(session, socket, pacing, shutdown);
+            Ok(async move { Ok(serving.await?.stats) })
+        },
+        || {
+            println!("{ready}");
+            tracing::info!(%listen, speed_factor = speed, "flyloop-sitl waiting for ArduPilot");
+        },
+    )
 }
 
 fn start(args: Args) -> Result<(), StartError> {
@@ -307,24 +312,23 @@ fn start_mavlink(args: Args, task: TaskKind, config: TaskConfig) -> Result<(), S
         args.seed
     );
 
-    let runtime = single_thread_runtime()?;
-    let stats = runtime.block_on(async move {
-        let shutdown = server::Shutdown::install()?;
-        let controller = tokio::net::UdpSocket::from_std(controller)?;
-        let gcs = match gcs {
-            Some((socket, target)) => Some(GcsLink {
-                socket: tokio::net::UdpSocket::from_std(socket)?,
-                target,
-            }),
-            None => None,
-        };
-        // Announced only once the sockets and the signal handlers are in place.
-        println!("{ready}");
-        tracing::info!(%listen, gcs = %gcs_text, "flyloop-sitl running");
-        server::run(sim, controller, gcs, shutdown).await
-    })?;
-    tracing::info!("stopped: {stats}");
-    Ok(())
+    serve_until_signal(
+        |shutdown| {
+            let controller = tokio::net::UdpSocket::from_std(controller)?;
+            let gcs = match gcs {
+                Some((socket, target)) => Some(GcsLink {
+                    socket: tokio::net::UdpSocket::from_std(socket)?,
+                    target,
+                }),
+                None => None,
+            };
+            Ok(server::run(sim, controller, gcs, shutdown))
+        },
+        || {
+            println!("{ready}");
+            tracing::info!(%listen, gcs = %gcs_text, "flyloop-sitl running");
+        },
+    )
 }
 
 /// Runs the SITL with command-line `args` (the program name first) until SIGINT / SIGTERM;

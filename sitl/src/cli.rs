@@ -59,7 +59,8 @@ pub struct Args {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
 
-    /// Parameter file (flat TOML: the model's and the task's parameters by name).
+    /// Parameter file (flat TOML of parameters by name: the model's and the task's, or with
+    /// --px4 / --ardupilot the vehicle's quadrotor and sensor parameters).
     #[arg(long)]
     pub config: Option<PathBuf>,
 
@@ -121,7 +122,7 @@ pub struct Args {
 
     /// PX4 and ArduPilot modes: simulation time between two rows of the track, µs (4000 =
     /// every PX4 step).
-    #[arg(long, default_value_t = crate::px4::track::TRACK_INTERVAL_US, value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long, default_value_t = crate::track::TRACK_INTERVAL_US, value_parser = clap::value_parser!(u64).range(1..))]
     pub track_interval_us: u64,
 
     /// Print the task's parameters and exit: `table` (MAVLink ids, names, ranges, defaults;

@@ -1,8 +1,14 @@
-//! The config file: a flat TOML table of the task's parameters (model and task sets), by the
-//! core's names or their MAVLink short ids. Missing keys keep the core's defaults; every error
-//! names the parameter and its bound (the core's [`ParamError`]).
+//! The parameter file, one loader for every mode: a flat TOML table of parameters by the
+//! core's names (in the MAVLink SITL also by their MAVLink short ids), plus, for the flight
+//! tasks, a `[randomize]` table of ranges. The MAVLink SITL reads the task's parameter sets
+//! from it ([`parse`]), the autopilot modes their vehicle ([`AutopilotVehicle::parse`]).
+//! Missing keys keep the core's defaults; every error names the parameter and its bound (the
+//! core's [`ParamError`]).
 
 use flyloop_core::ParamError;
+use flyloop_core::params::Parameters;
+use flyloop_core::quadrotor::QuadrotorParams;
+use flyloop_core::sensors::SensorParams;
 use flyloop_core::tasks::randomization::ParamRange;
 use flyloop_core::tasks::registry::{TaskConfig, TaskKind, from_values_and_ranges, param_rows};
 use std::path::{Path, PathBuf};
@@ -19,31 +25,39 @@ pub enum ConfigError {
     Invalid { path: PathBuf, source: ParamError },
 }
 
-/// Parses `text` into the parameter sets of `task` (other sets keep their defaults) and
-/// checks that the task builds from them.
-pub fn parse(task: TaskKind, text: &str) -> Result<TaskConfig, ParamError> {
-    let table: toml::Table = toml::from_str(text)?;
-    let mut values: Vec<(&str, f64)> = Vec::with_capacity(table.len());
-    let mut ranges = Vec::new();
-    for (key, value) in &table {
-        if key == RANDOMIZE_TABLE {
-            ranges = parse_ranges(value)?;
-            continue;
-        }
-        let Some(number) = toml_number(value) else {
-            let entry = param_rows::find(&param_rows::entries(task), task, key)?;
-            return Err(ParamError::Parse(format!(
-                "parameter `{}` must be a number or a boolean",
-                entry.name
-            )));
-        };
-        values.push((key.as_str(), number));
-    }
-    from_values_and_ranges(task, values, ranges)
-}
-
 /// The config file's table of randomisation ranges: `[randomize]` with `name = [low, high]`.
 pub const RANDOMIZE_TABLE: &str = "randomize";
+
+/// What a parameter file sets: each parameter's number (by the key written), and the
+/// `[randomize]` ranges if the file has that table.
+struct Entries<'t> {
+    values: Vec<(&'t str, f64)>,
+    ranges: Option<Vec<ParamRange>>,
+}
+
+/// Walks a parameter file's table, the one walker of every mode. `name_of` gives a key's
+/// core name, or the error naming a key the mode does not know.
+fn walk<'t>(
+    table: &'t toml::Table,
+    name_of: impl Fn(&str) -> Result<&'static str, ParamError>,
+) -> Result<Entries<'t>, ParamError> {
+    let mut entries = Entries {
+        values: Vec::with_capacity(table.len()),
+        ranges: None,
+    };
+    for (key, value) in table {
+        if key == RANDOMIZE_TABLE {
+            entries.ranges = Some(parse_ranges(value)?);
+            continue;
+        }
+        let name = name_of(key)?;
+        let number = toml_number(value).ok_or_else(|| {
+            ParamError::Parse(format!("parameter `{name}` must be a number or a boolean"))
+        })?;
+        entries.values.push((key.as_str(), number));
+    }
+    Ok(entries)
+}
 
 /// `[randomize]`'s entries as ranges; each must be a pair of numbers.
 fn parse_ranges(value: &toml::Value) -> Result<Vec<ParamRange>, ParamError> {
@@ -74,7 +88,7 @@ fn parse_ranges(value: &toml::Value) -> Result<Vec<ParamRange>, ParamError> {
 
 /// A parameter file's value as a number: integers, floats, and booleans as 0/1; `None` for
 /// anything else (the caller names the parameter in its error).
-pub(crate) fn toml_number(value: &toml::Value) -> Option<f64> {
+fn toml_number(value: &toml::Value) -> Option<f64> {
     match value {
         toml::Value::Integer(i) => Some(*i as f64),
         toml::Value::Float(x) => Some(*x),
@@ -83,14 +97,78 @@ pub(crate) fn toml_number(value: &toml::Value) -> Option<f64> {
     }
 }
 
+/// Parses `text` into the parameter sets of `task` (other sets keep their defaults) and
+/// checks that the task builds from them.
+pub fn parse(task: TaskKind, text: &str) -> Result<TaskConfig, ParamError> {
+    let table: toml::Table = toml::from_str(text)?;
+    let rows = param_rows::entries(task);
+    let file = walk(&table, |key| Ok(param_rows::find(&rows, task, key)?.name))?;
+    from_values_and_ranges(task, file.values, file.ranges.unwrap_or_default())
+}
+
+/// The preset the autopilot modes fly by default (sitl/presets/px4_iris.toml, built in).
+pub const IRIS_PRESET: &str = include_str!("../presets/px4_iris.toml");
+
+/// The vehicle of the autopilot modes (PX4 and ArduPilot): quadrotor and sensor parameters.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct AutopilotVehicle {
+    pub quadrotor: QuadrotorParams,
+    pub sensors: SensorParams,
+}
+
+impl AutopilotVehicle {
+    /// The built-in Iris preset.
+    pub fn iris() -> Self {
+        // The preset is part of the binary and parsed by a unit test; defaults if ever broken.
+        Self::parse(IRIS_PRESET).unwrap_or_default()
+    }
+
+    /// Quadrotor and sensor parameters by their core names, in one flat table; no
+    /// randomisation.
+    pub fn parse(text: &str) -> Result<Self, ParamError> {
+        let table: toml::Table = toml::from_str(text)?;
+        let file = walk(&table, autopilot_name)?;
+        if file.ranges.is_some() {
+            return Err(ParamError::Parse(format!(
+                "`{RANDOMIZE_TABLE}`: the PX4 and ArduPilot modes fly one vehicle, without randomisation"
+            )));
+        }
+        let (quad, sensors): (Vec<_>, Vec<_>) = file
+            .values
+            .into_iter()
+            .partition(|(key, _)| QuadrotorParams::spec(key).is_ok());
+        Ok(AutopilotVehicle {
+            quadrotor: QuadrotorParams::from_values(quad)?,
+            sensors: SensorParams::from_values(sensors)?,
+        })
+    }
+}
+
+/// A key of the autopilot modes' file: a quadrotor or a sensor parameter (the sets are named
+/// as in docs/parameters.md).
+fn autopilot_name(key: &str) -> Result<&'static str, ParamError> {
+    let spec = QuadrotorParams::spec(key).map(|s| s.name);
+    spec.or_else(|_| SensorParams::spec(key).map(|s| s.name))
+        .map_err(|_| {
+            ParamError::UnknownName(format!(
+                "{key}` for PX4 or ArduPilot mode: expected one of `QuadrotorParams` or `SensorParams"
+            ))
+        })
+}
+
 /// The parameter sets of `task` from the file at `path`.
 pub fn load(task: TaskKind, path: &Path) -> Result<TaskConfig, ConfigError> {
     read(path, |text| parse(task, text))
 }
 
-/// Reads the parameter file at `path` with `parse`; the one loader of every mode, so a
-/// missing file and a bad value are reported the same way.
-pub fn read<T>(
+/// The autopilot modes' vehicle from the file at `path`.
+pub fn load_autopilot_vehicle(path: &Path) -> Result<AutopilotVehicle, ConfigError> {
+    read(path, AutopilotVehicle::parse)
+}
+
+/// Reads the parameter file at `path` with `parse`, so a missing file and a bad value are
+/// reported the same way in every mode.
+fn read<T>(
     path: &Path,
     parse: impl FnOnce(&str) -> Result<T, ParamError>,
 ) -> Result<T, ConfigError> {
@@ -105,96 +183,4 @@ pub fn read<T>(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn names_and_short_ids_both_set_their_parameter() {
-        let c = parse(
-            TaskKind::Hover,
-            "mass = 1.5\nmax_steps = 200\nwind_enabled = false\ntgt_chg_intv = 50\n",
-        )
-        .unwrap();
-        assert_eq!(c.quadrotor.mass, 1.5);
-        assert_eq!(c.flight.max_steps, 200);
-        assert!(!c.quadrotor.wind_enabled);
-        assert_eq!(c.flight.target_change_interval, 50);
-        assert_eq!(
-            c.quadrotor.arm_length, 0.1,
-            "missing keys keep their defaults"
-        );
-    }
-
-    #[test]
-    fn a_bad_value_names_the_parameter_and_its_bound() {
-        let err = parse(TaskKind::Hover, "mass = -2.0")
-            .unwrap_err()
-            .to_string();
-        assert!(err.contains("`mass` = -2 kg is out of range"), "{err}");
-        let err = parse(TaskKind::Landing, "max_steps = 0")
-            .unwrap_err()
-            .to_string();
-        assert!(err.contains("`max_steps` = 0 is out of range"), "{err}");
-        let err = parse(TaskKind::Hover, "max_num_waypoints = 3")
-            .unwrap_err()
-            .to_string();
-        assert!(err.contains("max_num_waypoints"), "{err}");
-        assert_eq!(
-            parse(TaskKind::Hover, "masss = 1").unwrap_err().to_string(),
-            "unknown parameter `masss` for task `hover`"
-        );
-        let err = parse(TaskKind::Hover, "mass = \"heavy\"")
-            .unwrap_err()
-            .to_string();
-        assert!(err.contains("`mass` must be a number"), "{err}");
-        let err = parse(TaskKind::Hover, "mass = ").unwrap_err().to_string();
-        assert!(err.contains("invalid parameter file"), "{err}");
-    }
-
-    #[test]
-    fn randomisation_ranges_come_from_their_table() {
-        let c = parse(
-            TaskKind::Hover,
-            "mass = 1.5\n[randomize]\nmass = [1.2, 1.8]\nroll_rate_p = [0.1, 0.2]\n",
-        )
-        .unwrap();
-        let r = c.randomize.ranges();
-        assert_eq!(r.len(), 2);
-        assert_eq!(
-            (r[0].name.as_str(), r[0].low, r[0].high),
-            ("mass", 1.2, 1.8)
-        );
-        let err = parse(TaskKind::Hover, "[randomize]\nmass = [2.0, 1.0]")
-            .unwrap_err()
-            .to_string();
-        assert!(err.contains("`mass` = [2, 1] kg must be ordered"), "{err}");
-        let err = parse(TaskKind::Hover, "[randomize]\nmass = 1.0")
-            .unwrap_err()
-            .to_string();
-        assert!(err.contains("range `mass` must be a pair"), "{err}");
-        let err = parse(TaskKind::Hover, "[randomize]\nmasss = [1, 2]")
-            .unwrap_err()
-            .to_string();
-        assert!(err.contains("`masss`"), "{err}");
-        let err = parse(TaskKind::Landing, "[randomize]\nmass = [1, 2]")
-            .unwrap_err()
-            .to_string();
-        assert!(err.contains("no randomisation"), "{err}");
-    }
-
-    #[test]
-    fn relations_between_parameters_are_checked() {
-        let err = parse(
-            TaskKind::Hover,
-            "wind_speed_min = 9.0\nwind_speed_max = 3.0",
-        )
-        .unwrap_err()
-        .to_string();
-        assert!(err.contains("wind_speed_min"), "{err}");
-        parse(
-            TaskKind::Hover,
-            "wind_speed_min = 2.0\nwind_speed_max = 3.0",
-        )
-        .unwrap();
-    }
-}
+mod tests;

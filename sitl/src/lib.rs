@@ -7,11 +7,13 @@
 //! - [`wire`]: frames in and out of datagrams,
 //! - [`kinematics`]: the one place where ENU/FLU becomes NED/FRD,
 //! - [`task_frame`]: the task frame layout (DEBUG_FLOAT_ARRAY),
-//! - [`param_table`], [`param_protocol`], [`config`]: parameters over MAVLink and from TOML
-//!   (the task registry itself is the core's `flyloop_core::tasks::registry`),
+//! - [`param_table`], [`param_protocol`]: parameters over MAVLink (the task registry itself is
+//!   the core's `flyloop_core::tasks::registry`),
+//! - [`config`]: the parameter file of every mode (the task's, or the autopilot modes' vehicle),
 //! - [`px4`]: PX4 mode, flyloop as PX4's simulator over TCP,
 //! - [`ardupilot`]: ArduPilot mode, flyloop as ArduPilot's JSON physics backend over UDP,
-//! - [`pacer`]: the wall-clock pacer of both autopilot modes.
+//! - [`pacer`]: the wall-clock pacer of both autopilot modes,
+//! - [`track`]: their ground-truth track file (`--track`).
 
 pub mod app;
 pub mod ardupilot;
@@ -31,5 +33,6 @@ pub mod starter_config;
 pub mod stats;
 pub mod task_frame;
 pub mod telemetry;
+pub mod track;
 pub mod vehicle;
 pub mod wire;

@@ -7,6 +7,8 @@ use crate::wire;
 use std::future::pending;
 use std::io;
 use std::net::SocketAddr;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 use tokio::net::UdpSocket;
 use tokio::signal::unix::{SignalKind, signal};
@@ -73,6 +75,38 @@ impl Shutdown {
 /// again.
 pub(crate) const STOP_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 
+/// Runs `work` on a thread of its own (the autopilot modes' blocking socket loops) until it
+/// returns; a signal meanwhile sets the stop flag `work` watches. `beside` runs again and
+/// again while waiting (PX4 mode refuses second connections there). Returns what `work`
+/// returned and whether a signal came: a signal taken while `work` was ending on its own is
+/// still a stop (e.g. PX4 closing the socket must not swallow it). `thread` names the thread
+/// in the error if it panicked.
+pub(crate) async fn on_stoppable_thread<T: Send + 'static>(
+    thread: &str,
+    shutdown: &mut Shutdown,
+    work: impl FnOnce(&AtomicBool) -> T + Send + 'static,
+    mut beside: impl AsyncFnMut(),
+) -> io::Result<(T, bool)> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let mut worker = tokio::task::spawn_blocking(move || work(&flag));
+    let mut stopping = false;
+    loop {
+        tokio::select! {
+            biased;
+            joined = &mut worker => match joined {
+                Ok(done) => return Ok((done, stopping)),
+                Err(e) => return Err(io::Error::other(format!("{thread} failed: {e}"))),
+            },
+            _ = shutdown.signalled(), if !stopping => {
+                stop.store(true, Ordering::Relaxed);
+                stopping = true;
+            }
+            () = beside() => {}
+        }
+    }
+}
+
 /// Whether a blocking receive's error only means "nothing yet, try again".
 pub(crate) fn is_retry(kind: io::ErrorKind) -> bool {
     use io::ErrorKind::{Interrupted, TimedOut, WouldBlock};
@@ -98,48 +132,20 @@ pub async fn run(
             biased;
             _ = shutdown.signalled() => break,
             r = controller.recv_from(&mut buf) => match r {
-                Ok((n, from)) => {
-                    let start = Instant::now();
-                    out.clear();
-                    sim.handle(Link::Controller, from, &buf[..n], start, &mut out);
-                    sim.stats.handling += start.elapsed();
-                    if !out.is_empty() {
-                        send(&controller, &out, from, &mut sim.stats).await;
-                    }
-                    sim.stats.busy += start.elapsed();
-                }
-                Err(e) => {
-                    sim.stats.io_errors += 1;
-                    tracing::debug!(error = %e, "receive failed on the controller link");
-                }
+                Ok((n, from)) => answer_controller(&mut sim, &controller, &buf[..n], from, &mut out).await,
+                Err(e) => receive_failed(&mut sim.stats, "controller", &e),
             },
             r = receive(gcs_socket, &mut gcs_buf), if gcs_socket.is_some() => match (r, gcs_socket) {
-                (Ok((n, from)), Some(socket)) => {
-                    out.clear();
-                    sim.handle(Link::Gcs, from, &gcs_buf[..n], Instant::now(), &mut out);
-                    if !out.is_empty() {
-                        send(socket, &out, from, &mut sim.stats).await;
-                    }
-                }
-                (Err(e), _) => {
-                    sim.stats.io_errors += 1;
-                    tracing::debug!(error = %e, "receive failed on the ground-station link");
-                }
+                (Ok((n, from)), Some(socket)) => answer_gcs(&mut sim, socket, &gcs_buf[..n], from, &mut out).await,
+                (Err(e), _) => receive_failed(&mut sim.stats, "ground-station", &e),
                 (Ok(_), None) => {}
             },
             _ = sleep_until(deadline(next_physics)), if realtime => {
-                next_physics = sim.realtime_tick(Instant::now());
-                let stream = std::mem::take(&mut sim.stream);
-                for (to, bytes) in &stream {
-                    send(&controller, bytes, *to, &mut sim.stats).await;
-                }
-                sim.stream = stream;
+                next_physics = realtime_tick(&mut sim, &controller).await;
             },
             _ = sleep_until(deadline(next_gcs)), if gcs.is_some() => {
                 if let Some(g) = &gcs {
-                    out.clear();
-                    next_gcs = sim.gcs_tick(Instant::now(), &mut out);
-                    send(&g.socket, &out, g.target, &mut sim.stats).await;
+                    next_gcs = gcs_tick(&mut sim, g, &mut out).await;
                 }
             },
         }
@@ -147,6 +153,66 @@ pub async fn run(
     }
     tracing::info!("stopping on a signal");
     Ok(sim.stats)
+}
+
+/// A controller datagram: handled, and the replies sent back to `from`; the time it took
+/// is counted (handling, and busy with the send).
+async fn answer_controller(
+    sim: &mut Sim,
+    socket: &UdpSocket,
+    datagram: &[u8],
+    from: SocketAddr,
+    out: &mut Vec<u8>,
+) {
+    let start = Instant::now();
+    out.clear();
+    sim.handle(Link::Controller, from, datagram, start, out);
+    sim.stats.handling += start.elapsed();
+    if !out.is_empty() {
+        send(socket, out, from, &mut sim.stats).await;
+    }
+    sim.stats.busy += start.elapsed();
+}
+
+/// A ground-station datagram: handled, and the replies sent back to `from`.
+async fn answer_gcs(
+    sim: &mut Sim,
+    socket: &UdpSocket,
+    datagram: &[u8],
+    from: SocketAddr,
+    out: &mut Vec<u8>,
+) {
+    out.clear();
+    sim.handle(Link::Gcs, from, datagram, Instant::now(), out);
+    if !out.is_empty() {
+        send(socket, out, from, &mut sim.stats).await;
+    }
+}
+
+/// A failed receive on a link is counted and logged; the server goes on.
+fn receive_failed(stats: &mut Stats, link: &str, e: &io::Error) {
+    stats.io_errors += 1;
+    tracing::debug!(error = %e, "receive failed on the {link} link");
+}
+
+/// The real-time clock's tick: the vehicles due step and each controller peer gets its
+/// stream; returns when the next tick is due.
+async fn realtime_tick(sim: &mut Sim, controller: &UdpSocket) -> Instant {
+    let next = sim.realtime_tick(Instant::now());
+    let stream = std::mem::take(&mut sim.stream);
+    for (to, bytes) in &stream {
+        send(controller, bytes, *to, &mut sim.stats).await;
+    }
+    sim.stream = stream;
+    next
+}
+
+/// The ground-station telemetry due now, sent; returns when the next is due.
+async fn gcs_tick(sim: &mut Sim, gcs: &GcsLink, out: &mut Vec<u8>) -> Instant {
+    out.clear();
+    let next = sim.gcs_tick(Instant::now(), out);
+    send(&gcs.socket, out, gcs.target, &mut sim.stats).await;
+    next
 }
 
 /// Sends the event messages (failsafe, episode ends) raised while handling the last event.

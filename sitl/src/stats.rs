@@ -75,13 +75,6 @@ impl Stats {
 
 impl fmt::Display for Stats {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let per = |d: Duration, n: u64| {
-            if n == 0 {
-                0.0
-            } else {
-                d.as_secs_f64() * 1e6 / n as f64
-            }
-        };
         write!(
             f,
             "datagrams={} gcs_datagrams={} frames={} steps={} resets={} truncated={} bad_crc={} mavlink1={} \
@@ -108,9 +101,18 @@ impl fmt::Display for Stats {
             self.io_errors,
             self.repeated_steps,
             self.stale_controls,
-            per(self.busy, self.datagrams),
-            per(self.handling, self.datagrams),
-            per(self.physics, self.steps),
+            us_per(self.busy, self.datagrams),
+            us_per(self.handling, self.datagrams),
+            us_per(self.physics, self.steps),
         )
+    }
+}
+
+/// Microseconds of `total` per item of `n` (0 with no items), for the stop lines.
+pub(crate) fn us_per(total: Duration, n: u64) -> f64 {
+    if n == 0 {
+        0.0
+    } else {
+        total.as_secs_f64() * 1e6 / n as f64
     }
 }

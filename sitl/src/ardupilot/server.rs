@@ -3,10 +3,10 @@
 
 use super::session::{Outcome, Session};
 use crate::pacer::{self, Anchor, Pacing};
-use crate::server::{STOP_POLL, Shutdown, is_retry};
+use crate::server::{STOP_POLL, Shutdown, is_retry, on_stoppable_thread};
+use std::future::pending;
 use std::io;
 use std::net::UdpSocket;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
@@ -26,24 +26,15 @@ pub async fn run(
 ) -> io::Result<Session> {
     socket.set_nonblocking(false)?;
     socket.set_read_timeout(Some(STOP_POLL))?;
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = Arc::clone(&stop);
-    let mut worker = tokio::task::spawn_blocking(move || {
-        serve(&mut session, &socket, pacing, &flag);
-        session.flush_track();
+    let work = move |stop: &AtomicBool| {
+        serve(&mut session, &socket, pacing, stop);
+        session.track.flush();
         session
-    });
-    let mut stopping = false;
-    let session = loop {
-        tokio::select! {
-            biased;
-            joined = &mut worker => match joined {
-                Ok(session) => break session,
-                Err(e) => return Err(io::Error::other(format!("ArduPilot thread failed: {e}"))),
-            },
-            _ = shutdown.signalled(), if !stopping => { stop.store(true, Ordering::Relaxed); stopping = true; }
-        }
     };
+    let (session, _) = on_stoppable_thread("ArduPilot thread", &mut shutdown, work, async || {
+        pending::<()>().await
+    })
+    .await?;
     tracing::info!("stopping on a signal");
     Ok(session)
 }
@@ -85,7 +76,7 @@ fn serve(session: &mut Session, socket: &UdpSocket, pacing: Pacing, stop: &Atomi
                         "no servo packet from ArduPilot for {:.1} s: stopped or killed? The vehicle holds; a restarted ArduPilot resets it",
                         SILENCE.as_secs_f64()
                     );
-                    session.flush_track();
+                    session.track.flush();
                 }
             }
             Err(e) => {

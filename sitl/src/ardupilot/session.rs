@@ -3,9 +3,10 @@
 
 use super::packet::{self, MAX_PWM, PacketError, ServoFrame};
 use super::reply::{self, State};
+use crate::config::AutopilotVehicle;
 use crate::kinematics::{attitude_ned, enu_to_ned, flu_to_frd};
-use crate::px4::config::Px4Config;
-use crate::px4::track::Track;
+use crate::stats::us_per;
+use crate::track::SessionTrack;
 use flyloop_core::ParamError;
 use flyloop_core::quadrotor::Quadrotor;
 use flyloop_core::sensors::Sensors;
@@ -18,7 +19,7 @@ use std::time::{Duration, Instant};
 #[derive(Debug, Clone)]
 pub struct SessionOptions {
     /// The vehicle and its sensors (the IMU's noise and bias; ArduPilot models the rest).
-    pub config: Px4Config,
+    pub vehicle: AutopilotVehicle,
     /// Seed of the vehicle's and the IMU's random generators.
     pub seed: u64,
 }
@@ -61,13 +62,6 @@ impl Counters {
 
 impl fmt::Display for Counters {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let per = |d: Duration, n: u64| {
-            if n == 0 {
-                0.0
-            } else {
-                d.as_secs_f64() * 1e6 / n as f64
-            }
-        };
         write!(
             f,
             "datagrams={} steps={} repeats={} connections={} gaps={} bad_length={} bad_magic={} \
@@ -84,8 +78,8 @@ impl fmt::Display for Counters {
             self.absurd_pwm,
             self.non_finite,
             self.io_errors,
-            per(self.handling, self.datagrams),
-            per(self.physics, self.steps),
+            us_per(self.handling, self.datagrams),
+            us_per(self.physics, self.steps),
         )
     }
 }
@@ -121,7 +115,8 @@ pub struct Session {
     reply: Vec<u8>,
     /// Kinds of bad input already logged.
     logged: u8,
-    track: Option<Track>,
+    /// Ground-truth CSV (`--track`), if any.
+    pub track: SessionTrack,
     pub stats: Counters,
 }
 
@@ -139,7 +134,7 @@ pub enum Outcome {
 impl Session {
     /// The vehicle at rest on its landing gear at home, facing north.
     pub fn new(options: &SessionOptions) -> Result<Self, ParamError> {
-        let c = &options.config;
+        let c = &options.vehicle;
         let quad = Quadrotor::standing(c.quadrotor.clone(), options.seed)?;
         let sensors = Sensors::new(c.sensors.clone(), options.seed)?;
         Ok(Session {
@@ -150,30 +145,9 @@ impl Session {
             last: None,
             reply: Vec::with_capacity(512),
             logged: 0,
-            track: None,
+            track: SessionTrack::default(),
             stats: Counters::default(),
         })
-    }
-
-    /// Writes the ground truth to `track` from now on (a new `connection` number per
-    /// ArduPilot).
-    pub fn set_track(&mut self, track: Track) {
-        self.track = Some(track);
-    }
-
-    /// Writes out buffered track rows.
-    pub fn flush_track(&mut self) {
-        if let Some(track) = &mut self.track {
-            let result = track.flush();
-            self.track_result(result);
-        }
-    }
-
-    fn track_result(&mut self, result: std::io::Result<()>) {
-        if let Err(e) = result {
-            tracing::error!(error = %e, "writing the track failed: track stopped");
-            self.track = None;
-        }
     }
 
     /// Physics time of the last reply, µs.
@@ -209,27 +183,45 @@ impl Session {
     /// A datagram from `from`.
     pub fn receive(&mut self, bytes: &[u8], from: SocketAddr) -> Outcome {
         self.stats.datagrams += 1;
-        let frame = match packet::parse(bytes) {
-            Ok(frame) => frame,
-            Err(e) => {
-                let kind = match e {
-                    PacketError::Length(_) => {
-                        self.stats.bad_length += 1;
-                        Kind::Length
-                    }
-                    PacketError::Magic { .. } => {
-                        self.stats.bad_magic += 1;
-                        Kind::Magic
-                    }
-                    PacketError::FrameRate => {
-                        self.stats.bad_frame_rate += 1;
-                        Kind::FrameRate
-                    }
-                };
-                self.log_once(kind, format_args!("datagram from {from} skipped: {e}"));
-                return Outcome::Skipped;
+        let Some(frame) = self.servo_frame(bytes, from) else {
+            return Outcome::Skipped;
+        };
+        if !self.is_new_frame(&frame, from) {
+            return Outcome::Repeated;
+        }
+        self.step(&frame);
+        self.last = Some((frame.frame_count, from));
+        Outcome::Stepped
+    }
+
+    /// The datagram's servo frame; `None` for bad input (counted by kind, logged once).
+    fn servo_frame(&mut self, bytes: &[u8], from: SocketAddr) -> Option<ServoFrame> {
+        let e = match packet::parse(bytes) {
+            Ok(frame) => return Some(frame),
+            Err(e) => e,
+        };
+        let kind = match e {
+            PacketError::Length(_) => {
+                self.stats.bad_length += 1;
+                Kind::Length
+            }
+            PacketError::Magic { .. } => {
+                self.stats.bad_magic += 1;
+                Kind::Magic
+            }
+            PacketError::FrameRate => {
+                self.stats.bad_frame_rate += 1;
+                Kind::FrameRate
             }
         };
+        self.log_once(kind, format_args!("datagram from {from} skipped: {e}"));
+        None
+    }
+
+    /// Whether `frame` is a new one to step; false for the last frame again (counted). The
+    /// first frame connects an ArduPilot; a frame count that went back is a restarted one
+    /// (the vehicle reset, a new connection); one that skipped ahead is a gap (counted).
+    fn is_new_frame(&mut self, frame: &ServoFrame, from: SocketAddr) -> bool {
         match self.last {
             None => {
                 tracing::info!(%from, frame_count = frame.frame_count, frame_rate = frame.frame_rate, "ArduPilot connected: lockstep");
@@ -238,7 +230,7 @@ impl Session {
             Some((count, peer)) if frame.frame_count == count && peer == from => {
                 self.stats.repeats += 1;
                 tracing::debug!(frame_count = count, "frame repeated: answered again");
-                return Outcome::Repeated;
+                return false;
             }
             Some((count, peer)) if frame.frame_count <= count => {
                 tracing::warn!(
@@ -264,18 +256,13 @@ impl Session {
             }
             Some(_) => {}
         }
-        self.step(&frame);
-        self.last = Some((frame.frame_count, from));
-        Outcome::Stepped
+        true
     }
 
     /// A new ArduPilot: counted, and a new connection number in the track.
     fn connect(&mut self) {
         self.stats.connections += 1;
-        if let Some(track) = &mut self.track {
-            let result = track.connect();
-            self.track_result(result);
-        }
+        self.track.connect();
     }
 
     /// The vehicle and IMU back to their start state, physics time to 0.
@@ -338,11 +325,7 @@ impl Session {
             );
         }
         reply::write(&mut self.reply, &state);
-        let time_us = self.time_us;
-        if let Some(track) = &mut self.track {
-            let result = track.record(time_us, &self.quad);
-            self.track_result(result);
-        }
+        self.track.record(self.time_us, &self.quad);
     }
 
     /// The body rates without noise, FRD (for tests).

@@ -22,14 +22,10 @@
 //! counted and skipped; controls with NaN are counted and skipped (the previous command
 //! holds, and the step still happens so PX4's lockstep does not stall).
 //!
-//! - [`config`]: the vehicle and sensor parameters (preset `sitl/presets/px4_iris.toml`),
 //! - [`messages`]: HIL_SENSOR / HIL_GPS from the core's sensor readings,
 //! - [`session`]: one vehicle flown by one PX4 connection, without sockets,
-//! - [`server`]: the TCP listener, the pacing and the connection life cycle,
-//! - [`track`]: the ground-truth track file (`--track`).
+//! - [`server`]: the TCP listener, the pacing and the connection life cycle.
 
-pub mod config;
 pub mod messages;
 pub mod server;
 pub mod session;
-pub mod track;

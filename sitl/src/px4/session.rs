@@ -1,12 +1,12 @@
 //! One vehicle flown by one PX4 connection, without sockets: bytes from PX4 in, bytes for PX4
 //! out. The server feeds it; tests drive it directly.
 
-use super::config::Px4Config;
 use super::messages;
-use super::track::Track;
+use crate::config::AutopilotVehicle;
 use crate::kinematics::{Home, Kinematics};
 use crate::stats::Stats;
 use crate::telemetry;
+use crate::track::SessionTrack;
 use crate::wire::{Encoder, StreamDecoder};
 use flyloop_core::ParamError;
 use flyloop_core::quadrotor::Quadrotor;
@@ -20,7 +20,7 @@ const SIMULATOR_SYSTEM: u8 = 1;
 /// What a session is built from.
 #[derive(Debug, Clone)]
 pub struct SessionOptions {
-    pub config: Px4Config,
+    pub vehicle: AutopilotVehicle,
     /// Physics step per controls message, µs (PX4 expects 4000).
     pub step_us: u64,
     /// Seed of the vehicle's and the sensors' random generators.
@@ -47,14 +47,14 @@ pub struct Session {
     decoder: StreamDecoder,
     encoder: Encoder,
     /// Ground-truth CSV (`--track`), if any.
-    track: Option<Track>,
+    pub track: SessionTrack,
     pub stats: Stats,
 }
 
 impl Session {
     /// The vehicle at rest on its landing gear at the origin, facing north.
     pub fn new(options: &SessionOptions) -> Result<Self, ParamError> {
-        let c = &options.config;
+        let c = &options.vehicle;
         let mut quad = Quadrotor::standing(c.quadrotor.clone(), options.seed)?;
         // One step with the motors off: the state PX4's first controls meet.
         quad.step(options.step_us.max(1) as f64 * 1e-6);
@@ -77,7 +77,7 @@ impl Session {
             gps_epoch_us: 0,
             decoder: StreamDecoder::default(),
             encoder: Encoder::default(),
-            track: None,
+            track: SessionTrack::default(),
             stats: Stats::default(),
         })
     }
@@ -94,32 +94,8 @@ impl Session {
         self.next_state_us = 0;
         self.gps_epoch_us = gps_epoch_us;
         self.decoder.clear();
-        if let Some(track) = &mut self.track {
-            let result = track.connect();
-            self.track_result(result);
-        }
+        self.track.connect();
         self.emit(out);
-    }
-
-    /// Writes the ground truth to `track` from now on.
-    pub fn set_track(&mut self, track: Track) {
-        self.track = Some(track);
-    }
-
-    /// Writes out buffered track rows (on disconnect and shutdown).
-    pub fn flush_track(&mut self) {
-        if let Some(track) = &mut self.track {
-            let result = track.flush();
-            self.track_result(result);
-        }
-    }
-
-    /// A failed track write is logged once and ends the track; the flight goes on.
-    fn track_result(&mut self, result: std::io::Result<()>) {
-        if let Err(e) = result {
-            tracing::error!(error = %e, "writing the track failed: track stopped");
-            self.track = None;
-        }
     }
 
     /// Whether PX4 drives the steps (its first controls have arrived).
@@ -230,10 +206,7 @@ impl Session {
         let reading = self.sensors.sample(&self.quad, dt);
         let sensor = messages::hil_sensor(&reading, self.time_us);
         self.encoder.push(out, SIMULATOR_SYSTEM, &sensor);
-        if let Some(track) = &mut self.track {
-            let result = track.record(self.time_us, &self.quad);
-            self.track_result(result);
-        }
+        self.track.record(self.time_us, &self.quad);
         if let Some(fix) = self.sensors.gps(&self.quad, self.time_us as f64 * 1e-6) {
             let stamp = self.gps_epoch_us + (fix.measured_at * 1e6).round() as u64;
             self.encoder

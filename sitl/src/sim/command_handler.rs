@@ -6,6 +6,7 @@ use mavlink::MavHeader;
 use mavlink::dialects::common::{
     COMMAND_ACK_DATA, COMMAND_LONG_DATA, MavCmd, MavMessage, MavResult, MavSeverity,
 };
+use std::ops::Range;
 
 impl Sim {
     fn ack(
@@ -28,6 +29,21 @@ impl Sim {
         self.push(link, out, i, &m);
     }
 
+    /// Acknowledges `command` from every vehicle in `targets` with `result`.
+    fn ack_all(
+        &mut self,
+        link: Link,
+        out: &mut Vec<u8>,
+        targets: Range<usize>,
+        header: MavHeader,
+        command: MavCmd,
+        result: MavResult,
+    ) {
+        for i in targets {
+            self.ack(link, out, i, header, command, result);
+        }
+    }
+
     // MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES is superseded but ground stations still send it.
     #[allow(deprecated)]
     pub(super) fn on_command(
@@ -41,83 +57,89 @@ impl Sim {
         let Some(targets) = self.targets(c.target_system) else {
             return;
         };
-        let all = c.target_system == 0;
         match c.command {
-            RESET_COMMAND => match crate::commands::reset_request(c) {
-                Ok(request) => {
-                    for i in targets {
-                        let seed = request.seed_for(&self.vehicles[i], all);
-                        self.reset_vehicle(link, header, i, seed, peer, out);
-                    }
-                }
-                Err(e) => {
-                    self.stats.refused_requests += 1;
-                    tracing::debug!(error = %e, "reset refused");
-                    for i in targets {
-                        self.ack(
-                            link,
-                            out,
-                            i,
-                            header,
-                            c.command,
-                            MavResult::MAV_RESULT_DENIED,
-                        );
-                        self.push_text(
-                            link,
-                            out,
-                            i,
-                            MavSeverity::MAV_SEVERITY_ERROR,
-                            &format!("reset refused: {e}"),
-                        );
-                    }
-                }
-            },
+            RESET_COMMAND => self.on_reset(link, header, c, targets, peer, out),
             MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL => {
                 let result = self.set_message_interval(link, c.param1, c.param2, peer);
                 if result != MavResult::MAV_RESULT_ACCEPTED {
                     self.stats.refused_requests += 1;
                 }
-                for i in targets {
-                    self.ack(link, out, i, header, c.command, result);
-                }
+                self.ack_all(link, out, targets, header, c.command, result);
             }
             MavCmd::MAV_CMD_REQUEST_MESSAGE | MavCmd::MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES => {
-                let message_id = if c.command == MavCmd::MAV_CMD_REQUEST_MESSAGE {
-                    crate::commands::message_id(c.param1)
-                } else {
-                    Some(id::AUTOPILOT_VERSION)
-                };
-                for i in targets {
-                    let reply = message_id.and_then(|m| self.message(link, i, m));
-                    let result = if reply.is_some() {
-                        MavResult::MAV_RESULT_ACCEPTED
-                    } else {
-                        self.stats.refused_requests += 1;
-                        MavResult::MAV_RESULT_UNSUPPORTED
-                    };
-                    self.ack(link, out, i, header, c.command, result);
-                    for m in reply.into_iter().flatten() {
-                        self.push(link, out, i, &m);
-                    }
-                }
+                self.on_message_request(link, header, c, targets, out);
             }
             _ => {
                 self.stats.ignored_messages += 1;
                 tracing::debug!(command = ?c.command, "unsupported command");
+                let unsupported = MavResult::MAV_RESULT_UNSUPPORTED;
+                self.ack_all(link, out, targets, header, c.command, unsupported);
+            }
+        }
+    }
+
+    /// The reset command: each vehicle in `targets` reset with its seed, or, for a request
+    /// that does not parse, denied on each with the reason as a STATUSTEXT.
+    fn on_reset(
+        &mut self,
+        link: Link,
+        header: MavHeader,
+        c: &COMMAND_LONG_DATA,
+        targets: Range<usize>,
+        peer: Option<usize>,
+        out: &mut Vec<u8>,
+    ) {
+        let all = c.target_system == 0;
+        match crate::commands::reset_request(c) {
+            Ok(request) => {
                 for i in targets {
-                    self.ack(
-                        link,
-                        out,
-                        i,
-                        header,
-                        c.command,
-                        MavResult::MAV_RESULT_UNSUPPORTED,
-                    );
+                    let seed = request.seed_for(&self.vehicles[i], all);
+                    self.reset_vehicle(link, header, i, seed, peer, out);
+                }
+            }
+            Err(e) => {
+                self.stats.refused_requests += 1;
+                tracing::debug!(error = %e, "reset refused");
+                for i in targets {
+                    let why = format!("reset refused: {e}");
+                    self.refuse_reset(link, out, i, header, MavResult::MAV_RESULT_DENIED, &why);
                 }
             }
         }
     }
 
+    /// REQUEST_MESSAGE (or the older REQUEST_AUTOPILOT_CAPABILITIES): each vehicle in
+    /// `targets` acknowledges, then sends the message if it has it.
+    fn on_message_request(
+        &mut self,
+        link: Link,
+        header: MavHeader,
+        c: &COMMAND_LONG_DATA,
+        targets: Range<usize>,
+        out: &mut Vec<u8>,
+    ) {
+        let message_id = if c.command == MavCmd::MAV_CMD_REQUEST_MESSAGE {
+            crate::commands::message_id(c.param1)
+        } else {
+            Some(id::AUTOPILOT_VERSION)
+        };
+        for i in targets {
+            let reply = message_id.and_then(|m| self.message(link, i, m));
+            let result = if reply.is_some() {
+                MavResult::MAV_RESULT_ACCEPTED
+            } else {
+                self.stats.refused_requests += 1;
+                MavResult::MAV_RESULT_UNSUPPORTED
+            };
+            self.ack(link, out, i, header, c.command, result);
+            for m in reply.into_iter().flatten() {
+                self.push(link, out, i, &m);
+            }
+        }
+    }
+
+    /// Resets vehicle `i` with `seed` and acknowledges it; the peer that asked (controller
+    /// link) gets the new state as a step's reply carries it.
     fn reset_vehicle(
         &mut self,
         link: Link,
@@ -132,37 +154,32 @@ impl Sim {
                 self.stats.resets += 1;
                 self.runtime[i].running = false;
                 self.runtime[i].failsafe = false;
-                self.ack(
-                    link,
-                    out,
-                    i,
-                    header,
-                    RESET_COMMAND,
-                    MavResult::MAV_RESULT_ACCEPTED,
-                );
+                let accepted = MavResult::MAV_RESULT_ACCEPTED;
+                self.ack(link, out, i, header, RESET_COMMAND, accepted);
                 if let Some(p) = peer {
                     self.push_vehicle_reply(i, p, out);
                 }
             }
             Err(e) => {
                 self.stats.refused_requests += 1;
-                self.ack(
-                    link,
-                    out,
-                    i,
-                    header,
-                    RESET_COMMAND,
-                    MavResult::MAV_RESULT_FAILED,
-                );
-                self.push_text(
-                    link,
-                    out,
-                    i,
-                    MavSeverity::MAV_SEVERITY_ERROR,
-                    &format!("reset failed: {e}"),
-                );
+                let why = format!("reset failed: {e}");
+                self.refuse_reset(link, out, i, header, MavResult::MAV_RESULT_FAILED, &why);
             }
         }
+    }
+
+    /// A reset vehicle `i` did not do: acknowledged with `result`, and `why` as an error text.
+    fn refuse_reset(
+        &mut self,
+        link: Link,
+        out: &mut Vec<u8>,
+        i: usize,
+        header: MavHeader,
+        result: MavResult,
+        why: &str,
+    ) {
+        self.ack(link, out, i, header, RESET_COMMAND, result);
+        self.push_text(link, out, i, MavSeverity::MAV_SEVERITY_ERROR, why);
     }
 
     /// SET_MESSAGE_INTERVAL: on the controller link it chooses what the sending peer gets

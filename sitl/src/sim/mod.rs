@@ -311,68 +311,87 @@ impl Sim {
         now: Instant,
         out: &mut Vec<u8>,
     ) {
-        let Some(i) = self.vehicle_index(header.system_id) else {
-            self.stats.unknown_vehicle += 1;
-            tracing::debug!(
-                system_id = header.system_id,
-                "controls for an unknown system id skipped"
-            );
+        let Some(i) = self.vehicle_to_command(header.system_id, c, out) else {
             return;
         };
+        if !self.set_controls(i, &c.controls, out) {
+            return;
+        }
+        match self.options.mode {
+            Mode::Lockstep => self.lockstep_step(i, peer, c.time_usec, out),
+            Mode::Realtime => self.command_arrived(i, now),
+        }
+    }
+
+    /// The index of the vehicle `system_id` if these controls are a new command for it;
+    /// `None` for an unknown vehicle, and in lockstep for controls without the LOCKSTEP flag
+    /// or for a step already taken (its cached reply sent again, see
+    /// [`Self::repeated_or_stale`]).
+    fn vehicle_to_command(
+        &mut self,
+        system_id: u8,
+        c: &HIL_ACTUATOR_CONTROLS_DATA,
+        out: &mut Vec<u8>,
+    ) -> Option<usize> {
+        let Some(i) = self.vehicle_index(system_id) else {
+            self.stats.unknown_vehicle += 1;
+            tracing::debug!(system_id, "controls for an unknown system id skipped");
+            return None;
+        };
+        if self.options.mode == Mode::Realtime {
+            return Some(i);
+        }
         let lockstep_flag = c
             .flags
             .contains(HilActuatorControlsFlags::HIL_ACTUATOR_CONTROLS_FLAGS_LOCKSTEP);
-        if self.options.mode == Mode::Lockstep && !lockstep_flag {
+        if !lockstep_flag {
             self.stats.ignored_messages += 1;
             tracing::debug!(
-                system_id = header.system_id,
+                system_id,
                 "controls without the LOCKSTEP flag ignored in lockstep"
             );
-            return;
+            return None;
         }
-        if self.options.mode == Mode::Lockstep && self.repeated_or_stale(i, c.time_usec, out) {
-            return;
-        }
-        match self.vehicles[i].set_controls(&c.controls) {
+        (!self.repeated_or_stale(i, c.time_usec, out)).then_some(i)
+    }
+
+    /// Sets vehicle `i`'s command (clamped into the action bounds, counted); a refused one
+    /// is counted and answered by a warning. Returns whether the command was set.
+    fn set_controls(&mut self, i: usize, controls: &[f32], out: &mut Vec<u8>) -> bool {
+        let system_id = self.vehicles[i].system_id;
+        match self.vehicles[i].set_controls(controls) {
             Ok(report) => {
                 if report.clamped {
                     self.stats.clamped_controls += 1;
-                    tracing::debug!(
-                        system_id = header.system_id,
-                        "controls clamped into the action bounds"
-                    );
+                    tracing::debug!(system_id, "controls clamped into the action bounds");
                 }
+                true
             }
             Err(e) => {
                 self.stats.refused_controls += 1;
-                tracing::debug!(system_id = header.system_id, error = %e, "controls refused");
-                let text = format!("vehicle {}: {e}", header.system_id);
-                self.push_text(
-                    Link::Controller,
-                    out,
-                    i,
-                    MavSeverity::MAV_SEVERITY_WARNING,
-                    &text,
-                );
-                return;
+                tracing::debug!(system_id, error = %e, "controls refused");
+                let text = format!("vehicle {system_id}: {e}");
+                let warning = MavSeverity::MAV_SEVERITY_WARNING;
+                self.push_text(Link::Controller, out, i, warning, &text);
+                false
             }
         }
-        match self.options.mode {
-            Mode::Lockstep => {
-                let start = Instant::now();
-                self.vehicles[i].step();
-                self.stats.physics += start.elapsed();
-                self.stats.steps += 1;
-                let from = out.len();
-                self.push_vehicle_reply(i, peer, out);
-                let v = &mut self.vehicles[i];
-                v.last_step = (c.time_usec != 0).then_some(c.time_usec);
-                v.last_reply.clear();
-                if v.last_step.is_some() {
-                    v.last_reply.extend_from_slice(&out[from..]);
-                }
-            }
-            Mode::Realtime => self.command_arrived(i, now),
+    }
+
+    /// One lockstep step of vehicle `i`, answered to `peer`; the answer is kept for a
+    /// command naming `step` again (`step` 0 names none).
+    fn lockstep_step(&mut self, i: usize, peer: usize, step: u64, out: &mut Vec<u8>) {
+        let start = Instant::now();
+        self.vehicles[i].step();
+        self.stats.physics += start.elapsed();
+        self.stats.steps += 1;
+        let from = out.len();
+        self.push_vehicle_reply(i, peer, out);
+        let v = &mut self.vehicles[i];
+        v.last_step = (step != 0).then_some(step);
+        v.last_reply.clear();
+        if v.last_step.is_some() {
+            v.last_reply.extend_from_slice(&out[from..]);
         }
     }
 

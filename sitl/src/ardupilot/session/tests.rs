@@ -6,7 +6,7 @@ use crate::ardupilot::packet::encode_16;
 
 fn session(seed: u64) -> Session {
     Session::new(&SessionOptions {
-        config: Px4Config::iris(),
+        vehicle: AutopilotVehicle::iris(),
         seed,
     })
     .unwrap()

@@ -11,7 +11,7 @@ use nalgebra::Vector3;
 
 fn session(seed: u64) -> Session {
     Session::new(&SessionOptions {
-        config: Px4Config::iris(),
+        vehicle: AutopilotVehicle::iris(),
         step_us: 4000,
         seed,
     })

@@ -1,8 +1,9 @@
-//! The flight track of PX4 mode (`--track FILE`): ground truth as CSV, one row every
-//! `--track-interval-us` of simulation time ([`TRACK_INTERVAL_US`] by default), for plots and for checking PX4's estimate.
+//! The flight track of the autopilot modes (`--track FILE`): ground truth as CSV, one row
+//! every `--track-interval-us` of simulation time ([`TRACK_INTERVAL_US`] by default), for
+//! plots and for checking the autopilot's estimate.
 //!
-//! Columns: `connection` (1 for the first PX4, 2 after a reconnect, …), `time_us` (simulation
-//! time = PX4's clock), `north,east,down` (m from home), `vn,ve,vd` (m/s),
+//! Columns: `connection` (1 for the first autopilot, 2 after a reconnect or restart, …),
+//! `time_us` (simulation time = the autopilot's clock), `north,east,down` (m from home), `vn,ve,vd` (m/s),
 //! `roll,pitch,yaw` (rad, FRD → NED), `m0..m3` (motor states in [0, 1]), `grounded` (0/1),
 //! `p,q,r` (body rates, rad/s, FRD).
 
@@ -41,7 +42,7 @@ impl Track {
         })
     }
 
-    /// A new PX4 connection: rows from now on carry its number.
+    /// A new autopilot connection: rows from now on carry its number.
     pub fn connect(&mut self) -> io::Result<()> {
         self.connection += 1;
         self.next_us = 0;
@@ -87,5 +88,42 @@ impl Track {
     /// Writes buffered rows out.
     pub fn flush(&mut self) -> io::Result<()> {
         self.out.flush()
+    }
+}
+
+/// A session's track: none, or one being written until a write fails (logged, and the
+/// track ends; the flight goes on).
+#[derive(Debug, Default)]
+pub struct SessionTrack(Option<Track>);
+
+impl SessionTrack {
+    /// Writes the ground truth to `track` from now on.
+    pub fn set(&mut self, track: Track) {
+        self.0 = Some(track);
+    }
+
+    /// A new autopilot connection (see [`Track::connect`]).
+    pub fn connect(&mut self) {
+        self.write(Track::connect);
+    }
+
+    /// A row for `quad` at `time_us` when one is due.
+    pub fn record(&mut self, time_us: u64, quad: &Quadrotor) {
+        self.write(|track| track.record(time_us, quad));
+    }
+
+    /// Writes out buffered rows (on disconnect, silence and shutdown).
+    pub fn flush(&mut self) {
+        self.write(Track::flush);
+    }
+
+    fn write(&mut self, write: impl FnOnce(&mut Track) -> io::Result<()>) {
+        let Some(track) = &mut self.0 else {
+            return;
+        };
+        if let Err(e) = write(track) {
+            tracing::error!(error = %e, "writing the track failed: track stopped");
+            self.0 = None;
+        }
     }
 }

@@ -1,0 +1,143 @@
+use super::*;
+
+#[test]
+fn names_and_short_ids_both_set_their_parameter() {
+    let c = parse(
+        TaskKind::Hover,
+        "mass = 1.5\nmax_steps = 200\nwind_enabled = false\ntgt_chg_intv = 50\n",
+    )
+    .unwrap();
+    assert_eq!(c.quadrotor.mass, 1.5);
+    assert_eq!(c.flight.max_steps, 200);
+    assert!(!c.quadrotor.wind_enabled);
+    assert_eq!(c.flight.target_change_interval, 50);
+    assert_eq!(
+        c.quadrotor.arm_length, 0.1,
+        "missing keys keep their defaults"
+    );
+}
+
+#[test]
+fn a_bad_value_names_the_parameter_and_its_bound() {
+    let err = parse(TaskKind::Hover, "mass = -2.0")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("`mass` = -2 kg is out of range"), "{err}");
+    let err = parse(TaskKind::Landing, "max_steps = 0")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("`max_steps` = 0 is out of range"), "{err}");
+    let err = parse(TaskKind::Hover, "max_num_waypoints = 3")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("max_num_waypoints"), "{err}");
+    assert_eq!(
+        parse(TaskKind::Hover, "masss = 1").unwrap_err().to_string(),
+        "unknown parameter `masss` for task `hover`"
+    );
+    let err = parse(TaskKind::Hover, "mass = \"heavy\"")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("`mass` must be a number"), "{err}");
+    let err = parse(TaskKind::Hover, "mass = ").unwrap_err().to_string();
+    assert!(err.contains("invalid parameter file"), "{err}");
+}
+
+#[test]
+fn randomisation_ranges_come_from_their_table() {
+    let c = parse(
+        TaskKind::Hover,
+        "mass = 1.5\n[randomize]\nmass = [1.2, 1.8]\nroll_rate_p = [0.1, 0.2]\n",
+    )
+    .unwrap();
+    let r = c.randomize.ranges();
+    assert_eq!(r.len(), 2);
+    assert_eq!(
+        (r[0].name.as_str(), r[0].low, r[0].high),
+        ("mass", 1.2, 1.8)
+    );
+    let err = parse(TaskKind::Hover, "[randomize]\nmass = [2.0, 1.0]")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("`mass` = [2, 1] kg must be ordered"), "{err}");
+    let err = parse(TaskKind::Hover, "[randomize]\nmass = 1.0")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("range `mass` must be a pair"), "{err}");
+    let err = parse(TaskKind::Hover, "[randomize]\nmasss = [1, 2]")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("`masss`"), "{err}");
+    let err = parse(TaskKind::Landing, "[randomize]\nmass = [1, 2]")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("no randomisation"), "{err}");
+}
+
+#[test]
+fn relations_between_parameters_are_checked() {
+    let err = parse(
+        TaskKind::Hover,
+        "wind_speed_min = 9.0\nwind_speed_max = 3.0",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("wind_speed_min"), "{err}");
+    parse(
+        TaskKind::Hover,
+        "wind_speed_min = 2.0\nwind_speed_max = 3.0",
+    )
+    .unwrap();
+}
+
+#[test]
+fn the_iris_preset_parses_and_hovers_near_0_6() {
+    let c = AutopilotVehicle::parse(IRIS_PRESET).unwrap();
+    assert_eq!(c, AutopilotVehicle::iris());
+    assert_eq!(c.quadrotor.mass, 1.5);
+    assert!(!c.quadrotor.wind_enabled);
+    let hover = c.quadrotor.hover_motor_state().unwrap();
+    assert!((hover - 0.6066).abs() < 1e-3, "{hover}");
+    assert_eq!(c.sensors, SensorParams::default());
+    // Feet under the rotors; standing, the centre of mass is 5.4 cm up.
+    let q = &c.quadrotor;
+    assert!((q.gear_x - q.arm_length / 2f64.sqrt()).abs() < 1e-3);
+    assert_eq!(q.gear_x, q.gear_y);
+    let rest = flyloop_core::quadrotor::contact::rest_height(q);
+    assert!((rest - 0.0538).abs() < 1e-4, "{rest}");
+}
+
+#[test]
+fn the_autopilot_vehicle_reads_both_sets_and_names_mistakes() {
+    let c = AutopilotVehicle::parse("mass = 2\ngps_rate = 5\n").unwrap();
+    assert_eq!((c.quadrotor.mass, c.sensors.gps_rate), (2.0, 5.0));
+    assert_eq!(
+        c.quadrotor.arm_length, 0.1,
+        "missing keys keep their defaults"
+    );
+    let e = AutopilotVehicle::parse("gps_rate = 0")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("`gps_rate` = 0 Hz is out of range"), "{e}");
+    assert_eq!(
+        AutopilotVehicle::parse("mas = 1").unwrap_err().to_string(),
+        "unknown parameter `mas` for PX4 or ArduPilot mode: expected one of `QuadrotorParams` or `SensorParams`"
+    );
+    assert_eq!(
+        AutopilotVehicle::parse("mass = \"x\"")
+            .unwrap_err()
+            .to_string(),
+        "invalid parameter file: parameter `mass` must be a number or a boolean"
+    );
+    // Short ids are the MAVLink SITL's; a task's parameter is not the vehicle's.
+    for key in ["ang_damp_quad", "max_steps"] {
+        let e = AutopilotVehicle::parse(&format!("{key} = 1"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(&format!("`{key}` for PX4")), "{e}");
+    }
+    let e = AutopilotVehicle::parse("[randomize]\nmass = [1, 2]")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("without randomisation"), "{e}");
+}
