@@ -107,9 +107,9 @@ def memory_per_env(env_id: str, n: int) -> tuple[float, float]:
 MEMORY_STEPS = 500
 
 
-def memory_child(env_id: str, n: int) -> None:
+def memory_child(env_id: str, n: int, steps: int = MEMORY_STEPS) -> None:
     """Prints the resident-set growth, bytes, of making, resetting and stepping the env
-    MEMORY_STEPS times with random actions (episodes end and restart meanwhile, so a
+    `steps` times with random actions (episodes end and restart meanwhile, so a
     Lander2D's rapier worlds, built only near the ground and the pad, are counted as they
     come and go)."""
     before = _rss_bytes()
@@ -118,7 +118,7 @@ def memory_child(env_id: str, n: int) -> None:
     envs.reset(seed=0)
     rng = np.random.default_rng(0)
     peak = 0
-    for _ in range(MEMORY_STEPS):
+    for _ in range(steps):
         envs.step(_actions(envs.single_action_space, rng, n))
         peak = max(peak, _rss_bytes())
     print(peak - before)
@@ -156,10 +156,12 @@ def main() -> None:
     parser.add_argument("--memory-envs", type=int, default=100_000)
     parser.add_argument("--sample-actions", action="store_true")
     parser.add_argument("--env", action="append", choices=sorted(ENVS), help="default: all")
-    parser.add_argument("--memory-child", nargs=2, help=argparse.SUPPRESS)
+    # ENV N [STEPS]: one memory measurement (what memory_per_env and the tests run).
+    parser.add_argument("--memory-child", nargs="+", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.memory_child:
-        memory_child(args.memory_child[0], int(args.memory_child[1]))
+        env_id, n, *steps = args.memory_child
+        memory_child(env_id, int(n), *map(int, steps))
         return
     print(machine())
     load = os.getloadavg()[0]

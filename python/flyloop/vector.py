@@ -125,7 +125,10 @@ class FlyloopVectorEnv(VectorEnv):
         g = self._generators[i]
         if g is None:
             g = self._generators[i] = seeding.np_random(self._seed_of[i])[0]
-        return int(g.integers(0, 2**63))
+        # The single env's `integers(0, 2**63)`: numpy's Lemire method over 2**63 values is
+        # the raw 64-bit draw shifted right by one, without its per-call set-up (a fifth of
+        # the cost; the vector env draws for every auto-reset).
+        return int(g.bit_generator.random_raw()) >> 1
 
     def _seed_env(self, i: int, seed: int) -> int:
         self._seed_of[i] = seed
