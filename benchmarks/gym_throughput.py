@@ -45,7 +45,9 @@ SCALE = [
 
 
 def _actions(space, rng, n):
-    return rng.uniform(space.low, space.high, (n, *space.shape)).astype(np.float32)
+    # Drawn in float32 (the envs' action dtype): half the cost of float64 and a cast.
+    u = rng.random((n, *space.shape), dtype=np.float32)
+    return space.low + (space.high - space.low) * u
 
 
 def single(env_id: str, seconds: float, sample: bool, backend: str) -> float:
