@@ -63,7 +63,7 @@ pub fn info_layout(task: &TaskInstance) -> Vec<(&'static str, usize, usize)> {
         .into_iter()
         .map(|(name, value)| {
             let mut tmp = Vec::new();
-            push_info(&mut tmp, &value);
+            push_info(&mut tmp, value.as_ref());
             let entry = (name, at, tmp.len());
             at += tmp.len();
             entry

@@ -446,10 +446,7 @@ impl Lander2d {
         };
         let platform_vx = self.platform_direction * params.platform_speed;
         self.wind_force = self.draws.wind_force(&params);
-        let wind = [
-            self.wind_force[0] + self.external_wind_force[0],
-            self.wind_force[1] + self.external_wind_force[1],
-        ];
+        let wind = self.wind_force();
         self.scene = Scene::new(&params, &drone, platform_x, platform_vx, wind);
         self.params = params;
         Ok(())

@@ -25,6 +25,17 @@ pub enum InfoRef<'a> {
     Vector(&'a [f64]),
 }
 
+impl InfoValue {
+    pub fn as_ref(&self) -> InfoRef<'_> {
+        match self {
+            InfoValue::Real(x) => InfoRef::Real(*x),
+            InfoValue::Integer(i) => InfoRef::Integer(*i),
+            InfoValue::Flag(b) => InfoRef::Flag(*b),
+            InfoValue::Vector(v) => InfoRef::Vector(v),
+        }
+    }
+}
+
 impl InfoRef<'_> {
     pub fn to_owned(self) -> InfoValue {
         match self {
