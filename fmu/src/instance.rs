@@ -251,6 +251,13 @@ impl Instance {
         self.log(fmi2Status::fmi2OK, message);
     }
 
+    /// Moves to `stage` and logs `message` as an event.
+    pub fn enter(&mut self, stage: Stage, message: &str) -> Result<(), FmuError> {
+        self.stage = stage;
+        self.event(message);
+        Ok(())
+    }
+
     /// Logs why `function` failed and moves to the Error stage when the error says so.
     pub fn report(&mut self, function: &str, error: &FmuError) -> fmi2Status {
         if error.enters_error_stage() {

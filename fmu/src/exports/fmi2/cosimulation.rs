@@ -42,7 +42,7 @@ unsafe fn status<T>(
     })
 }
 
-exports! {
+forward! {
     /// Advances from `currentCommunicationPoint` (which must be the instance's time) by
     /// `communicationStepSize` (> 0). The time after the step is t0 + n·h on the instance's
     /// grid; a step size within 1e-9 (relative) of the previous one is taken as the previous
@@ -50,12 +50,10 @@ exports! {
     /// Refused with fmi2Error, changing nothing: a mismatched communication point, h <= 0 or
     /// not finite, a step past the stop time. A state that turns non-finite gives fmi2Error
     /// and the Error stage.
-    fn fmi2DoStep(c: fmi2Component, currentCommunicationPoint: fmi2Real, communicationStepSize: fmi2Real, _noSetFMUStatePriorToCurrentPoint: fmi2Boolean) -> fmi2Status {
-        with_instance(c, "fmi2DoStep", masks::DO_STEP, |instance| {
-            instance.sim.do_step(currentCommunicationPoint, communicationStepSize)
-        })
-    }
+    fn fmi2DoStep(c: fmi2Component, currentCommunicationPoint: fmi2Real, communicationStepSize: fmi2Real, _noSetFMUStatePriorToCurrentPoint: fmi2Boolean) -> fmi2Status = masks::DO_STEP => |i| i.sim.do_step(currentCommunicationPoint, communicationStepSize);
+}
 
+exports! {
     /// Never applicable: fmi2DoStep never returns fmi2Pending.
     fn fmi2CancelStep(c: fmi2Component) -> fmi2Status {
         refuse(c, "fmi2CancelStep", masks::CANCEL_STEP, "fmi2DoStep never returns fmi2Pending")

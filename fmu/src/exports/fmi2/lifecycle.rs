@@ -1,7 +1,7 @@
 //! Creating, configuring, initialising, terminating, resetting and freeing an FMI 2.0
 //! instance, and its FMU states.
 
-use crate::exports::guard::{c_str, guarded, with_instance};
+use crate::exports::guard::{c_str, guarded};
 use crate::exports::shared::fmu_state::*;
 use crate::exports::shared::instantiate::{Request, instantiate};
 use crate::exports::shared::lifecycle::*;
@@ -47,28 +47,13 @@ exports! {
             Some(Request { function: "fmi2Instantiate", api: Api::Fmi2, name, interface, token, sink, logging_on })
         })
     }
-
-    /// Sets the start time (and the stop time, if defined). The tolerance is not used: both
-    /// models step on fixed grids.
-    fn fmi2SetupExperiment(c: fmi2Component, _toleranceDefined: fmi2Boolean, _tolerance: fmi2Real, startTime: fmi2Real, stopTimeDefined: fmi2Boolean, stopTime: fmi2Real) -> fmi2Status {
-        let function = "fmi2SetupExperiment";
-        with_instance(c, function, masks::SETUP_EXPERIMENT, |instance| {
-            let stop = (stopTimeDefined != fmi2False).then_some(stopTime);
-            setup_experiment(instance, function, startTime, stop)
-        })
-    }
-
-    fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status {
-        let function = "fmi2EnterInitializationMode";
-        with_instance(c, function, masks::ENTER_INITIALIZATION_MODE, |instance| {
-            instance.stage = Stage::InitializationMode;
-            instance.event(function);
-            Ok(())
-        })
-    }
 }
 
 forward! {
+    /// Sets the start time (and the stop time, if defined). The tolerance is not used: both
+    /// models step on fixed grids.
+    fn fmi2SetupExperiment(c: fmi2Component, _toleranceDefined: fmi2Boolean, _tolerance: fmi2Real, startTime: fmi2Real, stopTimeDefined: fmi2Boolean, stopTime: fmi2Real) -> fmi2Status = masks::SETUP_EXPERIMENT => |i, f| setup_experiment(i, f, startTime, (stopTimeDefined != fmi2False).then_some(stopTime));
+    fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status = masks::ENTER_INITIALIZATION_MODE => |i, f| i.enter(Stage::InitializationMode, f);
     /// Switches log categories: those named in `categories`, or all of them when
     /// `nCategories` is 0. An unknown category name is an error (the others still switch).
     fn fmi2SetDebugLogging(c: fmi2Component, loggingOn: fmi2Boolean, nCategories: usize, categories: *const fmi2String) -> fmi2Status = masks::SET_DEBUG_LOGGING => set_debug_logging;

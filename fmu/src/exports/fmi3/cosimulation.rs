@@ -34,20 +34,12 @@ exports! {
             result
         })
     }
+}
 
+forward! {
     /// Not needed: without event mode (hasEventMode="false") fmi3ExitInitializationMode
     /// already enters step mode.
-    fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status {
-        with_instance(instance, "fmi3EnterStepMode", masks3::ENTER_STEP_MODE, |instance| {
-            instance.check_co_simulation()?;
-            Err::<(), _>(FmuError::NotSupported("event mode is not used (hasEventMode=\"false\"): fmi3ExitInitializationMode enters step mode"))
-        })
-    }
-
+    fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status = masks3::ENTER_STEP_MODE => |i| i.check_co_simulation().and(Err::<(), _>(FmuError::NotSupported("event mode is not used (hasEventMode=\"false\"): fmi3ExitInitializationMode enters step mode")));
     /// maxOutputDerivativeOrder="0".
-    fn fmi3GetOutputDerivatives(instance: fmi3Instance, _valueReferences: *const fmi3ValueReference, _nValueReferences: usize, _orders: *const fmi3Int32, _values: *mut fmi3Float64, _nValues: usize) -> fmi3Status {
-        with_instance(instance, "fmi3GetOutputDerivatives", masks3::GET_OUTPUT_DERIVATIVES, |_| {
-            Err::<(), _>(FmuError::NotSupported("output derivatives (maxOutputDerivativeOrder=\"0\")"))
-        })
-    }
+    fn fmi3GetOutputDerivatives(instance: fmi3Instance, _valueReferences: *const fmi3ValueReference, _nValueReferences: usize, _orders: *const fmi3Int32, _values: *mut fmi3Float64, _nValues: usize) -> fmi3Status = masks3::GET_OUTPUT_DERIVATIVES => |_i| Err::<(), _>(FmuError::NotSupported("output derivatives (maxOutputDerivativeOrder=\"0\")"));
 }

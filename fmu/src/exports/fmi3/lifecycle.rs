@@ -1,7 +1,7 @@
 //! Creating, initialising, terminating, resetting and freeing an FMI 3.0 instance, and its
 //! FMU states (the same states as FMI 2.0's, under FMI 3.0's names).
 
-use crate::exports::guard::{c_str, guarded, with_instance};
+use crate::exports::guard::{c_str, guarded};
 use crate::exports::shared::fmu_state::*;
 use crate::exports::shared::instantiate::{Request, instantiate};
 use crate::exports::shared::lifecycle::*;
@@ -80,21 +80,12 @@ exports! {
         let refusal = Err("Scheduled Execution is not offered (the modelDescription has no ScheduledExecution element)".to_string());
         instantiate(|| Some(request("fmi3InstantiateScheduledExecution", refusal, strings, loggingOn, instanceEnvironment, logMessage)))
     }
-
-    /// Sets the experiment (start and stop time; the tolerance is not used) and enters
-    /// initialization mode.
-    fn fmi3EnterInitializationMode(instance: fmi3Instance, _toleranceDefined: fmi3Boolean, _tolerance: fmi3Float64, startTime: fmi3Float64, stopTimeDefined: fmi3Boolean, stopTime: fmi3Float64) -> fmi3Status {
-        let function = "fmi3EnterInitializationMode";
-        with_instance(instance, function, masks3::ENTER_INITIALIZATION_MODE, |instance| {
-            let stop = (stopTimeDefined != fmi3False).then_some(stopTime);
-            setup_experiment(instance, function, startTime, stop)?;
-            instance.stage = Stage::InitializationMode;
-            Ok(())
-        })
-    }
 }
 
 forward! {
+    /// Sets the experiment (start and stop time; the tolerance is not used) and enters
+    /// initialization mode.
+    fn fmi3EnterInitializationMode(instance: fmi3Instance, _toleranceDefined: fmi3Boolean, _tolerance: fmi3Float64, startTime: fmi3Float64, stopTimeDefined: fmi3Boolean, stopTime: fmi3Float64) -> fmi3Status = masks3::ENTER_INITIALIZATION_MODE => |i, f| setup_experiment(i, f, startTime, (stopTimeDefined != fmi3False).then_some(stopTime)).map(|()| i.stage = Stage::InitializationMode);
     fn fmi3SetDebugLogging(instance: fmi3Instance, loggingOn: fmi3Boolean, nCategories: usize, categories: *const fmi3String) -> fmi3Status = masks::SET_DEBUG_LOGGING => set_debug_logging;
     /// Co-Simulation enters step mode, Model Exchange event mode.
     fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status = masks::EXIT_INITIALIZATION_MODE => exit_initialization_mode;

@@ -87,25 +87,29 @@ pub(crate) fn exit_initialization_mode(
     instance: &mut Instance,
     function: &str,
 ) -> Result<(), FmuError> {
-    instance.stage = match instance.interface {
+    let stage = match instance.interface {
         Interface::CoSimulation => Stage::StepComplete,
         Interface::ModelExchange => Stage::EventMode,
     };
-    instance.event(&format!("{function}: t = {}", Compact(instance.sim.time())));
-    Ok(())
+    instance.enter(
+        stage,
+        &format!("{function}: t = {}", Compact(instance.sim.time())),
+    )
 }
 
 /// The body of fmi2Terminate and fmi3Terminate.
 pub(crate) fn terminate(instance: &mut Instance, function: &str) -> Result<(), FmuError> {
-    instance.stage = Stage::Terminated;
-    instance.event(&format!("{function}: t = {}", Compact(instance.sim.time())));
-    Ok(())
+    instance.enter(
+        Stage::Terminated,
+        &format!("{function}: t = {}", Compact(instance.sim.time())),
+    )
 }
 
 /// The body of fmi2Reset and fmi3Reset: back to the state right after instantiation.
 pub(crate) fn reset(instance: &mut Instance, function: &str) -> Result<(), FmuError> {
     instance.sim.reset()?;
-    instance.stage = Stage::Instantiated;
-    instance.event(&format!("{function}: back to the start values"));
-    Ok(())
+    instance.enter(
+        Stage::Instantiated,
+        &format!("{function}: back to the start values"),
+    )
 }
