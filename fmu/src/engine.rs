@@ -9,10 +9,10 @@
 use crate::error::FmuError;
 use crate::model::{Access, FmuModel, Hybrid, StepRequest};
 use crate::state_record;
-use crate::table::{ModelTable, settable_after_initialisation};
+use crate::table::{Api, ModelTable};
 use flyloop_core::SnapshotError;
 use flyloop_core::number::Compact;
-use flyloop_core::variables::{self, Causality};
+use flyloop_core::variables::{self, Causality, Variability};
 use serde::{Deserialize, Serialize};
 
 /// A communication point matches the instance's time within this fraction of max(1 s, |t|)
@@ -88,7 +88,7 @@ pub struct Experiment {
 
 /// The instance's simulation as the FMI functions drive it; a method named after an FMI
 /// function (`do_step`, `set_time`...) is that function's work.
-pub trait Simulation {
+pub trait Simulation: std::fmt::Debug {
     fn table(&self) -> &'static ModelTable;
     fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> Result<(), FmuError>;
     /// Reads or writes the variable at position `index` of the table; `initialised` once
@@ -205,10 +205,12 @@ impl<M: FmuModel> Engine<M> {
     fn decode(bytes: &[u8]) -> Result<(u8, Book<M::Initial>, M), FmuError> {
         let record: Record = state_record::decode(bytes)?;
         let table = M::table();
-        if record.guid != table.guid {
+        if record.guid != table.token(Api::Fmi2) {
             return Err(FmuError::InvalidArgument(format!(
                 "the FMU state belongs to a model with GUID {}, not to {} {}",
-                record.guid, table.info.identifier, table.guid
+                record.guid,
+                table.info.identifier,
+                table.token(Api::Fmi2)
             )));
         }
         let (book, model): Body<M::Initial> = postcard::from_bytes(&record.body)
@@ -262,10 +264,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
                     reason: "it is an output",
                 });
             }
-            Causality::Parameter
-                if initialised
-                    && !settable_after_initialisation(variable.causality, variable.variability) =>
-            {
+            Causality::Parameter if initialised && variable.variability != Variability::Tunable => {
                 return Err(FmuError::NotSettable {
                     name,
                     reason: "it is a fixed parameter; set it before initialization mode ends",
@@ -342,7 +341,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
     fn save(&self, stage: u8) -> Result<Vec<u8>, FmuError> {
         let body: Body<M::Initial> = (self.book.clone(), self.model.save()?);
         let record = Record {
-            guid: M::table().guid.clone(),
+            guid: M::table().token(Api::Fmi2).to_string(),
             stage,
             body: postcard::to_stdvec(&body)
                 .map_err(|e| FmuError::State(SnapshotError::Encode(e.to_string())))?,

@@ -192,6 +192,7 @@ pub struct SavedState {
     pub bytes: Vec<u8>,
 }
 
+#[derive(Debug)]
 pub struct Instance {
     pub api: Api,
     pub interface: Interface,
@@ -202,17 +203,6 @@ pub struct Instance {
     /// FMU states handed out and not yet freed, by address. A pointer that is not here is
     /// refused instead of dereferenced (double free, foreign pointer).
     states: HashMap<usize, Box<SavedState>>,
-}
-
-impl std::fmt::Debug for Instance {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Instance")
-            .field("name", &self.logger.instance_name)
-            .field("model", &self.sim.table().info.identifier)
-            .field("stage", &self.stage)
-            .field("states", &self.states.len())
-            .finish_non_exhaustive()
-    }
 }
 
 impl Instance {
@@ -260,12 +250,12 @@ impl Instance {
 
     /// Logs why `function` failed and moves to the Error stage when the error says so.
     pub fn report(&mut self, function: &str, error: &FmuError) -> fmi2Status {
-        if error.enters_error_stage() {
+        // A diverged model can no longer step (only get, reset, set state, free).
+        if matches!(error, FmuError::Diverged { .. }) {
             self.stage = Stage::Error;
         }
-        let status = error.status();
-        self.log(status, &format!("{function}: {error}"));
-        status
+        self.log(fmi2Status::fmi2Error, &format!("{function}: {error}"));
+        fmi2Status::fmi2Error
     }
 
     /// Fails with "Illegal call sequence" unless `mask` allows the current stage, and for a

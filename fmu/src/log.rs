@@ -74,7 +74,7 @@ pub enum Sink {
     },
 }
 
-/// The importer's logger with what it needs on every call.
+/// The importer's logger and the instance name it is given.
 #[derive(Debug)]
 pub struct Logger {
     pub sink: Sink,
@@ -82,40 +82,20 @@ pub struct Logger {
 }
 
 impl Logger {
-    /// Sends `message` (see [`Sink::send`]).
-    pub fn log(&self, status: fmi2Status, category: Category, message: &str) {
-        // SAFETY: callback and environment came together from the importer, which keeps
-        // them valid while the instance lives.
-        unsafe {
-            self.sink
-                .send(&self.instance_name, status, category, message)
-        }
-    }
-}
-
-impl Sink {
     /// Calls the callback once with `message` (NUL bytes in it become U+FFFD; FMI 2.0:
     /// always through a "%s" format so that a '%' in it is printed, never interpreted).
-    ///
-    /// # Safety
-    /// The callback and environment must be the importer's, valid for the call.
-    pub unsafe fn send(
-        &self,
-        instance_name: &CStr,
-        status: fmi2Status,
-        category: Category,
-        message: &str,
-    ) {
+    pub fn log(&self, status: fmi2Status, category: Category, message: &str) {
         let text = CString::new(message.replace('\0', "\u{fffd}")).unwrap_or_default();
         let category = CATEGORIES[category as usize].0.as_ptr();
-        match *self {
-            // SAFETY: the caller's contract; every string is NUL-terminated and outlives the
-            // call; the format consumes exactly one string argument.
+        match self.sink {
+            // SAFETY: callback and environment came together from the importer, which keeps
+            // them valid while the instance lives; every string is NUL-terminated and
+            // outlives the call; the format consumes exactly one string argument.
             Sink::Fmi2 {
                 callback,
                 environment,
             } => unsafe {
-                let name = instance_name.as_ptr();
+                let name = self.instance_name.as_ptr();
                 callback(
                     environment,
                     name,

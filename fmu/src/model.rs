@@ -80,7 +80,7 @@ impl<M: VariableTable> Deref for Table<M> {
 
 /// A model behind the FMU: its core variable table, built from start values, advanced by
 /// communication steps, saved to and restored from bytes.
-pub trait FmuModel: VariableTable {
+pub trait FmuModel: VariableTable<Initial: fmt::Debug> + fmt::Debug {
     /// The model's table, built once.
     fn table() -> &'static Table<Self>;
 

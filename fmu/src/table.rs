@@ -165,11 +165,10 @@ pub struct ModelTable {
     pub info: &'static ModelInfo,
     /// Every variable in value-reference order (the modelDescription's order).
     pub variables: Vec<Variable>,
-    pub guid: String,
-    pub guid_c: CString,
-    /// FMI 3.0's instantiationToken (its own interface: arrays, `time`, event indicators).
-    pub token3: String,
-    pub token3_c: CString,
+    /// FMI 2.0's GUID and FMI 3.0's instantiationToken (of its own interface: arrays, `time`,
+    /// event indicators); hex digits, dashes and braces, never a NUL.
+    pub guid: CString,
+    pub token3: CString,
     pub fmi3: Fmi3View,
     /// Value reference → position in `variables`.
     by_vr: VrIndex,
@@ -189,15 +188,11 @@ impl ModelTable {
         variables: Vec<Variable>,
         model_exchange: Option<ModelExchangeTable>,
     ) -> Self {
-        let guid = guid::of_interface(Api::Fmi2, info.identifier, &variables);
-        let token3 = guid::of_interface(Api::Fmi3, info.identifier, &variables);
+        let token = |api| CString::new(guid::of_interface(api, info.identifier, &variables));
         ModelTable {
             info,
-            // A GUID is hex digits, dashes and braces: it never holds a NUL.
-            guid_c: CString::new(guid.clone()).unwrap_or_default(),
-            token3_c: CString::new(token3.clone()).unwrap_or_default(),
-            guid,
-            token3,
+            guid: token(Api::Fmi2).unwrap_or_default(),
+            token3: token(Api::Fmi3).unwrap_or_default(),
             fmi3: Fmi3View::new(info, &variables),
             by_vr: VrIndex::new(variables.iter().map(|v| v.value_reference)),
             variables,
@@ -207,10 +202,11 @@ impl ModelTable {
 
     /// The GUID (FMI 2.0) or instantiation token (FMI 3.0).
     pub fn token(&self, api: Api) -> &str {
-        match api {
+        let token = match api {
             Api::Fmi2 => &self.guid,
             Api::Fmi3 => &self.token3,
-        }
+        };
+        token.to_str().unwrap_or_default()
     }
 
     pub fn index(&self, vr: u32) -> Option<usize> {
@@ -225,10 +221,6 @@ impl ModelTable {
         Ok(index)
     }
 
-    pub fn variable(&self, vr: u32) -> Option<&Variable> {
-        self.variables.get(self.index(vr)?)
-    }
-
     pub fn by_name(&self, name: &str) -> Option<&Variable> {
         self.variables.iter().find(|v| v.name == name)
     }
@@ -241,12 +233,6 @@ impl ModelTable {
             .find(|(name, _)| *name == output)
             .map_or(&[], |(_, inputs)| inputs)
     }
-}
-
-/// Whether a variable of `variability` and `causality` may be set once initialised.
-pub fn settable_after_initialisation(causality: Causality, variability: Variability) -> bool {
-    causality == Causality::Input
-        || (causality == Causality::Parameter && variability == Variability::Tunable)
 }
 
 /// Value reference of the FMI 3.0 independent variable `time` (above every model's own).
@@ -301,7 +287,7 @@ pub struct Variable3 {
 }
 
 impl Variable3 {
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.dimension.unwrap_or(1)
     }
 
@@ -312,11 +298,6 @@ impl Variable3 {
             Source::Model(elements) => elements,
             _ => &[],
         }
-    }
-
-    /// Never true: every variable holds at least one value.
-    pub fn is_empty(&self) -> bool {
-        false
     }
 
     /// A real local without start or range (`time`, the event indicators).
@@ -415,19 +396,6 @@ impl Fmi3View {
         }
     }
 
-    /// The FMI 3.0 variables holding the model variables `vrs`, each once, in order.
-    pub fn collapse(&self, vrs: &[u32]) -> Vec<u32> {
-        let mut out: Vec<u32> = Vec::new();
-        for &vr in vrs {
-            if let Some((fmi3, _)) = self.element(vr) {
-                if !out.contains(&fmi3) {
-                    out.push(fmi3);
-                }
-            }
-        }
-        out
-    }
-
     /// The FMI 3.0 variable (value reference) and element index holding model variable `vr`.
     pub fn element(&self, vr: u32) -> Option<(u32, usize)> {
         let at = self
@@ -441,11 +409,6 @@ impl Fmi3View {
     pub fn variable(&self, vr: u32) -> Option<&Variable3> {
         self.variables.get(self.by_vr.get(vr)?)
     }
-
-    /// The variable named `name`.
-    pub fn by_name(&self, name: &str) -> Option<&Variable3> {
-        self.variables.iter().find(|v| v.name == name)
-    }
 }
 
 #[cfg(test)]
@@ -453,11 +416,15 @@ mod tests {
     use super::*;
     use crate::models::tables;
 
+    fn by_name<'a>(view: &'a Fmi3View, name: &str) -> &'a Variable3 {
+        view.variables.iter().find(|v| v.name == name).unwrap()
+    }
+
     #[test]
     fn motor_commands_are_one_array_and_every_model_value_has_one_home() {
         let [quad, lander] = tables();
         let layout = &quad.fmi3;
-        let command = layout.by_name("motor_command").unwrap();
+        let command = by_name(layout, "motor_command");
         assert_eq!(command.value_reference, 0);
         assert_eq!(command.dimension, Some(4));
         assert_eq!(command.source, Source::Model(vec![0, 1, 2, 3]));
@@ -467,12 +434,14 @@ mod tests {
             None,
             "element 1 has no value reference of its own"
         );
-        assert_eq!(layout.by_name("der(motor_state)").unwrap().len(), 4);
+        assert_eq!(by_name(layout, "der(motor_state)").len(), 4);
         assert_eq!(layout.element(2), Some((0, 2)));
         // 25 states: 13 body scalars + motor_state[4] + 8 bristles = 22 variables.
         let me = quad.model_exchange.as_ref().unwrap();
-        assert_eq!(layout.collapse(&me.states).len(), 22);
-        assert_eq!(layout.collapse(&me.derivatives).len(), 22);
+        for vrs in [&me.states, &me.derivatives] {
+            let firsts = vrs.iter().filter(|&&vr| layout.element(vr).unwrap().1 == 0);
+            assert_eq!(firsts.count(), 22);
+        }
         assert_eq!(layout.event_indicators, [1001, 1002, 1003, 1004]);
         for table in [quad, lander] {
             let layout = &table.fmi3;

@@ -174,7 +174,7 @@ mod tests {
     fn a_panic_becomes_fatal_with_a_message_and_only_free_instance_remains() {
         let recorder = importer_logger::Recorder::default();
         let callbacks = recorder.callbacks();
-        let guid = crate::models::tables()[0].guid_c.clone();
+        let guid = crate::models::tables()[0].guid.clone();
         // SAFETY: valid strings and callbacks.
         let c = unsafe {
             fmi2Instantiate(

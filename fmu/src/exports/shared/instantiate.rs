@@ -29,12 +29,12 @@ pub(crate) fn create_instance(request: &Request<'_>) -> Option<*mut Instance> {
     match new_instance(request) {
         Ok(instance) => Some(Box::into_raw(Box::new(instance))),
         Err(message) => {
-            let shown = request.name.map(CStr::to_owned).unwrap_or_default();
-            let message = format!("{}: {message}", request.function);
-            // SAFETY: the sink's callback and environment come together from the importer.
-            unsafe {
-                (request.sink).send(&shown, fmi2Status::fmi2Error, Category::Error, &message)
+            let logger = Logger {
+                sink: request.sink,
+                instance_name: request.name.map(CStr::to_owned).unwrap_or_default(),
             };
+            let message = format!("{}: {message}", request.function);
+            logger.log(fmi2Status::fmi2Error, Category::Error, &message);
             None
         }
     }
