@@ -46,7 +46,6 @@ unsafe fn request<'a>(
 }
 
 exports! {
-    /// Frees the instance and every FMU state it handed out. NULL is ignored.
     fn fmi3FreeInstance(instance: fmi3Instance) {
         free_instance(instance, "fmi3FreeInstance");
     }
@@ -87,20 +86,13 @@ forward! {
     /// initialization mode.
     fn fmi3EnterInitializationMode(instance: fmi3Instance, _toleranceDefined: fmi3Boolean, _tolerance: fmi3Float64, startTime: fmi3Float64, stopTimeDefined: fmi3Boolean, stopTime: fmi3Float64) -> fmi3Status = masks3::ENTER_INITIALIZATION_MODE => |i, f| setup_experiment(i, f, startTime, (stopTimeDefined != fmi3False).then_some(stopTime)).map(|()| i.stage = Stage::InitializationMode);
     fn fmi3SetDebugLogging(instance: fmi3Instance, loggingOn: fmi3Boolean, nCategories: usize, categories: *const fmi3String) -> fmi3Status = masks::SET_DEBUG_LOGGING => set_debug_logging;
-    /// Co-Simulation enters step mode, Model Exchange event mode.
     fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status = masks::EXIT_INITIALIZATION_MODE => exit_initialization_mode;
     fn fmi3Terminate(instance: fmi3Instance) -> fmi3Status = masks::TERMINATE => terminate;
-    /// Back to the state right after instantiation: start values, no experiment.
     fn fmi3Reset(instance: fmi3Instance) -> fmi3Status = masks::RESET => reset;
-    /// Copies the current state; `*FMUState` NULL gets a new state, a state of this instance
-    /// is overwritten in place.
     fn fmi3GetFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status = masks::FMU_STATE => get_state;
-    /// Restores a state of this instance; `FMUState` is looked up, never dereferenced.
     fn fmi3SetFMUState(instance: fmi3Instance, FMUState: fmi3FMUState) -> fmi3Status = masks::FMU_STATE => set_state;
-    /// Frees a state and sets `*FMUState` to NULL.
     fn fmi3FreeFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status = masks::FMU_STATE => free_state;
     fn fmi3SerializedFMUStateSize(instance: fmi3Instance, FMUState: fmi3FMUState, size: *mut usize) -> fmi3Status = masks::FMU_STATE => serialized_size;
     fn fmi3SerializeFMUState(instance: fmi3Instance, FMUState: fmi3FMUState, serializedState: *mut fmi3Byte, size: usize) -> fmi3Status = masks::FMU_STATE => serialize;
-    /// Makes a state from serialized bytes after checking them completely.
     fn fmi3DeserializeFMUState(instance: fmi3Instance, serializedState: *const fmi3Byte, size: usize, FMUState: *mut fmi3FMUState) -> fmi3Status = masks::FMU_STATE => deserialize;
 }

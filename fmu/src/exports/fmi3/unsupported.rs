@@ -5,9 +5,10 @@
 
 use super::values::{accessors, each_variable, resolve};
 use crate::error::FmuError;
-use crate::exports::guard::{c_slice, refuse, with_instance};
+use crate::exports::guard::{c_slice, refuse};
+use crate::fmi2_types::fmi2Status;
 use crate::fmi3_types::*;
-use crate::instance::{Mask, masks3};
+use crate::instance::{Instance, masks3};
 use crate::table::{Api, ValueType};
 
 /// Defines fmi3Get<T> and fmi3Set<T> for types no variable has: every value reference is
@@ -36,37 +37,28 @@ no_variables! {
 ///
 /// # Safety
 /// `vr` must be NULL or hold `nvr` elements.
-unsafe fn no_binary(
-    instance: fmi3Instance,
-    function: &'static str,
-    mask: Mask,
+unsafe fn no_binary<B>(
+    instance: &mut Instance,
+    function: &str,
     (vr, nvr): (*const fmi3ValueReference, usize),
-    (values_null, n_values): (bool, usize),
-) -> fmi3Status {
-    with_instance(instance, function, mask, |instance| {
-        // SAFETY: per the function's contract.
-        let vrs = unsafe { c_slice(vr, nvr, "valueReferences[]") }?;
-        let variables = resolve(&instance.sim.table().fmi3, vrs, n_values)?;
-        if values_null && n_values > 0 {
-            return Err(FmuError::NullArgument("values[]"));
-        }
-        let binary = ValueType::none(Api::Fmi3, "Binary");
-        each_variable(instance, function, variables, binary, |_, _, _| Ok(()))
-    })
+    values: *const B,
+    n_values: usize,
+) -> Result<fmi2Status, FmuError> {
+    // SAFETY: per the function's contract.
+    let vrs = unsafe { c_slice(vr, nvr, "valueReferences[]") }?;
+    let variables = resolve(&instance.sim.table().fmi3, vrs, n_values)?;
+    if values.is_null() && n_values > 0 {
+        return Err(FmuError::NullArgument("values[]"));
+    }
+    let binary = ValueType::none(Api::Fmi3, "Binary");
+    each_variable(instance, function, variables, binary, |_, _, _| Ok(()))
 }
 
-exports! {
+forward! {
     /// No Binary variables: every value reference is refused.
-    fn fmi3GetBinary(instance: fmi3Instance, valueReferences: *const fmi3ValueReference, nValueReferences: usize, _valueSizes: *mut usize, values: *mut fmi3Binary, nValues: usize) -> fmi3Status {
-        let vrs = (valueReferences, nValueReferences);
-        no_binary(instance, "fmi3GetBinary", masks3::GET_VALUE, vrs, (values.is_null(), nValues))
-    }
-
+    fn fmi3GetBinary(instance: fmi3Instance, valueReferences: *const fmi3ValueReference, nValueReferences: usize, _valueSizes: *mut usize, values: *mut fmi3Binary, nValues: usize) -> fmi3Status = masks3::GET_VALUE => |i, f| no_binary(i, f, (valueReferences, nValueReferences), values.cast_const(), nValues);
     /// No Binary variables: every value reference is refused.
-    fn fmi3SetBinary(instance: fmi3Instance, valueReferences: *const fmi3ValueReference, nValueReferences: usize, _valueSizes: *const usize, values: *const fmi3Binary, nValues: usize) -> fmi3Status {
-        let vrs = (valueReferences, nValueReferences);
-        no_binary(instance, "fmi3SetBinary", masks3::SET_OTHER, vrs, (values.is_null(), nValues))
-    }
+    fn fmi3SetBinary(instance: fmi3Instance, valueReferences: *const fmi3ValueReference, nValueReferences: usize, _valueSizes: *const usize, values: *const fmi3Binary, nValues: usize) -> fmi3Status = masks3::SET_OTHER => |i, f| no_binary(i, f, (valueReferences, nValueReferences), values, nValues);
 }
 
 const NO_CLOCKS: &str = "this FMU has no clocks";
