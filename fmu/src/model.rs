@@ -24,7 +24,8 @@ pub struct StepRequest {
 }
 
 /// How the FMU reaches a variable in the model.
-pub enum Access<M: VariableTable> {
+#[derive(Debug)]
+pub enum Access<M: FmuModel> {
     /// A row of the core's table.
     Core(Row<M>),
     /// A read-only value the core's table does not hold (Model Exchange's extra states and
@@ -35,23 +36,14 @@ pub enum Access<M: VariableTable> {
     },
 }
 
-impl<M: VariableTable> fmt::Debug for Access<M> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Access::Core(_) => f.write_str("Core"),
-            Access::Local { at, .. } => write!(f, "Local({at})"),
-        }
-    }
-}
-
 /// A model's FMI table with the access to each of its variables, at the same positions.
 #[derive(Debug)]
-pub struct Table<M: VariableTable> {
+pub struct Table<M: FmuModel> {
     pub table: ModelTable,
     pub access: Vec<Access<M>>,
 }
 
-impl<M: VariableTable> Table<M> {
+impl<M: FmuModel> Table<M> {
     /// The core's variables of `M`, then `locals`.
     pub fn new(
         info: &'static ModelInfo,
@@ -70,7 +62,7 @@ impl<M: VariableTable> Table<M> {
     }
 }
 
-impl<M: VariableTable> Deref for Table<M> {
+impl<M: FmuModel> Deref for Table<M> {
     type Target = ModelTable;
 
     fn deref(&self) -> &ModelTable {
@@ -80,7 +72,7 @@ impl<M: VariableTable> Deref for Table<M> {
 
 /// A model behind the FMU: its core variable table, built from start values, advanced by
 /// communication steps, saved to and restored from bytes.
-pub trait FmuModel: VariableTable<Initial: fmt::Debug> + fmt::Debug {
+pub trait FmuModel: VariableTable<Initial: fmt::Debug, Params: fmt::Debug> + fmt::Debug {
     /// The model's table, built once.
     fn table() -> &'static Table<Self>;
 

@@ -7,7 +7,7 @@
 //! modelDescription/ can be compared byte for byte.
 
 use crate::log::CATEGORIES;
-use crate::table::{Api, Causality3, ModelTable, Variable3};
+use crate::table::{Api, ModelTable, Variable3};
 use crate::units::{self, BASE_UNITS};
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::{Causality, Variable};
@@ -240,11 +240,15 @@ impl<'a> Writer<'a> {
             let _ = writeln!(out, "    <!-- Index {} -->", i + 1);
         }
         let (name, vr, text) = (escape(&v.name), v.value_reference, escape(&v.description));
-        let (causality, variability) = (v.causality.name(), format!("{:?}", v.variability));
+        let causality = v
+            .causality
+            .map_or("independent".into(), |c| format!("{c:?}"));
+        let variability = format!("{:?}", v.variability);
         let _ = write!(
             out,
             "    <{element} name=\"{name}\" valueReference=\"{vr}\" description=\"{text}\" \
-             causality=\"{causality}\" variability=\"{}\"",
+             causality=\"{}\" variability=\"{}\"",
+            causality.to_lowercase(),
             variability.to_lowercase()
         );
         if self.api == Api::Fmi2 {
@@ -301,7 +305,7 @@ impl<'a> Writer<'a> {
     fn model_structure(&mut self) {
         let me = self.table.model_exchange.as_ref();
         let outputs: Vec<(u32, Option<String>)> = (self.variables.iter().enumerate())
-            .filter(|(_, v)| v.causality == Causality3::Model(Causality::Output))
+            .filter(|(_, v)| v.causality == Some(Causality::Output))
             .map(|(i, v)| {
                 let elements = v.elements().iter().map(|&at| &self.table.variables[at]);
                 let vrs = elements.flat_map(|e| output_dependencies(self.table, e));

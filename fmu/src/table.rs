@@ -240,23 +240,6 @@ pub const TIME_VR: u32 = 1000;
 /// Value reference of the first FMI 3.0 event-indicator variable; the others follow.
 pub const EVENT_INDICATOR_VR: u32 = 1001;
 
-/// FMI 3.0 causality: the model's, or `independent` for `time`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Causality3 {
-    Independent,
-    Model(Causality),
-}
-
-impl Causality3 {
-    /// The attribute's text in the modelDescription.
-    pub fn name(self) -> String {
-        match self {
-            Causality3::Independent => "independent".to_string(),
-            Causality3::Model(c) => format!("{c:?}").to_lowercase(),
-        }
-    }
-}
-
 /// Where an FMI 3.0 variable's values come from.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Source {
@@ -274,7 +257,8 @@ pub struct Variable3 {
     pub description: String,
     pub value_reference: u32,
     pub kind: ValueKind,
-    pub causality: Causality3,
+    /// The model's causality; `None` for the independent variable `time`.
+    pub causality: Option<Causality>,
     pub variability: Variability,
     pub unit: &'static str,
     pub min: Option<f64>,
@@ -307,7 +291,7 @@ impl Variable3 {
             description: text.to_string(),
             value_reference: vr,
             kind: ValueKind::Real,
-            causality: Causality3::Model(Causality::Local),
+            causality: Some(Causality::Local),
             variability: Variability::Continuous,
             unit,
             min: None,
@@ -330,7 +314,7 @@ impl Variable3 {
                 .to_string(),
             value_reference: v.value_reference,
             kind: v.kind,
-            causality: Causality3::Model(v.causality),
+            causality: Some(v.causality),
             variability: v.variability,
             unit: v.unit,
             min: v.min,
@@ -359,7 +343,7 @@ pub struct Fmi3View {
 impl Fmi3View {
     fn new(info: &ModelInfo, model: &[Variable]) -> Self {
         let time = Variable3 {
-            causality: Causality3::Independent,
+            causality: None,
             ..Variable3::computed("time", TIME_VR, "s", "Simulation time", Source::Time)
         };
         let mut variables = vec![time];

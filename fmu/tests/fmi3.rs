@@ -7,6 +7,7 @@
 
 mod support;
 
+use flyloop_core::variables::Causality;
 use flyloop_fmu::exports::*;
 use flyloop_fmu::fmi2_types::{fmi2LastSuccessfulTime, fmi2Status};
 use flyloop_fmu::fmi3_types::fmi3Status::{fmi3Error, fmi3OK};
@@ -164,7 +165,8 @@ fn fmi3_outputs(model: Model) -> Vec<(u32, usize)> {
         .variables
         .iter()
         .filter(|v| {
-            v.causality.name() == "output" && v.kind == flyloop_core::params::ValueKind::Real
+            v.causality == Some(Causality::Output)
+                && v.kind == flyloop_core::params::ValueKind::Real
         })
         .map(|v| (v.value_reference, v.dimension.unwrap_or(1)))
         .collect()
