@@ -5,7 +5,7 @@
 use crate::engine::Simulation;
 use crate::error::FmuError;
 use crate::fmi2_types::fmi2Status;
-use crate::log::{LogFilter, Logger, category_of};
+use crate::log::{Logger, category_of};
 use crate::table::Api;
 use std::collections::HashMap;
 
@@ -197,7 +197,8 @@ pub struct Instance {
     pub api: Api,
     pub interface: Interface,
     pub logger: Logger,
-    pub filter: LogFilter,
+    /// Whether each category (by its position in [`crate::log::CATEGORIES`]) is logged.
+    pub logging: [bool; 4],
     pub stage: Stage,
     pub sim: Box<dyn Simulation>,
     /// FMU states handed out and not yet freed, by address. A pointer that is not here is
@@ -217,7 +218,7 @@ impl Instance {
             api,
             interface,
             logger,
-            filter: LogFilter::at_instantiation(logging_on),
+            logging: [logging_on, logging_on, true, true],
             stage: Stage::Instantiated,
             sim,
             states: HashMap::new(),
@@ -231,7 +232,7 @@ impl Instance {
 
     pub fn log(&self, status: fmi2Status, message: &str) {
         let category = category_of(status);
-        if self.filter.enabled(category) {
+        if self.logging[category as usize] {
             self.logger.log(status, category, message);
         }
     }

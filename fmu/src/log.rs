@@ -1,11 +1,6 @@
-//! Logging through the importer's logger (FMI 2.0's variadic one or FMI 3.0's
-//! `fmi3LogMessageCallback`), by category.
-//!
-//! Categories (declared in the modelDescription's LogCategories): `logEvents` (lifecycle),
-//! `logStatusWarning`, `logStatusError` and `logStatusFatal`. fmi2Instantiate's loggingOn
-//! switches `logEvents` and `logStatusWarning`; errors and fatal errors are on from the start,
-//! because a status without its reason helps nobody. fmi2SetDebugLogging switches the
-//! categories it names (all of them when it names none), errors included.
+//! Logging through the importer's logger (FMI 2.0's variadic one or FMI 3.0's), by category.
+//! fmi2Instantiate's loggingOn switches events and warnings; errors and fatal errors are on
+//! from the start, because a status without its reason helps nobody.
 
 use crate::fmi2_types::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status};
 use crate::fmi3_types::{fmi3InstanceEnvironment, fmi3LogMessageCallback};
@@ -35,28 +30,6 @@ impl Category {
     pub fn from_name(name: &str) -> Option<Category> {
         let at = CATEGORIES.iter().position(|(c, _)| c.to_str() == Ok(name));
         at.map(|at| Self::ALL[at])
-    }
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct LogFilter([bool; 4]);
-
-impl LogFilter {
-    /// The filter after fmi2Instantiate(..., loggingOn).
-    pub fn at_instantiation(logging_on: bool) -> Self {
-        LogFilter([logging_on, logging_on, true, true])
-    }
-
-    pub fn set(&mut self, category: Category, on: bool) {
-        self.0[category as usize] = on;
-    }
-
-    pub fn set_all(&mut self, on: bool) {
-        self.0 = [on; 4];
-    }
-
-    pub fn enabled(&self, category: Category) -> bool {
-        self.0[category as usize]
     }
 }
 

@@ -120,9 +120,9 @@ fn write_units(out: &mut String, variables: &[Variable3]) -> Result<(), UnknownU
 /// The value references `output` depends on: its direct-feedthrough inputs and, under Model
 /// Exchange, the continuous states (none for a state itself, which is its own known).
 fn output_dependencies(table: &ModelTable, output: &Variable) -> Vec<u32> {
-    let mut dependencies: Vec<u32> = table
-        .direct_feedthrough(output.name)
-        .iter()
+    let feedthrough = table.info.direct_feedthrough.iter();
+    let inputs = feedthrough.filter(|(name, _)| *name == output.name);
+    let mut dependencies: Vec<u32> = (inputs.flat_map(|(_, inputs)| inputs.iter()))
         .filter_map(|name| table.by_name(name))
         .map(|v| v.value_reference)
         .collect();

@@ -1,7 +1,5 @@
-//! A model's variable table as the FMI layer looks it up on every call: the core's variables
-//! by value reference, the GUID and instantiation token that tie a modelDescription to the
-//! binary, and the FMI 3.0 view of the same variables ([`Fmi3View`]: arrays, `time`, one
-//! variable per event indicator).
+//! A model's variable table as the FMI layer looks it up on every call, with the FMI 3.0 view
+//! of the same variables ([`Fmi3View`]: arrays, `time`, one variable per event indicator).
 
 use crate::error::FmuError;
 use crate::guid;
@@ -125,9 +123,8 @@ pub struct ModelInfo {
     pub event_indicators: &'static [(&'static str, &'static str, &'static str)],
 }
 
-/// What a Model-Exchange capable model adds to its table: its continuous states and their
-/// derivatives as variables (value references in state-vector order) and its number of event
-/// indicators.
+/// What a Model-Exchange capable model adds to its table: value references of its continuous
+/// states and their derivatives (in state-vector order).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ModelExchangeTable {
     pub states: Vec<u32>,
@@ -135,15 +132,14 @@ pub struct ModelExchangeTable {
     pub event_indicators: usize,
 }
 
-/// Value reference → position in a variable list, in O(1): a dense table up to the largest
-/// value reference (about a thousand entries here).
+/// Value reference → position in a variable list: a dense table up to the largest value
+/// reference (about a thousand entries here).
 #[derive(Debug, Default)]
 pub struct VrIndex(Vec<u32>);
 
 impl VrIndex {
     const NONE: u32 = u32::MAX;
 
-    /// The index of `vrs`, the i-th value reference at position i.
     pub fn new(vrs: impl Iterator<Item = u32> + Clone) -> Self {
         let len = vrs.clone().max().map_or(0, |m| m as usize + 1);
         let mut table = vec![Self::NONE; len];
@@ -159,7 +155,6 @@ impl VrIndex {
     }
 }
 
-/// The variable table of a model with what the FMI layer looks up on every call.
 #[derive(Debug)]
 pub struct ModelTable {
     pub info: &'static ModelInfo,
@@ -172,14 +167,10 @@ pub struct ModelTable {
     pub fmi3: Fmi3View,
     /// Value reference → position in `variables`.
     by_vr: VrIndex,
-    /// States and derivatives, for a model that offers Model Exchange.
     pub model_exchange: Option<ModelExchangeTable>,
 }
 
 impl ModelTable {
-    /// The table of `info` over `variables` (which include the states and derivatives
-    /// `model_exchange` names).
-    ///
     /// # Panics
     /// If a declared array's elements are not in the table (a fault of the model's
     /// [`ModelInfo::arrays`], found by the crate's tests).
@@ -200,7 +191,6 @@ impl ModelTable {
         }
     }
 
-    /// The GUID (FMI 2.0) or instantiation token (FMI 3.0).
     pub fn token(&self, api: Api) -> &str {
         let token = match api {
             Api::Fmi2 => &self.guid,
@@ -224,15 +214,6 @@ impl ModelTable {
     pub fn by_name(&self, name: &str) -> Option<&Variable> {
         self.variables.iter().find(|v| v.name == name)
     }
-
-    /// The inputs output `output` depends on directly (see [`ModelInfo::direct_feedthrough`]).
-    pub fn direct_feedthrough(&self, output: &str) -> &'static [&'static str] {
-        self.info
-            .direct_feedthrough
-            .iter()
-            .find(|(name, _)| *name == output)
-            .map_or(&[], |(_, inputs)| inputs)
-    }
 }
 
 /// Value reference of the FMI 3.0 independent variable `time` (above every model's own).
@@ -243,14 +224,12 @@ pub const EVENT_INDICATOR_VR: u32 = 1001;
 /// Where an FMI 3.0 variable's values come from.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Source {
-    /// The model's variables at these positions of [`ModelTable::variables`] (one for a
-    /// scalar).
+    /// Positions in [`ModelTable::variables`] (one for a scalar).
     Model(Vec<usize>),
     Time,
     EventIndicator(usize),
 }
 
-/// One FMI 3.0 variable.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Variable3 {
     pub name: String,
@@ -263,7 +242,7 @@ pub struct Variable3 {
     pub unit: &'static str,
     pub min: Option<f64>,
     pub max: Option<f64>,
-    /// Start value of each element (empty when there is none).
+    /// Of each element (empty when there is none).
     pub start: Vec<f64>,
     /// `None` for a scalar, else the array's length.
     pub dimension: Option<usize>,
@@ -275,8 +254,7 @@ impl Variable3 {
         self.dimension.unwrap_or(1)
     }
 
-    /// The positions in [`ModelTable::variables`] of the model variables behind this one
-    /// (none for `time` and the event indicators).
+    /// The positions in [`ModelTable::variables`] behind this variable.
     pub fn elements(&self) -> &[usize] {
         match &self.source {
             Source::Model(elements) => elements,

@@ -40,7 +40,7 @@ pub(crate) unsafe fn set_debug_logging(
     // SAFETY: per the function's contract.
     let names = unsafe { c_slice(categories, n, "categories[]") }?;
     if names.is_empty() {
-        instance.filter.set_all(on);
+        instance.logging = [on; 4];
         return Ok(fmi2Status::fmi2OK);
     }
     let mut worst = fmi2Status::fmi2OK;
@@ -49,7 +49,7 @@ pub(crate) unsafe fn set_debug_logging(
         let name = unsafe { c_str(name) }.map(CStr::to_string_lossy);
         let error = match name.as_deref().map(|n| (n, Category::from_name(n))) {
             Some((_, Some(category))) => {
-                instance.filter.set(category, on);
+                instance.logging[category as usize] = on;
                 continue;
             }
             Some((n, None)) => FmuError::InvalidArgument(format!(
