@@ -43,7 +43,7 @@ impl Stage {
         Stage::ContinuousTimeMode,
     ];
 
-    /// A small code for FMU state bytes.
+    /// The stage's code in FMU state bytes.
     pub fn code(self) -> u8 {
         (self as u16).trailing_zeros() as u8
     }
@@ -52,7 +52,6 @@ impl Stage {
         Stage::ALL.into_iter().find(|s| s.code() == code)
     }
 
-    /// Whether an instance of `interface` can be in this stage.
     pub fn belongs_to(self, interface: Interface) -> bool {
         let model_exchange = matches!(self, Stage::EventMode | Stage::ContinuousTimeMode);
         let co_simulation = matches!(
@@ -66,7 +65,6 @@ impl Stage {
     }
 }
 
-/// The interface an instance was created for (fmi2Instantiate's fmuType).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Interface {
     CoSimulation,
@@ -237,7 +235,6 @@ impl Instance {
         }
     }
 
-    /// Logs a lifecycle event (status OK: category logEvents).
     pub fn event(&self, message: &str) {
         self.log(fmi2Status::fmi2OK, message);
     }
@@ -249,7 +246,7 @@ impl Instance {
         Ok(())
     }
 
-    /// Logs why `function` failed and moves to the Error stage when the error says so.
+    /// Logs why `function` failed.
     pub fn report(&mut self, function: &str, error: &FmuError) -> fmi2Status {
         // A diverged model can no longer step (only get, reset, set state, free).
         if matches!(error, FmuError::Diverged { .. }) {
@@ -259,8 +256,6 @@ impl Instance {
         fmi2Status::fmi2Error
     }
 
-    /// Fails with "Illegal call sequence" unless `mask` allows the current stage, and for a
-    /// Model Exchange function on a Co-Simulation instance.
     pub fn check_stage(&self, mask: Mask) -> Result<(), FmuError> {
         if !mask.allows(self.stage) {
             return Err(FmuError::IllegalCall {
@@ -292,8 +287,7 @@ impl Instance {
         }
     }
 
-    /// The stage saved as `code` in an FMU state, if an instance of this interface can be
-    /// in it.
+    /// The stage saved as `code`, if an instance of this interface can be in it.
     pub fn stage_from_code(&self, code: u8) -> Result<Stage, FmuError> {
         let stage = Stage::from_code(code).ok_or_else(|| {
             FmuError::InvalidArgument(format!("the FMU state holds an unknown stage code {code}"))

@@ -50,17 +50,9 @@ pub(crate) fn with_instance<R: Into<fmi2Status>, S: From<fmi2Status>>(
     }))
 }
 
-/// The body of a function this FMU does not offer: refuses with `why` (after the NULL and
-/// stage checks).
-pub(crate) fn refuse<S: From<fmi2Status>>(
-    c: fmi2Component,
-    function: &'static str,
-    mask: Mask,
-    why: &'static str,
-) -> S {
-    with_instance(c, function, mask, |_| {
-        Err::<(), _>(FmuError::NotSupported(why))
-    })
+/// The body of a function this FMU does not offer: refuses with `why`.
+pub(crate) fn refuse(why: &'static str) -> Result<(), FmuError> {
+    Err(FmuError::NotSupported(why))
 }
 
 /// A body without a status of its own answers OK.

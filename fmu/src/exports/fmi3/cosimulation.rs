@@ -3,7 +3,7 @@
 //! need.
 
 use crate::error::FmuError;
-use crate::exports::guard::{with_instance, write_out};
+use crate::exports::guard::{refuse, with_instance, write_out};
 use crate::fmi3_types::*;
 use crate::instance::{masks, masks3};
 
@@ -39,7 +39,7 @@ exports! {
 forward! {
     /// Not needed: without event mode (hasEventMode="false") fmi3ExitInitializationMode
     /// already enters step mode.
-    fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status = masks3::ENTER_STEP_MODE => |i| i.check_co_simulation().and(Err::<(), _>(FmuError::NotSupported("event mode is not used (hasEventMode=\"false\"): fmi3ExitInitializationMode enters step mode")));
+    fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status = masks3::ENTER_STEP_MODE => |i| i.check_co_simulation().and(refuse("event mode is not used (hasEventMode=\"false\"): fmi3ExitInitializationMode enters step mode"));
     /// maxOutputDerivativeOrder="0".
-    fn fmi3GetOutputDerivatives(instance: fmi3Instance, _valueReferences: *const fmi3ValueReference, _nValueReferences: usize, _orders: *const fmi3Int32, _values: *mut fmi3Float64, _nValues: usize) -> fmi3Status = masks3::GET_OUTPUT_DERIVATIVES => |_i| Err::<(), _>(FmuError::NotSupported("output derivatives (maxOutputDerivativeOrder=\"0\")"));
+    fn fmi3GetOutputDerivatives(instance: fmi3Instance, _valueReferences: *const fmi3ValueReference, _nValueReferences: usize, _orders: *const fmi3Int32, _values: *mut fmi3Float64, _nValues: usize) -> fmi3Status = masks3::GET_OUTPUT_DERIVATIVES => |_i| refuse("output derivatives (maxOutputDerivativeOrder=\"0\")");
 }

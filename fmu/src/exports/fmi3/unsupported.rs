@@ -5,7 +5,7 @@
 
 use super::values::{accessors, each_variable, resolve};
 use crate::error::FmuError;
-use crate::exports::guard::{c_slice, refuse};
+use crate::exports::guard::{c_slice, refuse, with_instance};
 use crate::fmi2_types::fmi2Status;
 use crate::fmi3_types::*;
 use crate::instance::{Instance, masks3};
@@ -73,7 +73,7 @@ macro_rules! refused {
             /// `instance` must be NULL or live; nothing else is read.
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn $name(instance: fmi3Instance, $(_: $t),*) -> fmi3Status {
-                refuse(instance, stringify!($name), masks3::ANY, $why)
+                with_instance(instance, stringify!($name), masks3::ANY, |_| refuse($why))
             }
         )*
     };
