@@ -4,7 +4,7 @@
 //! discrete changes happen at events only, never inside the solver's trial steps.
 
 use crate::error::FmuError;
-use crate::model::{Access, FmuModel, Hybrid, StepRequest};
+use crate::model::{Access, FmuModel, Hybrid, StepRequest, Table};
 use crate::state_record;
 use crate::table::{Api, ModelTable};
 use flyloop_core::SnapshotError;
@@ -166,7 +166,7 @@ impl<M: FmuModel> Engine<M> {
     /// The model's hybrid view, after checking that the importer's array `name` of length
     /// `len` has one entry per continuous state (`ni`: per event indicator).
     fn hybrid(&self, len: usize, name: &str) -> Result<&dyn Hybrid, FmuError> {
-        let table = M::table();
+        let table = &M::table().table;
         let (Some(me), Some(hybrid)) = (&table.model_exchange, self.model.hybrid()) else {
             return Err(co_simulation_only());
         };
@@ -189,7 +189,7 @@ impl<M: FmuModel> Engine<M> {
 
     fn decode(bytes: &[u8]) -> Result<(u8, Book<M::Initial>, M), FmuError> {
         let record: Record = state_record::decode(bytes)?;
-        let table = M::table();
+        let table = &M::table().table;
         if record.guid != table.token(Api::Fmi2) {
             return Err(FmuError::InvalidArgument(format!(
                 "the FMU state belongs to a model with GUID {}, not to {} {}",
@@ -239,7 +239,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
     }
 
     fn set(&mut self, index: usize, value: f64, initialised: bool) -> Result<(), FmuError> {
-        let table = M::table();
+        let Table { table, access } = M::table();
         let variable = &table.variables[index];
         let (name, vr) = (variable.name, variable.value_reference);
         match variable.causality {
@@ -257,7 +257,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
             }
             _ => {}
         }
-        let Access::Core(row) = table.access[index] else {
+        let Access::Core(row) = access[index] else {
             return Err(FmuError::UnknownValueReference(vr));
         };
         row.set(&mut self.model, &mut self.book.initial, value)?;
@@ -326,7 +326,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
     fn save(&self, stage: u8) -> Result<Vec<u8>, FmuError> {
         let body: Body<M::Initial> = (self.book.clone(), self.model.save()?);
         let record = Record {
-            guid: M::table().token(Api::Fmi2).to_string(),
+            guid: M::table().table.token(Api::Fmi2).to_string(),
             stage,
             body: postcard::to_stdvec(&body)
                 .map_err(|e| FmuError::State(SnapshotError::Encode(e.to_string())))?,
@@ -389,8 +389,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
     fn new_discrete_states(&mut self) -> Result<(bool, Option<f64>), FmuError> {
         let now = self.time();
         let elapsed = (now - self.book.event_time).max(0.0);
-        let n = M::table()
-            .model_exchange
+        let n = (M::table().table.model_exchange)
             .as_ref()
             .map_or(0, |me| me.states.len());
         let (mut before, mut after) = (vec![0.0; n], vec![0.0; n]);

@@ -8,7 +8,6 @@ use flyloop_core::ParamError;
 use flyloop_core::SnapshotError;
 use flyloop_core::variables::{self, Row, Variable, VariableTable};
 use std::fmt;
-use std::ops::Deref;
 
 /// One communication step as the model sees it (s). Times are on the FMU's grid (`t0 + n·h`,
 /// never summed), so a model with its own fixed step can count whole steps.
@@ -54,14 +53,6 @@ impl<M: FmuModel> Table<M> {
             table: ModelTable::new(info, variables, model_exchange),
             access,
         }
-    }
-}
-
-impl<M: FmuModel> Deref for Table<M> {
-    type Target = ModelTable;
-
-    fn deref(&self) -> &ModelTable {
-        &self.table
     }
 }
 

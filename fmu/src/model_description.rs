@@ -24,16 +24,9 @@ pub struct UnknownUnit {
 
 /// Escapes text for an XML attribute value.
 fn escape(text: &str) -> String {
-    let pairs = [
-        ('&', "&amp;"),
-        ('<', "&lt;"),
-        ('>', "&gt;"),
-        ('"', "&quot;"),
-        ('\'', "&apos;"),
-    ];
-    pairs
-        .iter()
-        .fold(text.to_string(), |t, &(c, e)| t.replace(c, e))
+    let text = text.replace('&', "&amp;").replace('<', "&lt;");
+    let text = text.replace('>', "&gt;").replace('"', "&quot;");
+    text.replace('\'', "&apos;")
 }
 
 /// An xs:double: the shortest text that reads back to the same f64.
@@ -157,7 +150,7 @@ impl<'a> Writer<'a> {
     /// [`Writer::id`] of the variable that holds model variable `vr`.
     fn id_of(&self, vr: u32) -> Option<u32> {
         match self.api {
-            Api::Fmi2 => self.table.index(vr).map(|i| i as u32 + 1),
+            Api::Fmi2 => self.table.by_vr.get(vr).map(|i| i as u32 + 1),
             Api::Fmi3 => self.table.fmi3.element(vr).map(|(vr, _)| vr),
         }
     }

@@ -166,7 +166,7 @@ pub struct ModelTable {
     pub token3: CString,
     pub fmi3: Fmi3View,
     /// Value reference → position in `variables`.
-    by_vr: VrIndex,
+    pub by_vr: VrIndex,
     pub model_exchange: Option<ModelExchangeTable>,
 }
 
@@ -199,13 +199,12 @@ impl ModelTable {
         token.to_str().unwrap_or_default()
     }
 
-    pub fn index(&self, vr: u32) -> Option<usize> {
-        self.by_vr.get(vr)
-    }
-
     /// The position of value reference `vr`, after checking that it is of type `ty`.
     pub fn lookup(&self, vr: u32, ty: ValueType) -> Result<usize, FmuError> {
-        let index = self.index(vr).ok_or(FmuError::UnknownValueReference(vr))?;
+        let index = self
+            .by_vr
+            .get(vr)
+            .ok_or(FmuError::UnknownValueReference(vr))?;
         let v = &self.variables[index];
         ty.check(v.name, vr, v.kind)?;
         Ok(index)

@@ -10,11 +10,8 @@ use std::ffi::{CStr, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// Runs `body` for the instance behind `c` if `mask` allows its stage, and answers its status
-/// (`()` is OK) in the caller's FMI version (`S`: fmi2Status or fmi3Status).
-///
-/// A NULL `c` gives fmi2Error (there is no logger to tell). An `Err` from the body is logged
-/// as "`function`: reason" and gives its status. A panic puts the instance in the Fatal
-/// stage and gives fmi2Fatal.
+/// (`()` is OK) in the caller's FMI version. A NULL `c` gives fmi2Error (there is no logger to
+/// tell); an `Err` is logged as "`function`: reason"; a panic enters the Fatal stage.
 pub(crate) fn with_instance<R: Into<fmi2Status>, S: From<fmi2Status>>(
     c: fmi2Component,
     function: &'static str,
