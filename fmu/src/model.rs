@@ -75,6 +75,7 @@ pub trait FmuModel: VariableTable<Initial: fmt::Debug, Params: fmt::Debug> + fmt
     /// The whole state as bytes (RNG and physics world included).
     fn save(&self) -> Result<Vec<u8>, SnapshotError>;
 
+    /// Foreign or damaged bytes are an error.
     fn restore(bytes: &[u8]) -> Result<Self, SnapshotError>;
 
     /// The model as a hybrid system for Model Exchange; `None` for Co-Simulation only.
