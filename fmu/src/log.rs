@@ -21,7 +21,10 @@ pub const CATEGORIES: [(&CStr, &str); 4] = [
     (c"logEvents", "Lifecycle: instantiation, initialisation, reset, termination, FMU states"),
     (c"logStatusWarning", "Calls that return fmi2Warning"),
     (c"logStatusError", "Calls that return fmi2Error, with the reason"),
-    (c"logStatusFatal", "Calls that return fmi2Fatal (an internal failure caught at the C boundary)"),
+    (
+        c"logStatusFatal",
+        "Calls that return fmi2Fatal (an internal failure caught at the C boundary)",
+    ),
 ];
 
 impl Category {

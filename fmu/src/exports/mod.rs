@@ -7,7 +7,10 @@
 
 /// Defines exported C functions, each a C signature and a body.
 macro_rules! exports {
-    ($($(#[doc = $doc:literal])* fn $name:ident($($arg:ident: $t:ty),* $(,)?) $(-> $ret:ty)? $body:block)*) => {$(
+    ($(
+        $(#[doc = $doc:literal])*
+        fn $name:ident($($arg:ident: $t:ty),* $(,)?) $(-> $ret:ty)? $body:block
+    )*) => {$(
         $(#[doc = $doc])*
         ///
         /// # Safety
@@ -28,7 +31,12 @@ macro_rules! exports {
 /// arguments, or `|instance| expression` (`|instance, function|` with the name).
 macro_rules! forward {
     () => {};
-    ($(#[doc = $doc:literal])* fn $name:ident($c:ident: $ct:ty $(, $arg:ident: $t:ty)*) -> $ret:ty = $mask:path => |$i:ident $(, $f:ident)?| $body:expr; $($rest:tt)*) => {
+    (
+        $(#[doc = $doc:literal])*
+        fn $name:ident($c:ident: $ct:ty $(, $arg:ident: $t:ty)* $(,)?) -> $ret:ty =
+            $mask:path => |$i:ident $(, $f:ident)?| $body:expr;
+        $($rest:tt)*
+    ) => {
         exports! {
             $(#[doc = $doc])*
             fn $name($c: $ct $(, $arg: $t)*) -> $ret {
@@ -38,15 +46,18 @@ macro_rules! forward {
         }
         forward! { $($rest)* }
     };
-    ($(#[doc = $doc:literal])* fn $name:ident($c:ident: $ct:ty $(, $arg:ident: $t:ty)*) -> $ret:ty = $mask:path => $body:path; $($rest:tt)*) => {
-        exports! {
+    (
+        $(#[doc = $doc:literal])*
+        fn $name:ident($c:ident: $ct:ty $(, $arg:ident: $t:ty)* $(,)?) -> $ret:ty =
+            $mask:path => $body:path;
+        $($rest:tt)*
+    ) => {
+        forward! {
             $(#[doc = $doc])*
-            fn $name($c: $ct $(, $arg: $t)*) -> $ret {
-                let function = stringify!($name);
-                $crate::exports::guard::with_instance($c, function, $mask, |instance| $body(instance, function $(, $arg)*))
-            }
+            fn $name($c: $ct $(, $arg: $t)*) -> $ret =
+                $mask => |instance, function| $body(instance, function $(, $arg)*);
+            $($rest)*
         }
-        forward! { $($rest)* }
     };
 }
 

@@ -17,7 +17,15 @@ fn count(instance: &Instance, of: fn(&ModelExchangeTable) -> usize) -> usize {
 exports! {
     /// The discrete changes of the event at the current time (turbulence sample, released
     /// bristles) and the next time event. Every output pointer must be writable.
-    fn fmi3UpdateDiscreteStates(instance: fmi3Instance, discreteStatesNeedUpdate: *mut fmi3Boolean, terminateSimulation: *mut fmi3Boolean, nominalsOfContinuousStatesChanged: *mut fmi3Boolean, valuesOfContinuousStatesChanged: *mut fmi3Boolean, nextEventTimeDefined: *mut fmi3Boolean, nextEventTime: *mut fmi3Float64) -> fmi3Status {
+    fn fmi3UpdateDiscreteStates(
+        instance: fmi3Instance,
+        discreteStatesNeedUpdate: *mut fmi3Boolean,
+        terminateSimulation: *mut fmi3Boolean,
+        nominalsOfContinuousStatesChanged: *mut fmi3Boolean,
+        valuesOfContinuousStatesChanged: *mut fmi3Boolean,
+        nextEventTimeDefined: *mut fmi3Boolean,
+        nextEventTime: *mut fmi3Float64,
+    ) -> fmi3Status {
         let function = "fmi3UpdateDiscreteStates";
         with_instance(instance, function, masks3::UPDATE_DISCRETE_STATES, |instance| {
             let flags = [
@@ -44,17 +52,67 @@ exports! {
 }
 
 forward! {
-    fn fmi3SetTime(instance: fmi3Instance, time: fmi3Float64) -> fmi3Status = masks::SET_TIME => |i| i.sim.set_time(time);
-    fn fmi3SetContinuousStates(instance: fmi3Instance, continuousStates: *const fmi3Float64, nContinuousStates: usize) -> fmi3Status = masks::SET_CONTINUOUS_STATES => |i| i.sim.set_continuous_states(c_slice(continuousStates, nContinuousStates, "continuous states")?);
-    fn fmi3GetContinuousStateDerivatives(instance: fmi3Instance, derivatives: *mut fmi3Float64, nContinuousStates: usize) -> fmi3Status = masks3::GET_DERIVATIVES => |i| i.sim.derivatives(c_slice_mut(derivatives, nContinuousStates, "derivatives")?);
-    fn fmi3GetEventIndicators(instance: fmi3Instance, eventIndicators: *mut fmi3Float64, nEventIndicators: usize) -> fmi3Status = masks::GET_EVENT_INDICATORS => |i| i.sim.event_indicators(c_slice_mut(eventIndicators, nEventIndicators, "eventIndicators")?);
-    fn fmi3GetContinuousStates(instance: fmi3Instance, continuousStates: *mut fmi3Float64, nContinuousStates: usize) -> fmi3Status = masks::GET_CONTINUOUS_STATES => |i| i.sim.continuous_states(c_slice_mut(continuousStates, nContinuousStates, "continuousStates")?);
-    fn fmi3GetNominalsOfContinuousStates(instance: fmi3Instance, nominals: *mut fmi3Float64, nContinuousStates: usize) -> fmi3Status = masks::GET_NOMINALS => |i| i.sim.nominals(c_slice_mut(nominals, nContinuousStates, "nominals")?);
+    fn fmi3SetTime(instance: fmi3Instance, time: fmi3Float64) -> fmi3Status =
+        masks::SET_TIME => |i| i.sim.set_time(time);
+    fn fmi3SetContinuousStates(
+        instance: fmi3Instance,
+        continuousStates: *const fmi3Float64,
+        nContinuousStates: usize,
+    ) -> fmi3Status = masks::SET_CONTINUOUS_STATES => |i| {
+        let states = c_slice(continuousStates, nContinuousStates, "continuous states")?;
+        i.sim.set_continuous_states(states)
+    };
+    fn fmi3GetContinuousStateDerivatives(
+        instance: fmi3Instance,
+        derivatives: *mut fmi3Float64,
+        nContinuousStates: usize,
+    ) -> fmi3Status = masks3::GET_DERIVATIVES => |i| {
+        i.sim.derivatives(c_slice_mut(derivatives, nContinuousStates, "derivatives")?)
+    };
+    fn fmi3GetEventIndicators(
+        instance: fmi3Instance,
+        eventIndicators: *mut fmi3Float64,
+        nEventIndicators: usize,
+    ) -> fmi3Status = masks::GET_EVENT_INDICATORS => |i| {
+        i.sim.event_indicators(c_slice_mut(eventIndicators, nEventIndicators, "eventIndicators")?)
+    };
+    fn fmi3GetContinuousStates(
+        instance: fmi3Instance,
+        continuousStates: *mut fmi3Float64,
+        nContinuousStates: usize,
+    ) -> fmi3Status = masks::GET_CONTINUOUS_STATES => |i| {
+        let states = c_slice_mut(continuousStates, nContinuousStates, "continuousStates")?;
+        i.sim.continuous_states(states)
+    };
+    fn fmi3GetNominalsOfContinuousStates(
+        instance: fmi3Instance,
+        nominals: *mut fmi3Float64,
+        nContinuousStates: usize,
+    ) -> fmi3Status = masks::GET_NOMINALS => |i| {
+        i.sim.nominals(c_slice_mut(nominals, nContinuousStates, "nominals")?)
+    };
     /// The number of event indicators (0 for a Co-Simulation-only model).
-    fn fmi3GetNumberOfEventIndicators(instance: fmi3Instance, nEventIndicators: *mut usize) -> fmi3Status = masks3::ANY => |i| write_out(nEventIndicators, count(i, |me| me.event_indicators), "the count");
+    fn fmi3GetNumberOfEventIndicators(
+        instance: fmi3Instance,
+        nEventIndicators: *mut usize,
+    ) -> fmi3Status = masks3::ANY => |i| {
+        write_out(nEventIndicators, count(i, |me| me.event_indicators), "the count")
+    };
     /// The number of continuous states (0 for a Co-Simulation-only model).
-    fn fmi3GetNumberOfContinuousStates(instance: fmi3Instance, nContinuousStates: *mut usize) -> fmi3Status = masks3::ANY => |i| write_out(nContinuousStates, count(i, |me| me.states.len()), "the count");
-    fn fmi3EnterEventMode(instance: fmi3Instance) -> fmi3Status = masks::ENTER_EVENT_MODE => enter_event_mode;
-    fn fmi3EnterContinuousTimeMode(instance: fmi3Instance) -> fmi3Status = masks::ENTER_CONTINUOUS_TIME_MODE => enter_continuous_time_mode;
-    fn fmi3CompletedIntegratorStep(instance: fmi3Instance, _noSetFMUStatePriorToCurrentPoint: fmi3Boolean, enterEventMode: *mut fmi3Boolean, terminateSimulation: *mut fmi3Boolean) -> fmi3Status = masks::COMPLETED_INTEGRATOR_STEP => completed_integrator_step;
+    fn fmi3GetNumberOfContinuousStates(
+        instance: fmi3Instance,
+        nContinuousStates: *mut usize,
+    ) -> fmi3Status = masks3::ANY => |i| {
+        write_out(nContinuousStates, count(i, |me| me.states.len()), "the count")
+    };
+    fn fmi3EnterEventMode(instance: fmi3Instance) -> fmi3Status =
+        masks::ENTER_EVENT_MODE => enter_event_mode;
+    fn fmi3EnterContinuousTimeMode(instance: fmi3Instance) -> fmi3Status =
+        masks::ENTER_CONTINUOUS_TIME_MODE => enter_continuous_time_mode;
+    fn fmi3CompletedIntegratorStep(
+        instance: fmi3Instance,
+        _noSetFMUStatePriorToCurrentPoint: fmi3Boolean,
+        enterEventMode: *mut fmi3Boolean,
+        terminateSimulation: *mut fmi3Boolean,
+    ) -> fmi3Status = masks::COMPLETED_INTEGRATOR_STEP => completed_integrator_step;
 }

@@ -15,7 +15,15 @@ use crate::table::{Api, ValueType};
 /// refused, naming the variable's real type when it exists; no value is ever converted.
 macro_rules! no_variables {
     ($($get:ident $set:ident $t:ty, $name:literal = $zero:expr;)*) => {$(
-        accessors!($get, $set, $t, ValueType::none(Api::Fmi3, $name), masks3::SET_OTHER, |_| $zero, |_| f64::NAN);
+        accessors!(
+            $get,
+            $set,
+            $t,
+            ValueType::none(Api::Fmi3, $name),
+            masks3::SET_OTHER,
+            |_| $zero,
+            |_| f64::NAN
+        );
     )*};
 }
 
@@ -56,9 +64,27 @@ unsafe fn no_binary<B>(
 
 forward! {
     /// No Binary variables: every value reference is refused.
-    fn fmi3GetBinary(instance: fmi3Instance, valueReferences: *const fmi3ValueReference, nValueReferences: usize, _valueSizes: *mut usize, values: *mut fmi3Binary, nValues: usize) -> fmi3Status = masks3::GET_VALUE => |i, f| no_binary(i, f, (valueReferences, nValueReferences), values.cast_const(), nValues);
+    fn fmi3GetBinary(
+        instance: fmi3Instance,
+        valueReferences: *const fmi3ValueReference,
+        nValueReferences: usize,
+        _valueSizes: *mut usize,
+        values: *mut fmi3Binary,
+        nValues: usize,
+    ) -> fmi3Status = masks3::GET_VALUE => |i, f| {
+        no_binary(i, f, (valueReferences, nValueReferences), values.cast_const(), nValues)
+    };
     /// No Binary variables: every value reference is refused.
-    fn fmi3SetBinary(instance: fmi3Instance, valueReferences: *const fmi3ValueReference, nValueReferences: usize, _valueSizes: *const usize, values: *const fmi3Binary, nValues: usize) -> fmi3Status = masks3::SET_OTHER => |i, f| no_binary(i, f, (valueReferences, nValueReferences), values, nValues);
+    fn fmi3SetBinary(
+        instance: fmi3Instance,
+        valueReferences: *const fmi3ValueReference,
+        nValueReferences: usize,
+        _valueSizes: *const usize,
+        values: *const fmi3Binary,
+        nValues: usize,
+    ) -> fmi3Status = masks3::SET_OTHER => |i, f| {
+        no_binary(i, f, (valueReferences, nValueReferences), values, nValues)
+    };
 }
 
 const NO_CLOCKS: &str = "this FMU has no clocks";
