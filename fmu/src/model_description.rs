@@ -1,10 +1,6 @@
-//! Writes a model's modelDescription.xml, FMI 2.0 or FMI 3.0, from its table: Co-Simulation,
-//! and Model Exchange for a model that offers it; every variable with unit, description,
-//! start and range (FMI 3.0: the [`Fmi3View`](crate::table::Fmi3View), with arrays, `time`
-//! and the event indicators); unit definitions for every unit used; log categories; the
-//! default experiment; the model structure. One writer, the versions differ only where the
-//! standards do. Deterministic output (no date), so the checked-in copies under
-//! modelDescription/ can be compared byte for byte.
+//! Writes a model's modelDescription.xml, FMI 2.0 or FMI 3.0, from its table: one writer,
+//! the versions differ only where the standards do. Deterministic output (no date), so the
+//! checked-in copies under modelDescription/ can be compared byte for byte.
 
 use crate::log::CATEGORIES;
 use crate::table::{Api, ModelTable, Variable3};

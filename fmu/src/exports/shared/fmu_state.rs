@@ -1,9 +1,6 @@
 //! FMU states: get, set, free, serialize, deserialize. A state is a copy of everything the
 //! instance holds (model with its RNG and physics world, stage, experiment, time grid, start
 //! values), so setting it and stepping again repeats the same outputs bit for bit.
-//!
-//! The instance keeps every state it hands out; a pointer it does not know (freed already,
-//! foreign, garbage) is refused with an error instead of being dereferenced.
 
 use crate::error::FmuError;
 use crate::exports::guard::{c_slice, c_slice_mut, write_out};
