@@ -31,7 +31,7 @@ fn instance(hover: f64) -> fmi2Component {
         let c = fmi2Instantiate(
             c"bench".as_ptr(),
             fmi2CoSimulation,
-            table.guid_c.as_ptr(),
+            table.guid.as_ptr(),
             std::ptr::null(),
             callbacks,
             fmi2False,
@@ -62,7 +62,7 @@ fn instance3(hover: f64) -> fmi3Instance {
     unsafe {
         let c = fmi3InstantiateCoSimulation(
             c"bench".as_ptr(),
-            table.token3_c.as_ptr(),
+            table.token3.as_ptr(),
             std::ptr::null(),
             0,
             0,

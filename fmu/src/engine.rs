@@ -1,18 +1,15 @@
-//! The model-independent part of an FMU instance below the state machine: start values,
-//! the experiment, the time grid, variable access, communication steps, FMU states and Model
-//! Exchange (the importer's solver owns time and the continuous states; the engine checks
-//! array lengths and time, and keeps the time of the last event so the model's discrete
-//! changes happen at events only, never inside the solver's trial steps). [`Engine`] does it
-//! for any [`FmuModel`]; the instance sees it through the object-safe [`Simulation`] so one
-//! library serves every model.
+//! The model-independent part of an FMU instance below the state machine, for any
+//! [`FmuModel`]; the instance sees it through the object-safe [`Simulation`] so one library
+//! serves every model. Model Exchange keeps the time of the last event so that the model's
+//! discrete changes happen at events only, never inside the solver's trial steps.
 
 use crate::error::FmuError;
-use crate::model::{Access, FmuModel, Hybrid, StepRequest};
+use crate::model::{Access, FmuModel, Hybrid, StepRequest, Table};
 use crate::state_record;
-use crate::table::{ModelTable, settable_after_initialisation};
+use crate::table::{Api, ModelTable};
 use flyloop_core::SnapshotError;
 use flyloop_core::number::Compact;
-use flyloop_core::variables::{self, Causality};
+use flyloop_core::variables::{self, Causality, Variability};
 use serde::{Deserialize, Serialize};
 
 /// A communication point matches the instance's time within this fraction of max(1 s, |t|)
@@ -24,7 +21,7 @@ pub const TIME_TOLERANCE: f64 = 1e-9;
 /// by a few ulps (0.02 - 0.01 != 0.01), and the model should not see that jitter.
 pub const STEP_TOLERANCE: f64 = 1e-9;
 
-/// A single fmi2DoStep may run at most this many internal steps (≈ tens of seconds of CPU).
+/// At most this many internal steps in one fmi2DoStep (≈ tens of seconds of CPU).
 pub const MAX_INTERNAL_STEPS: f64 = 1e8;
 
 /// The time grid: t = base + n·h while the step size stays h, so time is never a running
@@ -53,8 +50,7 @@ impl Clock {
         }
     }
 
-    /// The step size to use for a requested `h`: the grid's own step when `h` is within
-    /// [`STEP_TOLERANCE`] of it, else `h`.
+    /// The grid's own step when `h` is within [`STEP_TOLERANCE`] of it, else `h`.
     pub fn grid_step(&self, h: f64) -> f64 {
         if self.n > 0 && (h - self.step).abs() <= STEP_TOLERANCE * self.step {
             self.step
@@ -79,7 +75,6 @@ impl Clock {
     }
 }
 
-/// What fmi2SetupExperiment said.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Experiment {
     pub start: f64,
@@ -87,38 +82,30 @@ pub struct Experiment {
 }
 
 /// The instance's simulation as the FMI functions drive it; a method named after an FMI
-/// function (`do_step`, `set_time`...) is that function's work.
-pub trait Simulation {
+/// function (`do_step`, `set_time`...) is that function's work, `index` is a position in the
+/// table, `stage` the instance's stage code saved in FMU states. The Model Exchange methods
+/// (from `set_time` on) are an error for a Co-Simulation-only model.
+pub trait Simulation: std::fmt::Debug {
     fn table(&self) -> &'static ModelTable;
     fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> Result<(), FmuError>;
-    /// Reads or writes the variable at position `index` of the table; `initialised` once
-    /// past fmi2ExitInitializationMode.
     fn get(&self, index: usize) -> f64;
     fn set(&mut self, index: usize, value: f64, initialised: bool) -> Result<(), FmuError>;
     fn do_step(&mut self, communication_point: f64, step_size: f64) -> Result<(), FmuError>;
     fn time(&self) -> f64;
-    /// Back to the start values (fmi2Reset).
     fn reset(&mut self) -> Result<(), FmuError>;
-    /// Everything, with the caller's `stage` code, as FMU state bytes.
     fn save(&self, stage: u8) -> Result<Vec<u8>, FmuError>;
-    /// Checks that `bytes` are a state of this model, without applying them; returns the
-    /// stage code saved with them.
+    /// The stage code of state bytes of this model, without applying them.
     fn check_saved(&self, bytes: &[u8]) -> Result<u8, FmuError>;
-    /// Applies state bytes; returns the stage code saved with them. Nothing changes on error.
+    /// Applies state bytes and returns their stage code; nothing changes on error.
     fn restore(&mut self, bytes: &[u8]) -> Result<u8, FmuError>;
-
-    // Model Exchange; each is an error for a Co-Simulation-only model.
     fn set_time(&mut self, time: f64) -> Result<(), FmuError>;
     fn continuous_states(&self, x: &mut [f64]) -> Result<(), FmuError>;
-    /// fmi2SetContinuousStates; nothing changes when a value is refused.
     fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), FmuError>;
     fn derivatives(&self, dx: &mut [f64]) -> Result<(), FmuError>;
     fn event_indicators(&self, z: &mut [f64]) -> Result<(), FmuError>;
     fn nominals(&self, nominals: &mut [f64]) -> Result<(), FmuError>;
-    /// fmi2NewDiscreteStates: the discrete changes of an event at the current time. Returns
-    /// whether the continuous states changed, and the next time event (absolute time).
+    /// Whether the continuous states changed, and the next time event (absolute time).
     fn new_discrete_states(&mut self) -> Result<(bool, Option<f64>), FmuError>;
-    /// fmi2CompletedIntegratorStep: an error once the state is no longer finite.
     fn completed_integrator_step(&self) -> Result<(), FmuError>;
 }
 
@@ -145,8 +132,8 @@ fn co_simulation_only() -> FmuError {
     FmuError::NotSupported("Model Exchange: this model is Co-Simulation only")
 }
 
-/// An FMU state: which model it belongs to (readable for any model, so that a state of
-/// another model is named as such) around the model-specific part.
+/// An FMU state: its model's GUID (readable for any model, so that a state of another model
+/// is named as such) around the model-specific part.
 #[derive(Serialize, Deserialize)]
 struct Record {
     guid: String,
@@ -155,8 +142,7 @@ struct Record {
     body: Vec<u8>,
 }
 
-/// The model-specific part of an FMU state: the book, then the model's own snapshot (the
-/// core's format, with its own checks).
+/// The model-specific part of an FMU state: the book, then the model's own snapshot.
 type Body<I> = (Book<I>, Vec<u8>);
 
 impl<M: FmuModel> Engine<M> {
@@ -180,7 +166,7 @@ impl<M: FmuModel> Engine<M> {
     /// The model's hybrid view, after checking that the importer's array `name` of length
     /// `len` has one entry per continuous state (`ni`: per event indicator).
     fn hybrid(&self, len: usize, name: &str) -> Result<&dyn Hybrid, FmuError> {
-        let table = M::table();
+        let table = &M::table().table;
         let (Some(me), Some(hybrid)) = (&table.model_exchange, self.model.hybrid()) else {
             return Err(co_simulation_only());
         };
@@ -201,14 +187,15 @@ impl<M: FmuModel> Engine<M> {
         self.model.hybrid_mut().ok_or_else(co_simulation_only)
     }
 
-    /// Decodes FMU state bytes completely: stage code, bookkeeping and a restored model.
     fn decode(bytes: &[u8]) -> Result<(u8, Book<M::Initial>, M), FmuError> {
         let record: Record = state_record::decode(bytes)?;
-        let table = M::table();
-        if record.guid != table.guid {
+        let table = &M::table().table;
+        if record.guid != table.token(Api::Fmi2) {
             return Err(FmuError::InvalidArgument(format!(
                 "the FMU state belongs to a model with GUID {}, not to {} {}",
-                record.guid, table.info.identifier, table.guid
+                record.guid,
+                table.info.identifier,
+                table.token(Api::Fmi2)
             )));
         }
         let (book, model): Body<M::Initial> = postcard::from_bytes(&record.body)
@@ -252,7 +239,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
     }
 
     fn set(&mut self, index: usize, value: f64, initialised: bool) -> Result<(), FmuError> {
-        let table = M::table();
+        let Table { table, access } = M::table();
         let variable = &table.variables[index];
         let (name, vr) = (variable.name, variable.value_reference);
         match variable.causality {
@@ -262,10 +249,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
                     reason: "it is an output",
                 });
             }
-            Causality::Parameter
-                if initialised
-                    && !settable_after_initialisation(variable.causality, variable.variability) =>
-            {
+            Causality::Parameter if initialised && variable.variability != Variability::Tunable => {
                 return Err(FmuError::NotSettable {
                     name,
                     reason: "it is a fixed parameter; set it before initialization mode ends",
@@ -273,7 +257,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
             }
             _ => {}
         }
-        let Access::Core(row) = table.access[index] else {
+        let Access::Core(row) = access[index] else {
             return Err(FmuError::UnknownValueReference(vr));
         };
         row.set(&mut self.model, &mut self.book.initial, value)?;
@@ -342,7 +326,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
     fn save(&self, stage: u8) -> Result<Vec<u8>, FmuError> {
         let body: Body<M::Initial> = (self.book.clone(), self.model.save()?);
         let record = Record {
-            guid: M::table().guid.clone(),
+            guid: M::table().table.token(Api::Fmi2).to_string(),
             stage,
             body: postcard::to_stdvec(&body)
                 .map_err(|e| FmuError::State(SnapshotError::Encode(e.to_string())))?,
@@ -405,8 +389,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
     fn new_discrete_states(&mut self) -> Result<(bool, Option<f64>), FmuError> {
         let now = self.time();
         let elapsed = (now - self.book.event_time).max(0.0);
-        let n = M::table()
-            .model_exchange
+        let n = (M::table().table.model_exchange)
             .as_ref()
             .map_or(0, |me| me.states.len());
         let (mut before, mut after) = (vec![0.0; n], vec![0.0; n]);

@@ -1,7 +1,6 @@
 //! Why an FMI call was refused. Every variant becomes a status for the caller and a log
 //! message that says what to do about it.
 
-use crate::fmi2_types::fmi2Status;
 use flyloop_core::number::Compact;
 use flyloop_core::{ParamError, SnapshotError};
 
@@ -42,7 +41,7 @@ pub enum FmuError {
     Refused(ParamError),
     /// An FMU state that does not decode or does not fit this model.
     #[error("FMU state refused: {0}")]
-    State(SnapshotError),
+    State(#[from] SnapshotError),
     /// An fmi2FMUstate pointer this instance did not hand out, or has freed already.
     #[error(
         "the FMU state is not a live state of this instance \
@@ -92,28 +91,11 @@ pub enum FmuError {
     NotSupported(&'static str),
 }
 
-impl FmuError {
-    pub fn status(&self) -> fmi2Status {
-        fmi2Status::fmi2Error
-    }
-
-    /// Whether the instance can no longer step (only get, reset, set state, free).
-    pub fn enters_error_stage(&self) -> bool {
-        matches!(self, FmuError::Diverged { .. })
-    }
-}
-
 impl From<ParamError> for FmuError {
     fn from(e: ParamError) -> Self {
         match e {
             ParamError::UnknownValueReference(vr) => FmuError::UnknownValueReference(vr),
             other => FmuError::Refused(other),
         }
-    }
-}
-
-impl From<SnapshotError> for FmuError {
-    fn from(e: SnapshotError) -> Self {
-        FmuError::State(e)
     }
 }

@@ -21,9 +21,7 @@ pub type fmi2Byte = c_char;
 pub const fmi2True: fmi2Boolean = 1;
 pub const fmi2False: fmi2Boolean = 0;
 
-/// `fmi2TypesPlatform` of the standard's default headers.
 pub const fmi2TypesPlatform: &std::ffi::CStr = c"default";
-/// `fmi2Version`.
 pub const fmi2Version: &std::ffi::CStr = c"2.0";
 
 /// Status returned by every function; ordered from best to worst.
@@ -38,12 +36,10 @@ pub enum fmi2Status {
     fmi2Pending = 5,
 }
 
-/// `fmi2Type`: 0 = ModelExchange, 1 = CoSimulation.
 pub type fmi2Type = c_int;
 pub const fmi2ModelExchange: fmi2Type = 0;
 pub const fmi2CoSimulation: fmi2Type = 1;
 
-/// `fmi2StatusKind`.
 pub type fmi2StatusKind = c_int;
 pub const fmi2DoStepStatus: fmi2StatusKind = 0;
 pub const fmi2PendingStatus: fmi2StatusKind = 1;
@@ -64,8 +60,8 @@ pub type fmi2CallbackAllocateMemory = unsafe extern "C" fn(usize, usize) -> *mut
 pub type fmi2CallbackFreeMemory = unsafe extern "C" fn(*mut c_void);
 pub type fmi2StepFinished = unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2Status);
 
-/// `fmi2CallbackFunctions`. Function pointers are `Option`s so that a NULL from C is a
-/// `None` here rather than an invalid function pointer.
+/// Function pointers are `Option`s so that a NULL from C is a `None` here rather than an
+/// invalid function pointer.
 #[repr(C)]
 #[derive(Debug, Clone, Copy)]
 pub struct fmi2CallbackFunctions {
@@ -76,7 +72,6 @@ pub struct fmi2CallbackFunctions {
     pub componentEnvironment: fmi2ComponentEnvironment,
 }
 
-/// `fmi2EventInfo`: what fmi2NewDiscreteStates reports to a Model Exchange importer.
 #[repr(C)]
 #[derive(Debug, Clone, Copy)]
 pub struct fmi2EventInfo {

@@ -22,23 +22,19 @@ pub type fmi3Int32 = i32;
 pub type fmi3UInt32 = u32;
 pub type fmi3Int64 = i64;
 pub type fmi3UInt64 = u64;
-/// C `bool`, one byte.
+/// C `bool`, one byte (as `fmi3Clock`).
 pub type fmi3Boolean = u8;
 pub type fmi3Char = c_char;
 pub type fmi3String = *const fmi3Char;
 pub type fmi3Byte = u8;
 pub type fmi3Binary = *const fmi3Byte;
-/// C `bool`, one byte.
 pub type fmi3Clock = u8;
-/// `fmi3IntervalQualifier` (an enum the FMU would write).
 pub type fmi3IntervalQualifier = c_int;
-/// `fmi3DependencyKind` (an enum the FMU would write).
 pub type fmi3DependencyKind = c_int;
 
 pub const fmi3True: fmi3Boolean = 1;
 pub const fmi3False: fmi3Boolean = 0;
 
-/// `fmi3Version`.
 pub const fmi3Version: &std::ffi::CStr = c"3.0";
 
 /// Status returned by every function; ordered from best to worst.
@@ -52,10 +48,9 @@ pub enum fmi3Status {
     fmi3Fatal = 4,
 }
 
+/// The FMI layer works with FMI 2.0 statuses; fmi2Pending, which no FMI 3.0 function ever
+/// produces, would be an error.
 impl From<fmi2Status> for fmi3Status {
-    /// The FMI layer works with FMI 2.0 statuses; FMI 3.0 has the same ones without
-    /// fmi2Pending, which no FMI 3.0 function ever produces (asynchronous steps are not
-    /// offered) and which maps to an error should it ever appear.
     fn from(status: fmi2Status) -> Self {
         match status {
             fmi2Status::fmi2OK => fmi3Status::fmi3OK,
@@ -67,11 +62,11 @@ impl From<fmi2Status> for fmi3Status {
     }
 }
 
-/// `fmi3LogMessageCallback`: not variadic, unlike FMI 2.0's logger.
+/// Not variadic, unlike FMI 2.0's logger.
 pub type fmi3LogMessageCallback =
     unsafe extern "C" fn(fmi3InstanceEnvironment, fmi3Status, fmi3String, fmi3String);
 
-/// `fmi3IntermediateUpdateCallback` (never called: no intermediate update is offered).
+// Never called: intermediate update and Scheduled Execution are not offered.
 pub type fmi3IntermediateUpdateCallback = unsafe extern "C" fn(
     fmi3InstanceEnvironment,
     fmi3Float64,
@@ -83,9 +78,6 @@ pub type fmi3IntermediateUpdateCallback = unsafe extern "C" fn(
     *mut fmi3Float64,
 );
 
-/// `fmi3ClockUpdateCallback` (Scheduled Execution, not offered).
 pub type fmi3ClockUpdateCallback = unsafe extern "C" fn(fmi3InstanceEnvironment);
-/// `fmi3LockPreemptionCallback` (Scheduled Execution, not offered).
 pub type fmi3LockPreemptionCallback = unsafe extern "C" fn();
-/// `fmi3UnlockPreemptionCallback` (Scheduled Execution, not offered).
 pub type fmi3UnlockPreemptionCallback = unsafe extern "C" fn();

@@ -5,7 +5,7 @@
 use crate::engine::Simulation;
 use crate::error::FmuError;
 use crate::fmi2_types::fmi2Status;
-use crate::log::{LogFilter, Logger, category_of};
+use crate::log::{Logger, category_of};
 use crate::table::Api;
 use std::collections::HashMap;
 
@@ -43,7 +43,7 @@ impl Stage {
         Stage::ContinuousTimeMode,
     ];
 
-    /// A small code for FMU state bytes.
+    /// The stage's code in FMU state bytes.
     pub fn code(self) -> u8 {
         (self as u16).trailing_zeros() as u8
     }
@@ -52,7 +52,6 @@ impl Stage {
         Stage::ALL.into_iter().find(|s| s.code() == code)
     }
 
-    /// Whether an instance of `interface` can be in this stage.
     pub fn belongs_to(self, interface: Interface) -> bool {
         let model_exchange = matches!(self, Stage::EventMode | Stage::ContinuousTimeMode);
         let co_simulation = matches!(
@@ -66,7 +65,6 @@ impl Stage {
     }
 }
 
-/// The interface an instance was created for (fmi2Instantiate's fmuType).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Interface {
     CoSimulation,
@@ -192,27 +190,18 @@ pub struct SavedState {
     pub bytes: Vec<u8>,
 }
 
+#[derive(Debug)]
 pub struct Instance {
     pub api: Api,
     pub interface: Interface,
     pub logger: Logger,
-    pub filter: LogFilter,
+    /// Whether each category (by its position in [`crate::log::CATEGORIES`]) is logged.
+    pub logging: [bool; 4],
     pub stage: Stage,
     pub sim: Box<dyn Simulation>,
     /// FMU states handed out and not yet freed, by address. A pointer that is not here is
     /// refused instead of dereferenced (double free, foreign pointer).
     states: HashMap<usize, Box<SavedState>>,
-}
-
-impl std::fmt::Debug for Instance {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Instance")
-            .field("name", &self.logger.instance_name)
-            .field("model", &self.sim.table().info.identifier)
-            .field("stage", &self.stage)
-            .field("states", &self.states.len())
-            .finish_non_exhaustive()
-    }
 }
 
 impl Instance {
@@ -227,7 +216,7 @@ impl Instance {
             api,
             interface,
             logger,
-            filter: LogFilter::at_instantiation(logging_on),
+            logging: [logging_on, logging_on, true, true],
             stage: Stage::Instantiated,
             sim,
             states: HashMap::new(),
@@ -241,28 +230,32 @@ impl Instance {
 
     pub fn log(&self, status: fmi2Status, message: &str) {
         let category = category_of(status);
-        if self.filter.enabled(category) {
+        if self.logging[category as usize] {
             self.logger.log(status, category, message);
         }
     }
 
-    /// Logs a lifecycle event (status OK: category logEvents).
     pub fn event(&self, message: &str) {
         self.log(fmi2Status::fmi2OK, message);
     }
 
-    /// Logs why `function` failed and moves to the Error stage when the error says so.
-    pub fn report(&mut self, function: &str, error: &FmuError) -> fmi2Status {
-        if error.enters_error_stage() {
-            self.stage = Stage::Error;
-        }
-        let status = error.status();
-        self.log(status, &format!("{function}: {error}"));
-        status
+    /// Moves to `stage` and logs `message` as an event.
+    pub fn enter(&mut self, stage: Stage, message: &str) -> Result<(), FmuError> {
+        self.stage = stage;
+        self.event(message);
+        Ok(())
     }
 
-    /// Fails with "Illegal call sequence" unless `mask` allows the current stage, and for a
-    /// Model Exchange function on a Co-Simulation instance.
+    /// Logs why `function` failed.
+    pub fn report(&mut self, function: &str, error: &FmuError) -> fmi2Status {
+        // A diverged model can no longer step (only get, reset, set state, free).
+        if matches!(error, FmuError::Diverged { .. }) {
+            self.stage = Stage::Error;
+        }
+        self.log(fmi2Status::fmi2Error, &format!("{function}: {error}"));
+        fmi2Status::fmi2Error
+    }
+
     pub fn check_stage(&self, mask: Mask) -> Result<(), FmuError> {
         if !mask.allows(self.stage) {
             return Err(FmuError::IllegalCall {
@@ -294,8 +287,7 @@ impl Instance {
         }
     }
 
-    /// The stage saved as `code` in an FMU state, if an instance of this interface can be
-    /// in it.
+    /// The stage saved as `code`, if an instance of this interface can be in it.
     pub fn stage_from_code(&self, code: u8) -> Result<Stage, FmuError> {
         let stage = Stage::from_code(code).ok_or_else(|| {
             FmuError::InvalidArgument(format!("the FMU state holds an unknown stage code {code}"))

@@ -1,11 +1,6 @@
-//! Logging through the importer's logger (FMI 2.0's variadic one or FMI 3.0's
-//! `fmi3LogMessageCallback`), by category.
-//!
-//! Categories (declared in the modelDescription's LogCategories): `logEvents` (lifecycle),
-//! `logStatusWarning`, `logStatusError` and `logStatusFatal`. fmi2Instantiate's loggingOn
-//! switches `logEvents` and `logStatusWarning`; errors and fatal errors are on from the start,
-//! because a status without its reason helps nobody. fmi2SetDebugLogging switches the
-//! categories it names (all of them when it names none), errors included.
+//! Logging through the importer's logger (FMI 2.0's variadic one or FMI 3.0's), by category.
+//! fmi2Instantiate's loggingOn switches events and warnings; errors and fatal errors are on
+//! from the start, because a status without its reason helps nobody.
 
 use crate::fmi2_types::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status};
 use crate::fmi3_types::{fmi3InstanceEnvironment, fmi3LogMessageCallback};
@@ -26,7 +21,10 @@ pub const CATEGORIES: [(&CStr, &str); 4] = [
     (c"logEvents", "Lifecycle: instantiation, initialisation, reset, termination, FMU states"),
     (c"logStatusWarning", "Calls that return fmi2Warning"),
     (c"logStatusError", "Calls that return fmi2Error, with the reason"),
-    (c"logStatusFatal", "Calls that return fmi2Fatal (an internal failure caught at the C boundary)"),
+    (
+        c"logStatusFatal",
+        "Calls that return fmi2Fatal (an internal failure caught at the C boundary)",
+    ),
 ];
 
 impl Category {
@@ -35,28 +33,6 @@ impl Category {
     pub fn from_name(name: &str) -> Option<Category> {
         let at = CATEGORIES.iter().position(|(c, _)| c.to_str() == Ok(name));
         at.map(|at| Self::ALL[at])
-    }
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct LogFilter([bool; 4]);
-
-impl LogFilter {
-    /// The filter after fmi2Instantiate(..., loggingOn).
-    pub fn at_instantiation(logging_on: bool) -> Self {
-        LogFilter([logging_on, logging_on, true, true])
-    }
-
-    pub fn set(&mut self, category: Category, on: bool) {
-        self.0[category as usize] = on;
-    }
-
-    pub fn set_all(&mut self, on: bool) {
-        self.0 = [on; 4];
-    }
-
-    pub fn enabled(&self, category: Category) -> bool {
-        self.0[category as usize]
     }
 }
 
@@ -74,7 +50,7 @@ pub enum Sink {
     },
 }
 
-/// The importer's logger with what it needs on every call.
+/// The importer's logger and the instance name it is given.
 #[derive(Debug)]
 pub struct Logger {
     pub sink: Sink,
@@ -82,40 +58,20 @@ pub struct Logger {
 }
 
 impl Logger {
-    /// Sends `message` (see [`Sink::send`]).
-    pub fn log(&self, status: fmi2Status, category: Category, message: &str) {
-        // SAFETY: callback and environment came together from the importer, which keeps
-        // them valid while the instance lives.
-        unsafe {
-            self.sink
-                .send(&self.instance_name, status, category, message)
-        }
-    }
-}
-
-impl Sink {
     /// Calls the callback once with `message` (NUL bytes in it become U+FFFD; FMI 2.0:
     /// always through a "%s" format so that a '%' in it is printed, never interpreted).
-    ///
-    /// # Safety
-    /// The callback and environment must be the importer's, valid for the call.
-    pub unsafe fn send(
-        &self,
-        instance_name: &CStr,
-        status: fmi2Status,
-        category: Category,
-        message: &str,
-    ) {
+    pub fn log(&self, status: fmi2Status, category: Category, message: &str) {
         let text = CString::new(message.replace('\0', "\u{fffd}")).unwrap_or_default();
         let category = CATEGORIES[category as usize].0.as_ptr();
-        match *self {
-            // SAFETY: the caller's contract; every string is NUL-terminated and outlives the
-            // call; the format consumes exactly one string argument.
+        match self.sink {
+            // SAFETY: callback and environment came together from the importer, which keeps
+            // them valid while the instance lives; every string is NUL-terminated and
+            // outlives the call; the format consumes exactly one string argument.
             Sink::Fmi2 {
                 callback,
                 environment,
             } => unsafe {
-                let name = instance_name.as_ptr();
+                let name = self.instance_name.as_ptr();
                 callback(
                     environment,
                     name,

@@ -1,7 +1,6 @@
-//! What the FMI layer needs from a model, and nothing about physics: the [`FmuModel`] trait
-//! over the core's variable table, implemented for the quadrotor and the lander in
-//! [`crate::models`], and the model's [`Table`]: the FMI table plus, at the same positions,
-//! the core rows that read and write each variable.
+//! What the FMI layer needs from a model, and nothing about physics: [`FmuModel`] over the
+//! core's variable table, and the model's [`Table`]: the FMI table plus, at the same
+//! positions, the core rows that read and write each variable.
 
 use crate::error::FmuError;
 use crate::table::{ModelExchangeTable, ModelInfo, ModelTable};
@@ -9,23 +8,19 @@ use flyloop_core::ParamError;
 use flyloop_core::SnapshotError;
 use flyloop_core::variables::{self, Row, Variable, VariableTable};
 use std::fmt;
-use std::ops::Deref;
 
-/// One communication step as the model sees it. Times are on the FMU's grid
-/// (`t0 + n·h`, never summed), so a model with its own fixed step can count whole steps.
+/// One communication step as the model sees it (s). Times are on the FMU's grid (`t0 + n·h`,
+/// never summed), so a model with its own fixed step can count whole steps.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepRequest {
-    /// Start time of the experiment (fmi2SetupExperiment), s.
     pub start_time: f64,
-    /// Communication point at the end of this step, s.
     pub end_time: f64,
-    /// Communication step size h, s.
     pub step_size: f64,
 }
 
 /// How the FMU reaches a variable in the model.
-pub enum Access<M: VariableTable> {
-    /// A row of the core's table.
+#[derive(Debug)]
+pub enum Access<M: FmuModel> {
     Core(Row<M>),
     /// A read-only value the core's table does not hold (Model Exchange's extra states and
     /// derivatives): `read(model, at)`.
@@ -35,23 +30,14 @@ pub enum Access<M: VariableTable> {
     },
 }
 
-impl<M: VariableTable> fmt::Debug for Access<M> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Access::Core(_) => f.write_str("Core"),
-            Access::Local { at, .. } => write!(f, "Local({at})"),
-        }
-    }
-}
-
 /// A model's FMI table with the access to each of its variables, at the same positions.
 #[derive(Debug)]
-pub struct Table<M: VariableTable> {
+pub struct Table<M: FmuModel> {
     pub table: ModelTable,
     pub access: Vec<Access<M>>,
 }
 
-impl<M: VariableTable> Table<M> {
+impl<M: FmuModel> Table<M> {
     /// The core's variables of `M`, then `locals`.
     pub fn new(
         info: &'static ModelInfo,
@@ -70,18 +56,8 @@ impl<M: VariableTable> Table<M> {
     }
 }
 
-impl<M: VariableTable> Deref for Table<M> {
-    type Target = ModelTable;
-
-    fn deref(&self) -> &ModelTable {
-        &self.table
-    }
-}
-
-/// A model behind the FMU: its core variable table, built from start values, advanced by
-/// communication steps, saved to and restored from bytes.
-pub trait FmuModel: VariableTable {
-    /// The model's table, built once.
+/// A model behind the FMU, over its core variable table.
+pub trait FmuModel: VariableTable<Initial: fmt::Debug, Params: fmt::Debug> + fmt::Debug {
     fn table() -> &'static Table<Self>;
 
     /// A fresh model from `initial`, with the physical parameters of `previous` (or the
@@ -91,7 +67,6 @@ pub trait FmuModel: VariableTable {
     /// How many internal steps `step` would take (to refuse steps that would run for hours).
     fn internal_steps(&self, step: &StepRequest) -> f64;
 
-    /// Advances to `step.end_time`.
     fn advance(&mut self, step: &StepRequest);
 
     /// Whether the state holds only finite numbers (false once the dynamics diverged).
@@ -100,16 +75,14 @@ pub trait FmuModel: VariableTable {
     /// The whole state as bytes (RNG and physics world included).
     fn save(&self) -> Result<Vec<u8>, SnapshotError>;
 
-    /// A model from [`FmuModel::save`] bytes; foreign or damaged bytes are an error.
+    /// Foreign or damaged bytes are an error.
     fn restore(bytes: &[u8]) -> Result<Self, SnapshotError>;
 
-    /// The model as a hybrid system for Model Exchange, or `None` (the default) for a model
-    /// that is Co-Simulation only.
+    /// The model as a hybrid system for Model Exchange; `None` for Co-Simulation only.
     fn hybrid(&self) -> Option<&dyn Hybrid> {
         None
     }
 
-    /// [`FmuModel::hybrid`], mutable.
     fn hybrid_mut(&mut self) -> Option<&mut dyn Hybrid> {
         None
     }

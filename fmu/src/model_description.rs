@@ -1,13 +1,9 @@
-//! Writes a model's modelDescription.xml, FMI 2.0 or FMI 3.0, from its table: Co-Simulation,
-//! and Model Exchange for a model that offers it; every variable with unit, description,
-//! start and range (FMI 3.0: the [`Fmi3View`](crate::table::Fmi3View), with arrays, `time`
-//! and the event indicators); unit definitions for every unit used; log categories; the
-//! default experiment; the model structure. One writer, the versions differ only where the
-//! standards do. Deterministic output (no date), so the checked-in copies under
-//! modelDescription/ can be compared byte for byte.
+//! Writes a model's modelDescription.xml, FMI 2.0 or FMI 3.0, from its table: one writer,
+//! the versions differ only where the standards do. Deterministic output (no date), so the
+//! checked-in copies under modelDescription/ can be compared byte for byte.
 
 use crate::log::CATEGORIES;
-use crate::table::{Api, Causality3, ModelTable, Variable3};
+use crate::table::{Api, ModelTable, Variable3};
 use crate::units::{self, BASE_UNITS};
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::{Causality, Variable};
@@ -24,16 +20,9 @@ pub struct UnknownUnit {
 
 /// Escapes text for an XML attribute value.
 fn escape(text: &str) -> String {
-    let pairs = [
-        ('&', "&amp;"),
-        ('<', "&lt;"),
-        ('>', "&gt;"),
-        ('"', "&quot;"),
-        ('\'', "&apos;"),
-    ];
-    pairs
-        .iter()
-        .fold(text.to_string(), |t, &(c, e)| t.replace(c, e))
+    let text = text.replace('&', "&amp;").replace('<', "&lt;");
+    let text = text.replace('>', "&gt;").replace('"', "&quot;");
+    text.replace('\'', "&apos;")
 }
 
 /// An xs:double: the shortest text that reads back to the same f64.
@@ -120,9 +109,9 @@ fn write_units(out: &mut String, variables: &[Variable3]) -> Result<(), UnknownU
 /// The value references `output` depends on: its direct-feedthrough inputs and, under Model
 /// Exchange, the continuous states (none for a state itself, which is its own known).
 fn output_dependencies(table: &ModelTable, output: &Variable) -> Vec<u32> {
-    let mut dependencies: Vec<u32> = table
-        .direct_feedthrough(output.name)
-        .iter()
+    let feedthrough = table.info.direct_feedthrough.iter();
+    let inputs = feedthrough.filter(|(name, _)| *name == output.name);
+    let mut dependencies: Vec<u32> = (inputs.flat_map(|(_, inputs)| inputs.iter()))
         .filter_map(|name| table.by_name(name))
         .map(|v| v.value_reference)
         .collect();
@@ -157,7 +146,7 @@ impl<'a> Writer<'a> {
     /// [`Writer::id`] of the variable that holds model variable `vr`.
     fn id_of(&self, vr: u32) -> Option<u32> {
         match self.api {
-            Api::Fmi2 => self.table.index(vr).map(|i| i as u32 + 1),
+            Api::Fmi2 => self.table.by_vr.get(vr).map(|i| i as u32 + 1),
             Api::Fmi3 => self.table.fmi3.element(vr).map(|(vr, _)| vr),
         }
     }
@@ -240,11 +229,15 @@ impl<'a> Writer<'a> {
             let _ = writeln!(out, "    <!-- Index {} -->", i + 1);
         }
         let (name, vr, text) = (escape(&v.name), v.value_reference, escape(&v.description));
-        let (causality, variability) = (v.causality.name(), format!("{:?}", v.variability));
+        let causality = v
+            .causality
+            .map_or("independent".into(), |c| format!("{c:?}"));
+        let variability = format!("{:?}", v.variability);
         let _ = write!(
             out,
             "    <{element} name=\"{name}\" valueReference=\"{vr}\" description=\"{text}\" \
-             causality=\"{causality}\" variability=\"{}\"",
+             causality=\"{}\" variability=\"{}\"",
+            causality.to_lowercase(),
             variability.to_lowercase()
         );
         if self.api == Api::Fmi2 {
@@ -301,7 +294,7 @@ impl<'a> Writer<'a> {
     fn model_structure(&mut self) {
         let me = self.table.model_exchange.as_ref();
         let outputs: Vec<(u32, Option<String>)> = (self.variables.iter().enumerate())
-            .filter(|(_, v)| v.causality == Causality3::Model(Causality::Output))
+            .filter(|(_, v)| v.causality == Some(Causality::Output))
             .map(|(i, v)| {
                 let elements = v.elements().iter().map(|&at| &self.table.variables[at]);
                 let vrs = elements.flat_map(|e| output_dependencies(self.table, e));

@@ -41,11 +41,6 @@ pub fn stem(table: &ModelTable, version: Api) -> String {
     }
 }
 
-/// The modelDescription.xml of `table` in `version`.
-pub fn model_description(table: &ModelTable, version: Api) -> Result<String, UnknownUnit> {
-    model_description::generate(table, version)
-}
-
 /// Writes `<out_dir>/<stem>.fmu` holding `library` as the model's binary.
 pub fn write_fmu(
     table: &ModelTable,
@@ -53,7 +48,7 @@ pub fn write_fmu(
     library: &Path,
     out_dir: &Path,
 ) -> Result<PathBuf, PackError> {
-    let xml = model_description(table, version)?;
+    let xml = model_description::generate(table, version)?;
     let binary = fs::read(library).map_err(io(library))?;
     fs::create_dir_all(out_dir).map_err(io(out_dir))?;
     let path = out_dir.join(format!("{}.fmu", stem(table, version)));
@@ -94,6 +89,6 @@ pub fn write_model_description(
     if let Some(parent) = path.parent() {
         fs::create_dir_all(parent).map_err(io(parent))?;
     }
-    fs::write(&path, model_description(table, version)?).map_err(io(&path))?;
+    fs::write(&path, model_description::generate(table, version)?).map_err(io(&path))?;
     Ok(path)
 }

@@ -1,7 +1,5 @@
-//! A model's variable table as the FMI layer looks it up on every call: the core's variables
-//! by value reference, the GUID and instantiation token that tie a modelDescription to the
-//! binary, and the FMI 3.0 view of the same variables ([`Fmi3View`]: arrays, `time`, one
-//! variable per event indicator).
+//! A model's variable table as the FMI layer looks it up on every call, with the FMI 3.0 view
+//! of the same variables ([`Fmi3View`]: arrays, `time`, one variable per event indicator).
 
 use crate::error::FmuError;
 use crate::guid;
@@ -125,9 +123,8 @@ pub struct ModelInfo {
     pub event_indicators: &'static [(&'static str, &'static str, &'static str)],
 }
 
-/// What a Model-Exchange capable model adds to its table: its continuous states and their
-/// derivatives as variables (value references in state-vector order) and its number of event
-/// indicators.
+/// What a Model-Exchange capable model adds to its table: value references of its continuous
+/// states and their derivatives (in state-vector order).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ModelExchangeTable {
     pub states: Vec<u32>,
@@ -135,15 +132,14 @@ pub struct ModelExchangeTable {
     pub event_indicators: usize,
 }
 
-/// Value reference → position in a variable list, in O(1): a dense table up to the largest
-/// value reference (about a thousand entries here).
+/// Value reference → position in a variable list: a dense table up to the largest value
+/// reference (about a thousand entries here).
 #[derive(Debug, Default)]
 pub struct VrIndex(Vec<u32>);
 
 impl VrIndex {
     const NONE: u32 = u32::MAX;
 
-    /// The index of `vrs`, the i-th value reference at position i.
     pub fn new(vrs: impl Iterator<Item = u32> + Clone) -> Self {
         let len = vrs.clone().max().map_or(0, |m| m as usize + 1);
         let mut table = vec![Self::NONE; len];
@@ -159,28 +155,22 @@ impl VrIndex {
     }
 }
 
-/// The variable table of a model with what the FMI layer looks up on every call.
 #[derive(Debug)]
 pub struct ModelTable {
     pub info: &'static ModelInfo,
     /// Every variable in value-reference order (the modelDescription's order).
     pub variables: Vec<Variable>,
-    pub guid: String,
-    pub guid_c: CString,
-    /// FMI 3.0's instantiationToken (its own interface: arrays, `time`, event indicators).
-    pub token3: String,
-    pub token3_c: CString,
+    /// FMI 2.0's GUID and FMI 3.0's instantiationToken (of its own interface: arrays, `time`,
+    /// event indicators); hex digits, dashes and braces, never a NUL.
+    pub guid: CString,
+    pub token3: CString,
     pub fmi3: Fmi3View,
     /// Value reference → position in `variables`.
-    by_vr: VrIndex,
-    /// States and derivatives, for a model that offers Model Exchange.
+    pub by_vr: VrIndex,
     pub model_exchange: Option<ModelExchangeTable>,
 }
 
 impl ModelTable {
-    /// The table of `info` over `variables` (which include the states and derivatives
-    /// `model_exchange` names).
-    ///
     /// # Panics
     /// If a declared array's elements are not in the table (a fault of the model's
     /// [`ModelInfo::arrays`], found by the crate's tests).
@@ -189,15 +179,11 @@ impl ModelTable {
         variables: Vec<Variable>,
         model_exchange: Option<ModelExchangeTable>,
     ) -> Self {
-        let guid = guid::of_interface(Api::Fmi2, info.identifier, &variables);
-        let token3 = guid::of_interface(Api::Fmi3, info.identifier, &variables);
+        let token = |api| CString::new(guid::of_interface(api, info.identifier, &variables));
         ModelTable {
             info,
-            // A GUID is hex digits, dashes and braces: it never holds a NUL.
-            guid_c: CString::new(guid.clone()).unwrap_or_default(),
-            token3_c: CString::new(token3.clone()).unwrap_or_default(),
-            guid,
-            token3,
+            guid: token(Api::Fmi2).unwrap_or_default(),
+            token3: token(Api::Fmi3).unwrap_or_default(),
             fmi3: Fmi3View::new(info, &variables),
             by_vr: VrIndex::new(variables.iter().map(|v| v.value_reference)),
             variables,
@@ -205,48 +191,28 @@ impl ModelTable {
         }
     }
 
-    /// The GUID (FMI 2.0) or instantiation token (FMI 3.0).
     pub fn token(&self, api: Api) -> &str {
-        match api {
+        let token = match api {
             Api::Fmi2 => &self.guid,
             Api::Fmi3 => &self.token3,
-        }
-    }
-
-    pub fn index(&self, vr: u32) -> Option<usize> {
-        self.by_vr.get(vr)
+        };
+        token.to_str().unwrap_or_default()
     }
 
     /// The position of value reference `vr`, after checking that it is of type `ty`.
     pub fn lookup(&self, vr: u32, ty: ValueType) -> Result<usize, FmuError> {
-        let index = self.index(vr).ok_or(FmuError::UnknownValueReference(vr))?;
+        let index = self
+            .by_vr
+            .get(vr)
+            .ok_or(FmuError::UnknownValueReference(vr))?;
         let v = &self.variables[index];
         ty.check(v.name, vr, v.kind)?;
         Ok(index)
     }
 
-    pub fn variable(&self, vr: u32) -> Option<&Variable> {
-        self.variables.get(self.index(vr)?)
-    }
-
     pub fn by_name(&self, name: &str) -> Option<&Variable> {
         self.variables.iter().find(|v| v.name == name)
     }
-
-    /// The inputs output `output` depends on directly (see [`ModelInfo::direct_feedthrough`]).
-    pub fn direct_feedthrough(&self, output: &str) -> &'static [&'static str] {
-        self.info
-            .direct_feedthrough
-            .iter()
-            .find(|(name, _)| *name == output)
-            .map_or(&[], |(_, inputs)| inputs)
-    }
-}
-
-/// Whether a variable of `variability` and `causality` may be set once initialised.
-pub fn settable_after_initialisation(causality: Causality, variability: Variability) -> bool {
-    causality == Causality::Input
-        || (causality == Causality::Parameter && variability == Variability::Tunable)
 }
 
 /// Value reference of the FMI 3.0 independent variable `time` (above every model's own).
@@ -254,46 +220,28 @@ pub const TIME_VR: u32 = 1000;
 /// Value reference of the first FMI 3.0 event-indicator variable; the others follow.
 pub const EVENT_INDICATOR_VR: u32 = 1001;
 
-/// FMI 3.0 causality: the model's, or `independent` for `time`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Causality3 {
-    Independent,
-    Model(Causality),
-}
-
-impl Causality3 {
-    /// The attribute's text in the modelDescription.
-    pub fn name(self) -> String {
-        match self {
-            Causality3::Independent => "independent".to_string(),
-            Causality3::Model(c) => format!("{c:?}").to_lowercase(),
-        }
-    }
-}
-
 /// Where an FMI 3.0 variable's values come from.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Source {
-    /// The model's variables at these positions of [`ModelTable::variables`] (one for a
-    /// scalar).
+    /// Positions in [`ModelTable::variables`] (one for a scalar).
     Model(Vec<usize>),
     Time,
     EventIndicator(usize),
 }
 
-/// One FMI 3.0 variable.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Variable3 {
     pub name: String,
     pub description: String,
     pub value_reference: u32,
     pub kind: ValueKind,
-    pub causality: Causality3,
+    /// The model's causality; `None` for the independent variable `time`.
+    pub causality: Option<Causality>,
     pub variability: Variability,
     pub unit: &'static str,
     pub min: Option<f64>,
     pub max: Option<f64>,
-    /// Start value of each element (empty when there is none).
+    /// Of each element (empty when there is none).
     pub start: Vec<f64>,
     /// `None` for a scalar, else the array's length.
     pub dimension: Option<usize>,
@@ -301,22 +249,16 @@ pub struct Variable3 {
 }
 
 impl Variable3 {
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.dimension.unwrap_or(1)
     }
 
-    /// The positions in [`ModelTable::variables`] of the model variables behind this one
-    /// (none for `time` and the event indicators).
+    /// The positions in [`ModelTable::variables`] behind this variable.
     pub fn elements(&self) -> &[usize] {
         match &self.source {
             Source::Model(elements) => elements,
             _ => &[],
         }
-    }
-
-    /// Never true: every variable holds at least one value.
-    pub fn is_empty(&self) -> bool {
-        false
     }
 
     /// A real local without start or range (`time`, the event indicators).
@@ -326,7 +268,7 @@ impl Variable3 {
             description: text.to_string(),
             value_reference: vr,
             kind: ValueKind::Real,
-            causality: Causality3::Model(Causality::Local),
+            causality: Some(Causality::Local),
             variability: Variability::Continuous,
             unit,
             min: None,
@@ -349,7 +291,7 @@ impl Variable3 {
                 .to_string(),
             value_reference: v.value_reference,
             kind: v.kind,
-            causality: Causality3::Model(v.causality),
+            causality: Some(v.causality),
             variability: v.variability,
             unit: v.unit,
             min: v.min,
@@ -378,7 +320,7 @@ pub struct Fmi3View {
 impl Fmi3View {
     fn new(info: &ModelInfo, model: &[Variable]) -> Self {
         let time = Variable3 {
-            causality: Causality3::Independent,
+            causality: None,
             ..Variable3::computed("time", TIME_VR, "s", "Simulation time", Source::Time)
         };
         let mut variables = vec![time];
@@ -415,19 +357,6 @@ impl Fmi3View {
         }
     }
 
-    /// The FMI 3.0 variables holding the model variables `vrs`, each once, in order.
-    pub fn collapse(&self, vrs: &[u32]) -> Vec<u32> {
-        let mut out: Vec<u32> = Vec::new();
-        for &vr in vrs {
-            if let Some((fmi3, _)) = self.element(vr) {
-                if !out.contains(&fmi3) {
-                    out.push(fmi3);
-                }
-            }
-        }
-        out
-    }
-
     /// The FMI 3.0 variable (value reference) and element index holding model variable `vr`.
     pub fn element(&self, vr: u32) -> Option<(u32, usize)> {
         let at = self
@@ -441,11 +370,6 @@ impl Fmi3View {
     pub fn variable(&self, vr: u32) -> Option<&Variable3> {
         self.variables.get(self.by_vr.get(vr)?)
     }
-
-    /// The variable named `name`.
-    pub fn by_name(&self, name: &str) -> Option<&Variable3> {
-        self.variables.iter().find(|v| v.name == name)
-    }
 }
 
 #[cfg(test)]
@@ -453,11 +377,15 @@ mod tests {
     use super::*;
     use crate::models::tables;
 
+    fn by_name<'a>(view: &'a Fmi3View, name: &str) -> &'a Variable3 {
+        view.variables.iter().find(|v| v.name == name).unwrap()
+    }
+
     #[test]
     fn motor_commands_are_one_array_and_every_model_value_has_one_home() {
         let [quad, lander] = tables();
         let layout = &quad.fmi3;
-        let command = layout.by_name("motor_command").unwrap();
+        let command = by_name(layout, "motor_command");
         assert_eq!(command.value_reference, 0);
         assert_eq!(command.dimension, Some(4));
         assert_eq!(command.source, Source::Model(vec![0, 1, 2, 3]));
@@ -467,12 +395,14 @@ mod tests {
             None,
             "element 1 has no value reference of its own"
         );
-        assert_eq!(layout.by_name("der(motor_state)").unwrap().len(), 4);
+        assert_eq!(by_name(layout, "der(motor_state)").len(), 4);
         assert_eq!(layout.element(2), Some((0, 2)));
         // 25 states: 13 body scalars + motor_state[4] + 8 bristles = 22 variables.
         let me = quad.model_exchange.as_ref().unwrap();
-        assert_eq!(layout.collapse(&me.states).len(), 22);
-        assert_eq!(layout.collapse(&me.derivatives).len(), 22);
+        for vrs in [&me.states, &me.derivatives] {
+            let firsts = vrs.iter().filter(|&&vr| layout.element(vr).unwrap().1 == 0);
+            assert_eq!(firsts.count(), 22);
+        }
         assert_eq!(layout.event_indicators, [1001, 1002, 1003, 1004]);
         for table in [quad, lander] {
             let layout = &table.fmi3;

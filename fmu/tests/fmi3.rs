@@ -7,11 +7,12 @@
 
 mod support;
 
+use flyloop_core::variables::Causality;
 use flyloop_fmu::exports::*;
 use flyloop_fmu::fmi2_types::{fmi2LastSuccessfulTime, fmi2Status};
 use flyloop_fmu::fmi3_types::fmi3Status::{fmi3Error, fmi3OK};
 use flyloop_fmu::fmi3_types::*;
-use flyloop_fmu::table::{EVENT_INDICATOR_VR, TIME_VR};
+use flyloop_fmu::table::{Api, EVENT_INDICATOR_VR, TIME_VR};
 use std::ffi::CString;
 use support::{Fmu, Model, Recorder};
 
@@ -32,7 +33,7 @@ impl Drop for Fmu3 {
 fn instantiate(model: Model, model_exchange: bool, recorder: &Recorder) -> fmi3Instance {
     let (logger, env) = recorder.fmi3_logger();
     let name = CString::new("fmi3").unwrap();
-    let token = model.table().token3_c.as_ptr();
+    let token = model.table().token3.as_ptr();
     // SAFETY: valid strings and callbacks that outlive the instance.
     unsafe {
         if model_exchange {
@@ -164,9 +165,10 @@ fn fmi3_outputs(model: Model) -> Vec<(u32, usize)> {
         .variables
         .iter()
         .filter(|v| {
-            v.causality.name() == "output" && v.kind == flyloop_core::params::ValueKind::Real
+            v.causality == Some(Causality::Output)
+                && v.kind == flyloop_core::params::ValueKind::Real
         })
-        .map(|v| (v.value_reference, v.len()))
+        .map(|v| (v.value_reference, v.dimension.unwrap_or(1)))
         .collect()
 }
 
@@ -195,7 +197,13 @@ fn fmi3_co_simulation_equals_fmi2_bit_for_bit_with_wind_and_arrays() {
             .filter(|v| v.name.starts_with("motor_command"))
             .map(|v| v.value_reference)
             .collect();
-        let inputs3: Vec<u32> = model.table().fmi3.collapse(&inputs2);
+        // An array is named by its first element's value reference.
+        let fmi3 = &model.table().fmi3;
+        let inputs3: Vec<u32> = inputs2
+            .iter()
+            .copied()
+            .filter(|&vr| fmi3.variable(vr).is_some())
+            .collect();
         let outputs3 = fmi3_outputs(model);
         let outputs2 = fmi2_outputs(model);
         let n: usize = outputs3.iter().map(|&(_, n)| n).sum();
@@ -302,7 +310,9 @@ fn fmi3_model_exchange_gives_the_fmi2_states_derivatives_and_indicators() {
     assert_eq!(z2, z3);
     assert!(dx3.iter().any(|&d| d != 0.0));
     // The variables behind them: der(motor_state) as an array, the indicators, time.
-    let der_motor = model.table().fmi3.by_name("der(motor_state)").unwrap();
+    let der_motor = (model.table().fmi3.variables.iter())
+        .find(|v| v.name == "der(motor_state)")
+        .unwrap();
     let (status, values) = me3.get(&[der_motor.value_reference], 4);
     assert_eq!(status, fmi3OK);
     assert_eq!(values, dx3[13..17]);
@@ -406,7 +416,7 @@ fn instantiation_refusals_give_null_and_say_why() {
         // FMI 2.0's GUID is not an FMI 3.0 token.
         let wrong = fmi3InstantiateCoSimulation(
             name.as_ptr(),
-            lander.guid_c.as_ptr(),
+            lander.guid.as_ptr(),
             std::ptr::null(),
             0,
             1,
@@ -425,13 +435,17 @@ fn instantiation_refusals_give_null_and_say_why() {
                 .unwrap()
                 .message
                 .contains("instantiationToken")
-                && recorder.last().unwrap().message.contains(&lander.token3),
+                && recorder
+                    .last()
+                    .unwrap()
+                    .message
+                    .contains(lander.token(Api::Fmi3)),
             "{:?}",
             recorder.last()
         );
         let me = fmi3InstantiateModelExchange(
             name.as_ptr(),
-            lander.token3_c.as_ptr(),
+            lander.token3.as_ptr(),
             std::ptr::null(),
             0,
             1,
@@ -448,7 +462,7 @@ fn instantiation_refusals_give_null_and_say_why() {
         );
         let event_mode = fmi3InstantiateCoSimulation(
             name.as_ptr(),
-            lander.token3_c.as_ptr(),
+            lander.token3.as_ptr(),
             std::ptr::null(),
             0,
             1,
@@ -464,7 +478,7 @@ fn instantiation_refusals_give_null_and_say_why() {
         assert!(recorder.last().unwrap().message.contains("hasEventMode"));
         let scheduled = fmi3InstantiateScheduledExecution(
             name.as_ptr(),
-            lander.token3_c.as_ptr(),
+            lander.token3.as_ptr(),
             std::ptr::null(),
             0,
             1,
@@ -484,7 +498,7 @@ fn instantiation_refusals_give_null_and_say_why() {
         );
         let no_name = fmi3InstantiateModelExchange(
             std::ptr::null(),
-            Model::Quadrotor.table().token3_c.as_ptr(),
+            Model::Quadrotor.table().token3.as_ptr(),
             std::ptr::null(),
             0,
             1,
@@ -495,7 +509,7 @@ fn instantiation_refusals_give_null_and_say_why() {
         // FMI 3.0 allows a NULL logger: the instance works and logs nothing.
         let quiet = fmi3InstantiateModelExchange(
             name.as_ptr(),
-            Model::Quadrotor.table().token3_c.as_ptr(),
+            Model::Quadrotor.table().token3.as_ptr(),
             std::ptr::null(),
             0,
             1,

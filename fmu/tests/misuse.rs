@@ -8,6 +8,7 @@ mod support;
 
 use flyloop_fmu::exports::*;
 use flyloop_fmu::fmi2_types::*;
+use flyloop_fmu::table::Api;
 use std::ffi::CString;
 use support::{Fmu, Model, Recorder, callbacks_for};
 
@@ -64,7 +65,9 @@ fn a_wrong_guid_gives_null_and_says_which_guids_exist() {
         "{}",
         log[0]
     );
-    assert!(log[0].contains(&Model::Quadrotor.table().guid) && log[0].contains("Lander2D"));
+    assert!(
+        log[0].contains(Model::Quadrotor.table().token(Api::Fmi2)) && log[0].contains("Lander2D")
+    );
     let entry = recorder.entries.lock().unwrap()[0].clone();
     assert_eq!(
         (
@@ -78,7 +81,7 @@ fn a_wrong_guid_gives_null_and_says_which_guids_exist() {
 
 #[test]
 fn null_callbacks_a_null_logger_or_a_missing_name_give_null_without_a_crash() {
-    let guid = Model::Lander2D.table().guid.clone();
+    let guid = Model::Lander2D.table().token(Api::Fmi2).to_string();
     assert!(instantiate(Some("a"), fmi2CoSimulation, Some(&guid), None).is_null());
     let no_logger = fmi2CallbackFunctions {
         logger: None,

@@ -277,7 +277,7 @@ fn lander2d_refuses_model_exchange_with_the_reason() {
         fmi2Instantiate(
             c"lander".as_ptr(),
             fmi2ModelExchange,
-            Model::Lander2D.table().guid_c.as_ptr(),
+            Model::Lander2D.table().guid.as_ptr(),
             std::ptr::null(),
             &*callbacks,
             fmi2False,

@@ -10,11 +10,8 @@ use std::ffi::{CStr, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// Runs `body` for the instance behind `c` if `mask` allows its stage, and answers its status
-/// (`()` is OK) in the caller's FMI version (`S`: fmi2Status or fmi3Status).
-///
-/// A NULL `c` gives fmi2Error (there is no logger to tell). An `Err` from the body is logged
-/// as "`function`: reason" and gives its status. A panic puts the instance in the Fatal
-/// stage and gives fmi2Fatal.
+/// (`()` is OK) in the caller's FMI version. A NULL `c` gives fmi2Error (there is no logger to
+/// tell); an `Err` is logged as "`function`: reason"; a panic enters the Fatal stage.
 pub(crate) fn with_instance<R: Into<fmi2Status>, S: From<fmi2Status>>(
     c: fmi2Component,
     function: &'static str,
@@ -50,17 +47,9 @@ pub(crate) fn with_instance<R: Into<fmi2Status>, S: From<fmi2Status>>(
     }))
 }
 
-/// The body of a function this FMU does not offer: refuses with `why` (after the NULL and
-/// stage checks).
-pub(crate) fn refuse<S: From<fmi2Status>>(
-    c: fmi2Component,
-    function: &'static str,
-    mask: Mask,
-    why: &'static str,
-) -> S {
-    with_instance(c, function, mask, |_| {
-        Err::<(), _>(FmuError::NotSupported(why))
-    })
+/// The body of a function this FMU does not offer: refuses with `why`.
+pub(crate) fn refuse(why: &'static str) -> Result<(), FmuError> {
+    Err(FmuError::NotSupported(why))
 }
 
 /// A body without a status of its own answers OK.
@@ -174,7 +163,7 @@ mod tests {
     fn a_panic_becomes_fatal_with_a_message_and_only_free_instance_remains() {
         let recorder = importer_logger::Recorder::default();
         let callbacks = recorder.callbacks();
-        let guid = crate::models::tables()[0].guid_c.clone();
+        let guid = crate::models::tables()[0].guid.clone();
         // SAFETY: valid strings and callbacks.
         let c = unsafe {
             fmi2Instantiate(

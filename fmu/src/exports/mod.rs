@@ -7,7 +7,10 @@
 
 /// Defines exported C functions, each a C signature and a body.
 macro_rules! exports {
-    ($($(#[doc = $doc:literal])* fn $name:ident($($arg:ident: $t:ty),* $(,)?) $(-> $ret:ty)? $body:block)*) => {$(
+    ($(
+        $(#[doc = $doc:literal])*
+        fn $name:ident($($arg:ident: $t:ty),* $(,)?) $(-> $ret:ty)? $body:block
+    )*) => {$(
         $(#[doc = $doc])*
         ///
         /// # Safety
@@ -22,18 +25,39 @@ macro_rules! exports {
     )*};
 }
 
-/// Defines exported C functions whose body, once the instance passed the NULL and stage
-/// checks of `mask` ([`guard::with_instance`]), is a function of [`shared`] given the instance,
-/// the export's name and its other arguments: `fn name(arguments) -> status = mask => body;`.
+/// Defines exported C functions whose body runs once the instance passed the NULL and stage
+/// checks of `mask` ([`guard::with_instance`]): `fn name(arguments) -> status = mask => body;`
+/// where `body` is a function of [`shared`] given the instance, the export's name and its other
+/// arguments, or `|instance| expression` (`|instance, function|` with the name).
 macro_rules! forward {
-    ($($(#[doc = $doc:literal])* fn $name:ident($c:ident: $ct:ty $(, $arg:ident: $t:ty)*) -> $ret:ty = $mask:path => $body:path;)*) => {
-        exports! {$(
+    () => {};
+    (
+        $(#[doc = $doc:literal])*
+        fn $name:ident($c:ident: $ct:ty $(, $arg:ident: $t:ty)* $(,)?) -> $ret:ty =
+            $mask:path => |$i:ident $(, $f:ident)?| $body:expr;
+        $($rest:tt)*
+    ) => {
+        exports! {
             $(#[doc = $doc])*
             fn $name($c: $ct $(, $arg: $t)*) -> $ret {
-                let function = stringify!($name);
-                $crate::exports::guard::with_instance($c, function, $mask, |instance| $body(instance, function $(, $arg)*))
+                $(let $f = stringify!($name);)?
+                $crate::exports::guard::with_instance($c, stringify!($name), $mask, |$i| $body)
             }
-        )*}
+        }
+        forward! { $($rest)* }
+    };
+    (
+        $(#[doc = $doc:literal])*
+        fn $name:ident($c:ident: $ct:ty $(, $arg:ident: $t:ty)* $(,)?) -> $ret:ty =
+            $mask:path => $body:path;
+        $($rest:tt)*
+    ) => {
+        forward! {
+            $(#[doc = $doc])*
+            fn $name($c: $ct $(, $arg: $t)*) -> $ret =
+                $mask => |instance, function| $body(instance, function $(, $arg)*);
+            $($rest)*
+        }
     };
 }
 

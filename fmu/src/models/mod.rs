@@ -18,9 +18,9 @@ pub fn tables() -> [&'static ModelTable; 2] {
 /// A fresh simulation of the model whose GUID (FMI 2.0) or instantiation token (FMI 3.0) is
 /// `token`, or `None` for an unknown one.
 pub fn simulation_for(api: Api, token: &str) -> Option<Result<Box<dyn Simulation>, FmuError>> {
-    if token == Quadrotor::table().token(api) {
+    if token == Quadrotor::table().table.token(api) {
         Some(Engine::<Quadrotor>::new().map(|e| Box::new(e) as Box<dyn Simulation>))
-    } else if token == Lander2d::table().token(api) {
+    } else if token == Lander2d::table().table.token(api) {
         Some(Engine::<Lander2d>::new().map(|e| Box::new(e) as Box<dyn Simulation>))
     } else {
         None

@@ -67,7 +67,8 @@ static INFO: ModelInfo = ModelInfo {
         (
             "foot_height_0",
             "m",
-            "Height of foot 0 (front-right) above the ground; 1 with the ground off (event indicator)",
+            "Height of foot 0 (front-right) above the ground; 1 with the ground off \
+             (event indicator)",
         ),
         (
             "foot_height_1",

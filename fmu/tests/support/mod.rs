@@ -76,7 +76,7 @@ impl Fmu {
             fmi2Instantiate(
                 name.as_ptr(),
                 fmu_type,
-                model.table().guid_c.as_ptr(),
+                model.table().guid.as_ptr(),
                 std::ptr::null(),
                 &*callbacks,
                 fmi2False,

@@ -12,12 +12,18 @@ use flyloop_core::params::ValueKind;
 /// converts through `$to_c`, the setter (allowed in `$mask`) through `$from_c`. The body is
 /// here, not in a helper, so the model is two calls away: the guard, then the engine.
 macro_rules! accessors {
-    ($get:ident, $set:ident, $t:ty, $ty:expr, $mask:expr, $to_c:expr, $from_c:expr) => {
+    ($get:ident, $set:ident, $t:ty, $ty:expr, $mask:expr, $to_c:expr, $from_c:expr $(,)?) => {
         exports! {
-            fn $get(c: fmi2Component, vr: *const fmi2ValueReference, nvr: usize, value: *mut $t) -> fmi2Status {
+            fn $get(
+                c: fmi2Component,
+                vr: *const fmi2ValueReference,
+                nvr: usize,
+                value: *mut $t,
+            ) -> fmi2Status {
                 let function = stringify!($get);
                 with_instance(c, function, masks::GET_VALUE, |instance| {
-                    let (vrs, values) = (c_slice(vr, nvr, "vr[]")?, c_slice_mut(value, nvr, "value[]")?);
+                    let vrs = c_slice(vr, nvr, "vr[]")?;
+                    let values = c_slice_mut(value, nvr, "value[]")?;
                     let table = instance.sim.table();
                     let mut worst = fmi2Status::fmi2OK;
                     for (&vr, slot) in vrs.iter().zip(values) {
@@ -30,15 +36,21 @@ macro_rules! accessors {
                 })
             }
 
-            fn $set(c: fmi2Component, vr: *const fmi2ValueReference, nvr: usize, value: *const $t) -> fmi2Status {
+            fn $set(
+                c: fmi2Component,
+                vr: *const fmi2ValueReference,
+                nvr: usize,
+                value: *const $t,
+            ) -> fmi2Status {
                 let function = stringify!($set);
                 with_instance(c, function, $mask, |instance| {
-                    let (vrs, values) = (c_slice(vr, nvr, "vr[]")?, c_slice(value, nvr, "value[]")?);
+                    let vrs = c_slice(vr, nvr, "vr[]")?;
+                    let values = c_slice(value, nvr, "value[]")?;
                     let (initialised, table) = (instance.initialised(), instance.sim.table());
                     let mut worst = fmi2Status::fmi2OK;
                     for (&vr, &v) in vrs.iter().zip(values) {
-                        let result = table.lookup(vr, $ty).and_then(|index| instance.sim.set(index, $from_c(v), initialised));
-                        if let Err(e) = result {
+                        let set = |index| instance.sim.set(index, $from_c(v), initialised);
+                        if let Err(e) = table.lookup(vr, $ty).and_then(set) {
                             worst = worst.max(instance.report(function, &e));
                         }
                     }
@@ -49,10 +61,42 @@ macro_rules! accessors {
     };
 }
 
-accessors! { fmi2GetReal, fmi2SetReal, fmi2Real, ValueType::of(Api::Fmi2, ValueKind::Real), masks::SET_REAL, |v| v, |v| v }
+accessors! {
+    fmi2GetReal,
+    fmi2SetReal,
+    fmi2Real,
+    ValueType::of(Api::Fmi2, ValueKind::Real),
+    masks::SET_REAL,
+    |v| v,
+    |v| v,
+}
 // Integer variables hold integers within i32 (their table ranges say so).
-accessors! { fmi2GetInteger, fmi2SetInteger, fmi2Integer, ValueType::of(Api::Fmi2, ValueKind::Integer), masks::SET_OTHER, |v| v as fmi2Integer, f64::from }
-accessors! { fmi2GetBoolean, fmi2SetBoolean, fmi2Boolean, ValueType::of(Api::Fmi2, ValueKind::Boolean), masks::SET_OTHER, |v| if v != 0.0 { fmi2True } else { fmi2False }, |v| if v != fmi2False { 1.0 } else { 0.0 } }
+accessors! {
+    fmi2GetInteger,
+    fmi2SetInteger,
+    fmi2Integer,
+    ValueType::of(Api::Fmi2, ValueKind::Integer),
+    masks::SET_OTHER,
+    |v| v as fmi2Integer,
+    f64::from,
+}
+accessors! {
+    fmi2GetBoolean,
+    fmi2SetBoolean,
+    fmi2Boolean,
+    ValueType::of(Api::Fmi2, ValueKind::Boolean),
+    masks::SET_OTHER,
+    |v| if v != 0.0 { fmi2True } else { fmi2False },
+    |v| if v != fmi2False { 1.0 } else { 0.0 },
+}
 // There are no String variables: every value reference is refused (with its real type when
 // it exists); no value is ever converted.
-accessors! { fmi2GetString, fmi2SetString, fmi2String, ValueType::none(Api::Fmi2, "String"), masks::SET_OTHER, |_| std::ptr::null(), |_| f64::NAN }
+accessors! {
+    fmi2GetString,
+    fmi2SetString,
+    fmi2String,
+    ValueType::none(Api::Fmi2, "String"),
+    masks::SET_OTHER,
+    |_| std::ptr::null(),
+    |_| f64::NAN,
+}

@@ -3,7 +3,7 @@
 //! need.
 
 use crate::error::FmuError;
-use crate::exports::guard::{with_instance, write_out};
+use crate::exports::guard::{refuse, with_instance, write_out};
 use crate::fmi3_types::*;
 use crate::instance::{masks, masks3};
 
@@ -12,7 +12,16 @@ exports! {
     /// `communicationStepSize`, exactly as fmi2DoStep does. Never asks for event handling,
     /// never terminates, never returns early; `*lastSuccessfulTime` is the time after the
     /// step. The four output pointers must not be NULL.
-    fn fmi3DoStep(instance: fmi3Instance, currentCommunicationPoint: fmi3Float64, communicationStepSize: fmi3Float64, _noSetFMUStatePriorToCurrentPoint: fmi3Boolean, eventHandlingNeeded: *mut fmi3Boolean, terminateSimulation: *mut fmi3Boolean, earlyReturn: *mut fmi3Boolean, lastSuccessfulTime: *mut fmi3Float64) -> fmi3Status {
+    fn fmi3DoStep(
+        instance: fmi3Instance,
+        currentCommunicationPoint: fmi3Float64,
+        communicationStepSize: fmi3Float64,
+        _noSetFMUStatePriorToCurrentPoint: fmi3Boolean,
+        eventHandlingNeeded: *mut fmi3Boolean,
+        terminateSimulation: *mut fmi3Boolean,
+        earlyReturn: *mut fmi3Boolean,
+        lastSuccessfulTime: *mut fmi3Float64,
+    ) -> fmi3Status {
         with_instance(instance, "fmi3DoStep", masks::DO_STEP, |instance| {
             instance.check_co_simulation()?;
             let flags = [
@@ -34,20 +43,25 @@ exports! {
             result
         })
     }
+}
 
+forward! {
     /// Not needed: without event mode (hasEventMode="false") fmi3ExitInitializationMode
     /// already enters step mode.
-    fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status {
-        with_instance(instance, "fmi3EnterStepMode", masks3::ENTER_STEP_MODE, |instance| {
-            instance.check_co_simulation()?;
-            Err::<(), _>(FmuError::NotSupported("event mode is not used (hasEventMode=\"false\"): fmi3ExitInitializationMode enters step mode"))
-        })
-    }
-
+    fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status = masks3::ENTER_STEP_MODE => |i| {
+        let why = "event mode is not used (hasEventMode=\"false\"): fmi3ExitInitializationMode \
+                   enters step mode";
+        i.check_co_simulation().and(refuse(why))
+    };
     /// maxOutputDerivativeOrder="0".
-    fn fmi3GetOutputDerivatives(instance: fmi3Instance, _valueReferences: *const fmi3ValueReference, _nValueReferences: usize, _orders: *const fmi3Int32, _values: *mut fmi3Float64, _nValues: usize) -> fmi3Status {
-        with_instance(instance, "fmi3GetOutputDerivatives", masks3::GET_OUTPUT_DERIVATIVES, |_| {
-            Err::<(), _>(FmuError::NotSupported("output derivatives (maxOutputDerivativeOrder=\"0\")"))
-        })
-    }
+    fn fmi3GetOutputDerivatives(
+        instance: fmi3Instance,
+        _valueReferences: *const fmi3ValueReference,
+        _nValueReferences: usize,
+        _orders: *const fmi3Int32,
+        _values: *mut fmi3Float64,
+        _nValues: usize,
+    ) -> fmi3Status = masks3::GET_OUTPUT_DERIVATIVES => |_i| {
+        refuse("output derivatives (maxOutputDerivativeOrder=\"0\")")
+    };
 }

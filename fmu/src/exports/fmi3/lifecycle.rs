@@ -1,7 +1,7 @@
 //! Creating, initialising, terminating, resetting and freeing an FMI 3.0 instance, and its
 //! FMU states (the same states as FMI 2.0's, under FMI 3.0's names).
 
-use crate::exports::guard::{c_str, guarded, with_instance};
+use crate::exports::guard::{c_str, guarded};
 use crate::exports::shared::fmu_state::*;
 use crate::exports::shared::instantiate::{Request, instantiate};
 use crate::exports::shared::lifecycle::*;
@@ -17,36 +17,35 @@ pub extern "C" fn fmi3GetVersion() -> *const c_char {
     guarded(fmi3Version.as_ptr(), || fmi3Version.as_ptr())
 }
 
-/// The request of an fmi3Instantiate* function for `interface` (or the reason it holds).
+/// What the fmi3Instantiate* functions do for `interface` (or the reason it holds).
 ///
 /// # Safety
 /// The strings must be NULL or NUL-terminated.
-unsafe fn request<'a>(
+unsafe fn instantiate3(
     function: &'static str,
     interface: Result<Interface, String>,
-    (name, token): (fmi3String, fmi3String),
-    logging_on: fmi3Boolean,
-    environment: fmi3InstanceEnvironment,
-    callback: Option<fmi3LogMessageCallback>,
-) -> Request<'a> {
-    Request {
-        function,
-        api: Api::Fmi3,
-        // SAFETY: NULL or NUL-terminated strings (the contract).
-        name: unsafe { c_str(name) },
-        interface,
-        // SAFETY: as above.
-        token: unsafe { c_str(token) },
-        sink: Sink::Fmi3 {
-            callback,
-            environment,
-        },
-        logging_on: logging_on != fmi3False,
-    }
+    (name, token, logging_on): (fmi3String, fmi3String, fmi3Boolean),
+    (environment, callback): (fmi3InstanceEnvironment, Option<fmi3LogMessageCallback>),
+) -> fmi3Instance {
+    instantiate(|| {
+        Some(Request {
+            function,
+            api: Api::Fmi3,
+            // SAFETY: NULL or NUL-terminated strings (the contract).
+            name: unsafe { c_str(name) },
+            interface,
+            // SAFETY: as above.
+            token: unsafe { c_str(token) },
+            sink: Sink::Fmi3 {
+                callback,
+                environment,
+            },
+            logging_on: logging_on != fmi3False,
+        })
+    })
 }
 
 exports! {
-    /// Frees the instance and every FMU state it handed out. NULL is ignored.
     fn fmi3FreeInstance(instance: fmi3Instance) {
         free_instance(instance, "fmi3FreeInstance");
     }
@@ -54,62 +53,118 @@ exports! {
     /// A Model Exchange instance of the model whose token is `instantiationToken`
     /// (Quadrotor; Lander2D is Co-Simulation only). NULL, with the reason logged, on any
     /// failure.
-    fn fmi3InstantiateModelExchange(instanceName: fmi3String, instantiationToken: fmi3String, _resourcePath: fmi3String, _visible: fmi3Boolean, loggingOn: fmi3Boolean, instanceEnvironment: fmi3InstanceEnvironment, logMessage: Option<fmi3LogMessageCallback>) -> fmi3Instance {
-        let strings = (instanceName, instantiationToken);
+    fn fmi3InstantiateModelExchange(
+        instanceName: fmi3String,
+        instantiationToken: fmi3String,
+        _resourcePath: fmi3String,
+        _visible: fmi3Boolean,
+        loggingOn: fmi3Boolean,
+        instanceEnvironment: fmi3InstanceEnvironment,
+        logMessage: Option<fmi3LogMessageCallback>,
+    ) -> fmi3Instance {
+        let args = (instanceName, instantiationToken, loggingOn);
+        let logger = (instanceEnvironment, logMessage);
         let interface = Ok(Interface::ModelExchange);
-        instantiate(|| Some(request("fmi3InstantiateModelExchange", interface, strings, loggingOn, instanceEnvironment, logMessage)))
+        instantiate3("fmi3InstantiateModelExchange", interface, args, logger)
     }
 
     /// A Co-Simulation instance. Refused (NULL, with the reason logged) with
     /// `eventModeUsed`: the FMUs declare hasEventMode="false". Early return and intermediate
     /// variables are not offered; `earlyReturnAllowed` and the intermediate callback are
     /// never used.
-    fn fmi3InstantiateCoSimulation(instanceName: fmi3String, instantiationToken: fmi3String, _resourcePath: fmi3String, _visible: fmi3Boolean, loggingOn: fmi3Boolean, eventModeUsed: fmi3Boolean, _earlyReturnAllowed: fmi3Boolean, _requiredIntermediateVariables: *const fmi3ValueReference, _nRequiredIntermediateVariables: usize, instanceEnvironment: fmi3InstanceEnvironment, logMessage: Option<fmi3LogMessageCallback>, _intermediateUpdate: Option<fmi3IntermediateUpdateCallback>) -> fmi3Instance {
-        let strings = (instanceName, instantiationToken);
+    fn fmi3InstantiateCoSimulation(
+        instanceName: fmi3String,
+        instantiationToken: fmi3String,
+        _resourcePath: fmi3String,
+        _visible: fmi3Boolean,
+        loggingOn: fmi3Boolean,
+        eventModeUsed: fmi3Boolean,
+        _earlyReturnAllowed: fmi3Boolean,
+        _requiredIntermediateVariables: *const fmi3ValueReference,
+        _nRequiredIntermediateVariables: usize,
+        instanceEnvironment: fmi3InstanceEnvironment,
+        logMessage: Option<fmi3LogMessageCallback>,
+        _intermediateUpdate: Option<fmi3IntermediateUpdateCallback>,
+    ) -> fmi3Instance {
+        let args = (instanceName, instantiationToken, loggingOn);
+        let logger = (instanceEnvironment, logMessage);
         let interface = if eventModeUsed != fmi3False {
-            Err("eventModeUsed is true, but this FMU has no event mode in Co-Simulation (hasEventMode=\"false\")".to_string())
+            let why = "eventModeUsed is true, but this FMU has no event mode in Co-Simulation \
+                       (hasEventMode=\"false\")";
+            Err(why.to_string())
         } else {
             Ok(Interface::CoSimulation)
         };
-        instantiate(|| Some(request("fmi3InstantiateCoSimulation", interface, strings, loggingOn, instanceEnvironment, logMessage)))
+        instantiate3("fmi3InstantiateCoSimulation", interface, args, logger)
     }
 
     /// Scheduled Execution is not offered: always NULL, with the reason logged.
-    fn fmi3InstantiateScheduledExecution(instanceName: fmi3String, instantiationToken: fmi3String, _resourcePath: fmi3String, _visible: fmi3Boolean, loggingOn: fmi3Boolean, instanceEnvironment: fmi3InstanceEnvironment, logMessage: Option<fmi3LogMessageCallback>, _clockUpdate: Option<fmi3ClockUpdateCallback>, _lockPreemption: Option<fmi3LockPreemptionCallback>, _unlockPreemption: Option<fmi3UnlockPreemptionCallback>) -> fmi3Instance {
-        let strings = (instanceName, instantiationToken);
-        let refusal = Err("Scheduled Execution is not offered (the modelDescription has no ScheduledExecution element)".to_string());
-        instantiate(|| Some(request("fmi3InstantiateScheduledExecution", refusal, strings, loggingOn, instanceEnvironment, logMessage)))
-    }
-
-    /// Sets the experiment (start and stop time; the tolerance is not used) and enters
-    /// initialization mode.
-    fn fmi3EnterInitializationMode(instance: fmi3Instance, _toleranceDefined: fmi3Boolean, _tolerance: fmi3Float64, startTime: fmi3Float64, stopTimeDefined: fmi3Boolean, stopTime: fmi3Float64) -> fmi3Status {
-        let function = "fmi3EnterInitializationMode";
-        with_instance(instance, function, masks3::ENTER_INITIALIZATION_MODE, |instance| {
-            let stop = (stopTimeDefined != fmi3False).then_some(stopTime);
-            setup_experiment(instance, function, startTime, stop)?;
-            instance.stage = Stage::InitializationMode;
-            Ok(())
-        })
+    fn fmi3InstantiateScheduledExecution(
+        instanceName: fmi3String,
+        instantiationToken: fmi3String,
+        _resourcePath: fmi3String,
+        _visible: fmi3Boolean,
+        loggingOn: fmi3Boolean,
+        instanceEnvironment: fmi3InstanceEnvironment,
+        logMessage: Option<fmi3LogMessageCallback>,
+        _clockUpdate: Option<fmi3ClockUpdateCallback>,
+        _lockPreemption: Option<fmi3LockPreemptionCallback>,
+        _unlockPreemption: Option<fmi3UnlockPreemptionCallback>,
+    ) -> fmi3Instance {
+        let args = (instanceName, instantiationToken, loggingOn);
+        let logger = (instanceEnvironment, logMessage);
+        let why = "Scheduled Execution is not offered (the modelDescription has no \
+                   ScheduledExecution element)";
+        let refusal = Err(why.to_string());
+        instantiate3("fmi3InstantiateScheduledExecution", refusal, args, logger)
     }
 }
 
 forward! {
-    fn fmi3SetDebugLogging(instance: fmi3Instance, loggingOn: fmi3Boolean, nCategories: usize, categories: *const fmi3String) -> fmi3Status = masks::SET_DEBUG_LOGGING => set_debug_logging;
-    /// Co-Simulation enters step mode, Model Exchange event mode.
-    fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status = masks::EXIT_INITIALIZATION_MODE => exit_initialization_mode;
+    /// Sets the experiment (start and stop time; the tolerance is not used) and enters
+    /// initialization mode.
+    fn fmi3EnterInitializationMode(
+        instance: fmi3Instance,
+        _toleranceDefined: fmi3Boolean,
+        _tolerance: fmi3Float64,
+        startTime: fmi3Float64,
+        stopTimeDefined: fmi3Boolean,
+        stopTime: fmi3Float64,
+    ) -> fmi3Status = masks3::ENTER_INITIALIZATION_MODE => |i, f| {
+        let stop = (stopTimeDefined != fmi3False).then_some(stopTime);
+        setup_experiment(i, f, startTime, stop).map(|()| i.stage = Stage::InitializationMode)
+    };
+    fn fmi3SetDebugLogging(
+        instance: fmi3Instance,
+        loggingOn: fmi3Boolean,
+        nCategories: usize,
+        categories: *const fmi3String,
+    ) -> fmi3Status = masks::SET_DEBUG_LOGGING => set_debug_logging;
+    fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status =
+        masks::EXIT_INITIALIZATION_MODE => exit_initialization_mode;
     fn fmi3Terminate(instance: fmi3Instance) -> fmi3Status = masks::TERMINATE => terminate;
-    /// Back to the state right after instantiation: start values, no experiment.
     fn fmi3Reset(instance: fmi3Instance) -> fmi3Status = masks::RESET => reset;
-    /// Copies the current state; `*FMUState` NULL gets a new state, a state of this instance
-    /// is overwritten in place.
-    fn fmi3GetFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status = masks::FMU_STATE => get_state;
-    /// Restores a state of this instance; `FMUState` is looked up, never dereferenced.
-    fn fmi3SetFMUState(instance: fmi3Instance, FMUState: fmi3FMUState) -> fmi3Status = masks::FMU_STATE => set_state;
-    /// Frees a state and sets `*FMUState` to NULL.
-    fn fmi3FreeFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status = masks::FMU_STATE => free_state;
-    fn fmi3SerializedFMUStateSize(instance: fmi3Instance, FMUState: fmi3FMUState, size: *mut usize) -> fmi3Status = masks::FMU_STATE => serialized_size;
-    fn fmi3SerializeFMUState(instance: fmi3Instance, FMUState: fmi3FMUState, serializedState: *mut fmi3Byte, size: usize) -> fmi3Status = masks::FMU_STATE => serialize;
-    /// Makes a state from serialized bytes after checking them completely.
-    fn fmi3DeserializeFMUState(instance: fmi3Instance, serializedState: *const fmi3Byte, size: usize, FMUState: *mut fmi3FMUState) -> fmi3Status = masks::FMU_STATE => deserialize;
+    fn fmi3GetFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status =
+        masks::FMU_STATE => get_state;
+    fn fmi3SetFMUState(instance: fmi3Instance, FMUState: fmi3FMUState) -> fmi3Status =
+        masks::FMU_STATE => set_state;
+    fn fmi3FreeFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status =
+        masks::FMU_STATE => free_state;
+    fn fmi3SerializedFMUStateSize(
+        instance: fmi3Instance,
+        FMUState: fmi3FMUState,
+        size: *mut usize,
+    ) -> fmi3Status = masks::FMU_STATE => serialized_size;
+    fn fmi3SerializeFMUState(
+        instance: fmi3Instance,
+        FMUState: fmi3FMUState,
+        serializedState: *mut fmi3Byte,
+        size: usize,
+    ) -> fmi3Status = masks::FMU_STATE => serialize;
+    fn fmi3DeserializeFMUState(
+        instance: fmi3Instance,
+        serializedState: *const fmi3Byte,
+        size: usize,
+        FMUState: *mut fmi3FMUState,
+    ) -> fmi3Status = masks::FMU_STATE => deserialize;
 }

@@ -5,31 +5,27 @@ use crate::error::FmuError;
 use crate::exports::guard::{c_slice, c_slice_mut, with_instance, write_out};
 use crate::exports::shared::model_exchange::*;
 use crate::fmi3_types::*;
-use crate::instance::{masks, masks3};
+use crate::instance::{Instance, masks, masks3};
 use crate::table::ModelExchangeTable;
 
 /// How many values a Model Exchange quantity of the model has (0 for a Co-Simulation-only
-/// model), written to `out`.
-///
-/// # Safety
-/// `out` must be NULL or writable.
-unsafe fn count(
-    instance: fmi3Instance,
-    function: &'static str,
-    out: *mut usize,
-    of: fn(&ModelExchangeTable) -> usize,
-) -> fmi3Status {
-    with_instance(instance, function, masks3::ANY, |instance| {
-        let n = instance.sim.table().model_exchange.as_ref().map_or(0, of);
-        // SAFETY: per the function's contract.
-        unsafe { write_out(out, n, "the count") }
-    })
+/// model).
+fn count(instance: &Instance, of: fn(&ModelExchangeTable) -> usize) -> usize {
+    instance.sim.table().model_exchange.as_ref().map_or(0, of)
 }
 
 exports! {
     /// The discrete changes of the event at the current time (turbulence sample, released
     /// bristles) and the next time event. Every output pointer must be writable.
-    fn fmi3UpdateDiscreteStates(instance: fmi3Instance, discreteStatesNeedUpdate: *mut fmi3Boolean, terminateSimulation: *mut fmi3Boolean, nominalsOfContinuousStatesChanged: *mut fmi3Boolean, valuesOfContinuousStatesChanged: *mut fmi3Boolean, nextEventTimeDefined: *mut fmi3Boolean, nextEventTime: *mut fmi3Float64) -> fmi3Status {
+    fn fmi3UpdateDiscreteStates(
+        instance: fmi3Instance,
+        discreteStatesNeedUpdate: *mut fmi3Boolean,
+        terminateSimulation: *mut fmi3Boolean,
+        nominalsOfContinuousStatesChanged: *mut fmi3Boolean,
+        valuesOfContinuousStatesChanged: *mut fmi3Boolean,
+        nextEventTimeDefined: *mut fmi3Boolean,
+        nextEventTime: *mut fmi3Float64,
+    ) -> fmi3Status {
         let function = "fmi3UpdateDiscreteStates";
         with_instance(instance, function, masks3::UPDATE_DISCRETE_STATES, |instance| {
             let flags = [
@@ -53,61 +49,70 @@ exports! {
             write_out(nextEventTime, next.unwrap_or(0.0), "nextEventTime")
         })
     }
-
-    /// A finite time not before the last event.
-    fn fmi3SetTime(instance: fmi3Instance, time: fmi3Float64) -> fmi3Status {
-        with_instance(instance, "fmi3SetTime", masks::SET_TIME, |instance| instance.sim.set_time(time))
-    }
-
-    /// Sets the states; nothing changes when a value is not finite.
-    fn fmi3SetContinuousStates(instance: fmi3Instance, continuousStates: *const fmi3Float64, nContinuousStates: usize) -> fmi3Status {
-        with_instance(instance, "fmi3SetContinuousStates", masks::SET_CONTINUOUS_STATES, |instance| {
-            instance.sim.set_continuous_states(c_slice(continuousStates, nContinuousStates, "continuous states")?)
-        })
-    }
-
-    /// The derivatives of the continuous states: the core's right-hand side, bit for bit.
-    fn fmi3GetContinuousStateDerivatives(instance: fmi3Instance, derivatives: *mut fmi3Float64, nContinuousStates: usize) -> fmi3Status {
-        with_instance(instance, "fmi3GetContinuousStateDerivatives", masks3::GET_DERIVATIVES, |instance| {
-            instance.sim.derivatives(c_slice_mut(derivatives, nContinuousStates, "derivatives")?)
-        })
-    }
-
-    /// The foot heights (m): a sign change is a touch-down or a lift-off.
-    fn fmi3GetEventIndicators(instance: fmi3Instance, eventIndicators: *mut fmi3Float64, nEventIndicators: usize) -> fmi3Status {
-        with_instance(instance, "fmi3GetEventIndicators", masks::GET_EVENT_INDICATORS, |instance| {
-            instance.sim.event_indicators(c_slice_mut(eventIndicators, nEventIndicators, "eventIndicators")?)
-        })
-    }
-
-    fn fmi3GetContinuousStates(instance: fmi3Instance, continuousStates: *mut fmi3Float64, nContinuousStates: usize) -> fmi3Status {
-        with_instance(instance, "fmi3GetContinuousStates", masks::GET_CONTINUOUS_STATES, |instance| {
-            instance.sim.continuous_states(c_slice_mut(continuousStates, nContinuousStates, "continuousStates")?)
-        })
-    }
-
-    /// 1 for every state.
-    fn fmi3GetNominalsOfContinuousStates(instance: fmi3Instance, nominals: *mut fmi3Float64, nContinuousStates: usize) -> fmi3Status {
-        with_instance(instance, "fmi3GetNominalsOfContinuousStates", masks::GET_NOMINALS, |instance| {
-            instance.sim.nominals(c_slice_mut(nominals, nContinuousStates, "nominals")?)
-        })
-    }
-
-    /// The number of event indicators (0 for a Co-Simulation-only model).
-    fn fmi3GetNumberOfEventIndicators(instance: fmi3Instance, nEventIndicators: *mut usize) -> fmi3Status {
-        count(instance, "fmi3GetNumberOfEventIndicators", nEventIndicators, |me| me.event_indicators)
-    }
-
-    /// The number of continuous states (0 for a Co-Simulation-only model).
-    fn fmi3GetNumberOfContinuousStates(instance: fmi3Instance, nContinuousStates: *mut usize) -> fmi3Status {
-        count(instance, "fmi3GetNumberOfContinuousStates", nContinuousStates, |me| me.states.len())
-    }
 }
 
 forward! {
-    /// Model Exchange only (Co-Simulation has no event mode here).
-    fn fmi3EnterEventMode(instance: fmi3Instance) -> fmi3Status = masks::ENTER_EVENT_MODE => enter_event_mode;
-    fn fmi3EnterContinuousTimeMode(instance: fmi3Instance) -> fmi3Status = masks::ENTER_CONTINUOUS_TIME_MODE => enter_continuous_time_mode;
-    /// No step event and no termination; an error once the state is not finite.
-    fn fmi3CompletedIntegratorStep(instance: fmi3Instance, _noSetFMUStatePriorToCurrentPoint: fmi3Boolean, enterEventMode: *mut fmi3Boolean, terminateSimulation: *mut fmi3Boolean) -> fmi3Status = masks::COMPLETED_INTEGRATOR_STEP => completed_integrator_step;
+    fn fmi3SetTime(instance: fmi3Instance, time: fmi3Float64) -> fmi3Status =
+        masks::SET_TIME => |i| i.sim.set_time(time);
+    fn fmi3SetContinuousStates(
+        instance: fmi3Instance,
+        continuousStates: *const fmi3Float64,
+        nContinuousStates: usize,
+    ) -> fmi3Status = masks::SET_CONTINUOUS_STATES => |i| {
+        let states = c_slice(continuousStates, nContinuousStates, "continuous states")?;
+        i.sim.set_continuous_states(states)
+    };
+    fn fmi3GetContinuousStateDerivatives(
+        instance: fmi3Instance,
+        derivatives: *mut fmi3Float64,
+        nContinuousStates: usize,
+    ) -> fmi3Status = masks3::GET_DERIVATIVES => |i| {
+        i.sim.derivatives(c_slice_mut(derivatives, nContinuousStates, "derivatives")?)
+    };
+    fn fmi3GetEventIndicators(
+        instance: fmi3Instance,
+        eventIndicators: *mut fmi3Float64,
+        nEventIndicators: usize,
+    ) -> fmi3Status = masks::GET_EVENT_INDICATORS => |i| {
+        i.sim.event_indicators(c_slice_mut(eventIndicators, nEventIndicators, "eventIndicators")?)
+    };
+    fn fmi3GetContinuousStates(
+        instance: fmi3Instance,
+        continuousStates: *mut fmi3Float64,
+        nContinuousStates: usize,
+    ) -> fmi3Status = masks::GET_CONTINUOUS_STATES => |i| {
+        let states = c_slice_mut(continuousStates, nContinuousStates, "continuousStates")?;
+        i.sim.continuous_states(states)
+    };
+    fn fmi3GetNominalsOfContinuousStates(
+        instance: fmi3Instance,
+        nominals: *mut fmi3Float64,
+        nContinuousStates: usize,
+    ) -> fmi3Status = masks::GET_NOMINALS => |i| {
+        i.sim.nominals(c_slice_mut(nominals, nContinuousStates, "nominals")?)
+    };
+    /// The number of event indicators (0 for a Co-Simulation-only model).
+    fn fmi3GetNumberOfEventIndicators(
+        instance: fmi3Instance,
+        nEventIndicators: *mut usize,
+    ) -> fmi3Status = masks3::ANY => |i| {
+        write_out(nEventIndicators, count(i, |me| me.event_indicators), "the count")
+    };
+    /// The number of continuous states (0 for a Co-Simulation-only model).
+    fn fmi3GetNumberOfContinuousStates(
+        instance: fmi3Instance,
+        nContinuousStates: *mut usize,
+    ) -> fmi3Status = masks3::ANY => |i| {
+        write_out(nContinuousStates, count(i, |me| me.states.len()), "the count")
+    };
+    fn fmi3EnterEventMode(instance: fmi3Instance) -> fmi3Status =
+        masks::ENTER_EVENT_MODE => enter_event_mode;
+    fn fmi3EnterContinuousTimeMode(instance: fmi3Instance) -> fmi3Status =
+        masks::ENTER_CONTINUOUS_TIME_MODE => enter_continuous_time_mode;
+    fn fmi3CompletedIntegratorStep(
+        instance: fmi3Instance,
+        _noSetFMUStatePriorToCurrentPoint: fmi3Boolean,
+        enterEventMode: *mut fmi3Boolean,
+        terminateSimulation: *mut fmi3Boolean,
+    ) -> fmi3Status = masks::COMPLETED_INTEGRATOR_STEP => completed_integrator_step;
 }

@@ -6,15 +6,24 @@
 use super::values::{accessors, each_variable, resolve};
 use crate::error::FmuError;
 use crate::exports::guard::{c_slice, refuse, with_instance};
+use crate::fmi2_types::fmi2Status;
 use crate::fmi3_types::*;
-use crate::instance::{Mask, masks3};
+use crate::instance::{Instance, masks3};
 use crate::table::{Api, ValueType};
 
 /// Defines fmi3Get<T> and fmi3Set<T> for types no variable has: every value reference is
 /// refused, naming the variable's real type when it exists; no value is ever converted.
 macro_rules! no_variables {
     ($($get:ident $set:ident $t:ty, $name:literal = $zero:expr;)*) => {$(
-        accessors!($get, $set, $t, ValueType::none(Api::Fmi3, $name), masks3::SET_OTHER, |_| $zero, |_| f64::NAN);
+        accessors!(
+            $get,
+            $set,
+            $t,
+            ValueType::none(Api::Fmi3, $name),
+            masks3::SET_OTHER,
+            |_| $zero,
+            |_| f64::NAN
+        );
     )*};
 }
 
@@ -36,37 +45,46 @@ no_variables! {
 ///
 /// # Safety
 /// `vr` must be NULL or hold `nvr` elements.
-unsafe fn no_binary(
-    instance: fmi3Instance,
-    function: &'static str,
-    mask: Mask,
+unsafe fn no_binary<B>(
+    instance: &mut Instance,
+    function: &str,
     (vr, nvr): (*const fmi3ValueReference, usize),
-    (values_null, n_values): (bool, usize),
-) -> fmi3Status {
-    with_instance(instance, function, mask, |instance| {
-        // SAFETY: per the function's contract.
-        let vrs = unsafe { c_slice(vr, nvr, "valueReferences[]") }?;
-        let variables = resolve(&instance.sim.table().fmi3, vrs, n_values)?;
-        if values_null && n_values > 0 {
-            return Err(FmuError::NullArgument("values[]"));
-        }
-        let binary = ValueType::none(Api::Fmi3, "Binary");
-        each_variable(instance, function, variables, binary, |_, _, _| Ok(()))
-    })
+    values: *const B,
+    n_values: usize,
+) -> Result<fmi2Status, FmuError> {
+    // SAFETY: per the function's contract.
+    let vrs = unsafe { c_slice(vr, nvr, "valueReferences[]") }?;
+    let variables = resolve(&instance.sim.table().fmi3, vrs, n_values)?;
+    if values.is_null() && n_values > 0 {
+        return Err(FmuError::NullArgument("values[]"));
+    }
+    let binary = ValueType::none(Api::Fmi3, "Binary");
+    each_variable(instance, function, variables, binary, |_, _, _| Ok(()))
 }
 
-exports! {
+forward! {
     /// No Binary variables: every value reference is refused.
-    fn fmi3GetBinary(instance: fmi3Instance, valueReferences: *const fmi3ValueReference, nValueReferences: usize, _valueSizes: *mut usize, values: *mut fmi3Binary, nValues: usize) -> fmi3Status {
-        let vrs = (valueReferences, nValueReferences);
-        no_binary(instance, "fmi3GetBinary", masks3::GET_VALUE, vrs, (values.is_null(), nValues))
-    }
-
+    fn fmi3GetBinary(
+        instance: fmi3Instance,
+        valueReferences: *const fmi3ValueReference,
+        nValueReferences: usize,
+        _valueSizes: *mut usize,
+        values: *mut fmi3Binary,
+        nValues: usize,
+    ) -> fmi3Status = masks3::GET_VALUE => |i, f| {
+        no_binary(i, f, (valueReferences, nValueReferences), values.cast_const(), nValues)
+    };
     /// No Binary variables: every value reference is refused.
-    fn fmi3SetBinary(instance: fmi3Instance, valueReferences: *const fmi3ValueReference, nValueReferences: usize, _valueSizes: *const usize, values: *const fmi3Binary, nValues: usize) -> fmi3Status {
-        let vrs = (valueReferences, nValueReferences);
-        no_binary(instance, "fmi3SetBinary", masks3::SET_OTHER, vrs, (values.is_null(), nValues))
-    }
+    fn fmi3SetBinary(
+        instance: fmi3Instance,
+        valueReferences: *const fmi3ValueReference,
+        nValueReferences: usize,
+        _valueSizes: *const usize,
+        values: *const fmi3Binary,
+        nValues: usize,
+    ) -> fmi3Status = masks3::SET_OTHER => |i, f| {
+        no_binary(i, f, (valueReferences, nValueReferences), values, nValues)
+    };
 }
 
 const NO_CLOCKS: &str = "this FMU has no clocks";
@@ -81,7 +99,7 @@ macro_rules! refused {
             /// `instance` must be NULL or live; nothing else is read.
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn $name(instance: fmi3Instance, $(_: $t),*) -> fmi3Status {
-                refuse(instance, stringify!($name), masks3::ANY, $why)
+                with_instance(instance, stringify!($name), masks3::ANY, |_| refuse($why))
             }
         )*
     };

@@ -90,10 +90,16 @@ pub(crate) fn each_variable(
 /// converts through `$to_c`, the setter (allowed in `$mask`) through `$from_c`. The body is
 /// here, not in a helper, so the model is two calls away: the guard, then the engine.
 macro_rules! accessors {
-    ($get:ident, $set:ident, $t:ty, $ty:expr, $mask:expr, $to_c:expr, $from_c:expr) => {
+    ($get:ident, $set:ident, $t:ty, $ty:expr, $mask:expr, $to_c:expr, $from_c:expr $(,)?) => {
         exports! {
             /// Reads the variables (arrays element by element) into `values`.
-            fn $get(instance: fmi3Instance, valueReferences: *const fmi3ValueReference, nValueReferences: usize, values: *mut $t, nValues: usize) -> fmi3Status {
+            fn $get(
+                instance: fmi3Instance,
+                valueReferences: *const fmi3ValueReference,
+                nValueReferences: usize,
+                values: *mut $t,
+                nValues: usize,
+            ) -> fmi3Status {
                 use $crate::exports::fmi3::values::{computed, each_variable, resolve};
                 use $crate::exports::guard::{c_slice, c_slice_mut, with_instance};
                 let function = stringify!($get);
@@ -117,7 +123,13 @@ macro_rules! accessors {
             }
 
             /// Writes `values` to the variables (arrays element by element).
-            fn $set(instance: fmi3Instance, valueReferences: *const fmi3ValueReference, nValueReferences: usize, values: *const $t, nValues: usize) -> fmi3Status {
+            fn $set(
+                instance: fmi3Instance,
+                valueReferences: *const fmi3ValueReference,
+                nValueReferences: usize,
+                values: *const $t,
+                nValues: usize,
+            ) -> fmi3Status {
                 use $crate::exports::fmi3::values::{each_variable, not_settable, resolve};
                 use $crate::exports::guard::{c_slice, with_instance};
                 let function = stringify!($set);
@@ -147,7 +159,31 @@ macro_rules! accessors {
 }
 pub(crate) use accessors;
 
-accessors! { fmi3GetFloat64, fmi3SetFloat64, fmi3Float64, ValueType::of(Api::Fmi3, ValueKind::Real), masks3::SET_FLOAT64, |v| v, |v| v }
+accessors! {
+    fmi3GetFloat64,
+    fmi3SetFloat64,
+    fmi3Float64,
+    ValueType::of(Api::Fmi3, ValueKind::Real),
+    masks3::SET_FLOAT64,
+    |v| v,
+    |v| v,
+}
 // Int32 variables hold integers within i32 (their table ranges say so).
-accessors! { fmi3GetInt32, fmi3SetInt32, fmi3Int32, ValueType::of(Api::Fmi3, ValueKind::Integer), masks3::SET_OTHER, |v| v as i32, f64::from }
-accessors! { fmi3GetBoolean, fmi3SetBoolean, fmi3Boolean, ValueType::of(Api::Fmi3, ValueKind::Boolean), masks3::SET_OTHER, |v| u8::from(v != 0.0), |v: u8| if v != 0 { 1.0 } else { 0.0 } }
+accessors! {
+    fmi3GetInt32,
+    fmi3SetInt32,
+    fmi3Int32,
+    ValueType::of(Api::Fmi3, ValueKind::Integer),
+    masks3::SET_OTHER,
+    |v| v as i32,
+    f64::from,
+}
+accessors! {
+    fmi3GetBoolean,
+    fmi3SetBoolean,
+    fmi3Boolean,
+    ValueType::of(Api::Fmi3, ValueKind::Boolean),
+    masks3::SET_OTHER,
+    |v| u8::from(v != 0.0),
+    |v: u8| if v != 0 { 1.0 } else { 0.0 },
+}

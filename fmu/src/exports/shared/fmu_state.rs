@@ -1,9 +1,6 @@
 //! FMU states: get, set, free, serialize, deserialize. A state is a copy of everything the
 //! instance holds (model with its RNG and physics world, stage, experiment, time grid, start
 //! values), so setting it and stepping again repeats the same outputs bit for bit.
-//!
-//! The instance keeps every state it hands out; a pointer it does not know (freed already,
-//! foreign, garbage) is refused with an error instead of being dereferenced.
 
 use crate::error::FmuError;
 use crate::exports::guard::{c_slice, c_slice_mut, write_out};
@@ -23,9 +20,6 @@ unsafe fn slot<'a>(FMUstate: *mut StatePtr) -> Result<&'a mut StatePtr, FmuError
     unsafe { FMUstate.as_mut() }.ok_or(FmuError::NullArgument("FMUstate"))
 }
 
-/// Copies the current state. `*FMUstate` NULL gets a new state; a state of this instance is
-/// overwritten in place.
-///
 /// # Safety
 /// `FMUstate` must be NULL or valid for reads and writes of one pointer.
 pub(crate) unsafe fn get_state(
@@ -42,12 +36,8 @@ pub(crate) unsafe fn get_state(
     Ok(())
 }
 
-/// Restores a state of this instance (stage, time and everything else included).
-///
-/// # Safety
-/// `c` must be NULL or a live instance; `FMUstate` may be anything (it is looked up, not
-/// dereferenced).
-pub(crate) unsafe fn set_state(
+/// `FMUstate` is looked up, never dereferenced.
+pub(crate) fn set_state(
     instance: &mut Instance,
     function: &str,
     FMUstate: StatePtr,
@@ -68,8 +58,7 @@ pub(crate) unsafe fn set_state(
     Ok(())
 }
 
-/// Frees a state and sets `*FMUstate` to NULL. `*FMUstate` NULL is ignored; a pointer this
-/// instance does not hold (a second free) is an error.
+/// `*FMUstate` NULL is ignored.
 ///
 /// # Safety
 /// `FMUstate` must be NULL or valid for reads and writes of one pointer.
@@ -100,8 +89,6 @@ pub(crate) unsafe fn serialized_size(
     unsafe { write_out(size, length, "size") }
 }
 
-/// Copies a state's bytes; `size` must be what fmi2SerializedFMUstateSize said.
-///
 /// # Safety
 /// `serializedState` must be NULL or writable for `size` bytes.
 pub(crate) unsafe fn serialize<B>(
@@ -125,9 +112,6 @@ pub(crate) unsafe fn serialize<B>(
     Ok(())
 }
 
-/// Makes a state from serialized bytes after checking them completely (format, checksum,
-/// model, a restorable model snapshot). Bytes that fail give an error and change nothing.
-///
 /// # Safety
 /// `serializedState` must be NULL or readable for `size` bytes; `FMUstate` must be NULL or
 /// valid for reads and writes of one pointer.

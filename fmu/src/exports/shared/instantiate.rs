@@ -1,6 +1,4 @@
-//! What fmi2Instantiate and FMI 3.0's fmi3Instantiate* share: checking the name, the
-//! interface and the GUID / instantiation token, creating the model, and saying why when any
-//! of it fails.
+//! What fmi2Instantiate and FMI 3.0's fmi3Instantiate* share.
 
 use crate::fmi2_types::fmi2Status;
 use crate::instance::{Instance, Interface};
@@ -12,7 +10,6 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// An instantiation request, its C arguments already read.
 pub(crate) struct Request<'a> {
-    /// The C function's name, for messages.
     pub function: &'static str,
     pub api: Api,
     pub name: Option<&'a CStr>,
@@ -22,22 +19,6 @@ pub(crate) struct Request<'a> {
     pub token: Option<&'a CStr>,
     pub sink: Sink,
     pub logging_on: bool,
-}
-
-/// The new instance, or `None` after logging why not.
-pub(crate) fn create_instance(request: &Request<'_>) -> Option<*mut Instance> {
-    match new_instance(request) {
-        Ok(instance) => Some(Box::into_raw(Box::new(instance))),
-        Err(message) => {
-            let shown = request.name.map(CStr::to_owned).unwrap_or_default();
-            let message = format!("{}: {message}", request.function);
-            // SAFETY: the sink's callback and environment come together from the importer.
-            unsafe {
-                (request.sink).send(&shown, fmi2Status::fmi2Error, Category::Error, &message)
-            };
-            None
-        }
-    }
 }
 
 /// The instance `request` asks for, or why there is none.
@@ -78,12 +59,22 @@ fn new_instance(request: &Request<'_>) -> Result<Instance, String> {
     Ok(instance)
 }
 
-/// The instance `build` asks for, or NULL (`build` gives `None` when there is no logger to
-/// tell why; a panic, caught here, gives NULL too).
+/// The instance `build` asks for, or NULL after logging why not (`build` gives `None` when
+/// there is no logger to tell why; a panic, caught here, gives NULL too).
 pub(crate) fn instantiate<'a>(build: impl FnOnce() -> Option<Request<'a>>) -> *mut c_void {
-    let outcome = catch_unwind(AssertUnwindSafe(|| create_instance(&build()?)));
-    match outcome {
-        Ok(Some(instance)) => instance.cast(),
-        _ => std::ptr::null_mut(),
-    }
+    let outcome = catch_unwind(AssertUnwindSafe(|| {
+        let request = build()?;
+        let message = match new_instance(&request) {
+            Ok(instance) => return Some(Box::into_raw(Box::new(instance)).cast()),
+            Err(message) => format!("{}: {message}", request.function),
+        };
+        let name = request.name.map(CStr::to_owned).unwrap_or_default();
+        let logger = Logger {
+            sink: request.sink,
+            instance_name: name,
+        };
+        logger.log(fmi2Status::fmi2Error, Category::Error, &message);
+        None
+    }));
+    outcome.ok().flatten().unwrap_or(std::ptr::null_mut())
 }

@@ -37,32 +37,30 @@ pub(crate) unsafe fn set_debug_logging(
     categories: *const fmi2String,
 ) -> Result<fmi2Status, FmuError> {
     let on = on.into() != 0;
-    {
-        // SAFETY: per the function's contract.
-        let names = unsafe { c_slice(categories, n, "categories[]") }?;
-        if names.is_empty() {
-            instance.filter.set_all(on);
-            return Ok(fmi2Status::fmi2OK);
-        }
-        let mut worst = fmi2Status::fmi2OK;
-        for &name in names {
-            // SAFETY: each entry is NULL or a C string (the contract).
-            let name = unsafe { c_str(name) }.map(CStr::to_string_lossy);
-            let error = match name.as_deref().map(|n| (n, Category::from_name(n))) {
-                Some((_, Some(category))) => {
-                    instance.filter.set(category, on);
-                    continue;
-                }
-                Some((n, None)) => FmuError::InvalidArgument(format!(
-                    "unknown log category `{n}` (known: logEvents, logStatusWarning, \
-                     logStatusError, logStatusFatal)"
-                )),
-                None => FmuError::NullArgument("categories[i]"),
-            };
-            worst = worst.max(instance.report(function, &error));
-        }
-        Ok(worst)
+    // SAFETY: per the function's contract.
+    let names = unsafe { c_slice(categories, n, "categories[]") }?;
+    if names.is_empty() {
+        instance.logging = [on; 4];
+        return Ok(fmi2Status::fmi2OK);
     }
+    let mut worst = fmi2Status::fmi2OK;
+    for &name in names {
+        // SAFETY: each entry is NULL or a C string (the contract).
+        let name = unsafe { c_str(name) }.map(CStr::to_string_lossy);
+        let error = match name.as_deref().map(|n| (n, Category::from_name(n))) {
+            Some((_, Some(category))) => {
+                instance.logging[category as usize] = on;
+                continue;
+            }
+            Some((n, None)) => FmuError::InvalidArgument(format!(
+                "unknown log category `{n}` (known: logEvents, logStatusWarning, \
+                 logStatusError, logStatusFatal)"
+            )),
+            None => FmuError::NullArgument("categories[i]"),
+        };
+        worst = worst.max(instance.report(function, &error));
+    }
+    Ok(worst)
 }
 
 /// The experiment (fmi2SetupExperiment; fmi3EnterInitializationMode's arguments).
@@ -87,25 +85,29 @@ pub(crate) fn exit_initialization_mode(
     instance: &mut Instance,
     function: &str,
 ) -> Result<(), FmuError> {
-    instance.stage = match instance.interface {
+    let stage = match instance.interface {
         Interface::CoSimulation => Stage::StepComplete,
         Interface::ModelExchange => Stage::EventMode,
     };
-    instance.event(&format!("{function}: t = {}", Compact(instance.sim.time())));
-    Ok(())
+    instance.enter(
+        stage,
+        &format!("{function}: t = {}", Compact(instance.sim.time())),
+    )
 }
 
 /// The body of fmi2Terminate and fmi3Terminate.
 pub(crate) fn terminate(instance: &mut Instance, function: &str) -> Result<(), FmuError> {
-    instance.stage = Stage::Terminated;
-    instance.event(&format!("{function}: t = {}", Compact(instance.sim.time())));
-    Ok(())
+    instance.enter(
+        Stage::Terminated,
+        &format!("{function}: t = {}", Compact(instance.sim.time())),
+    )
 }
 
 /// The body of fmi2Reset and fmi3Reset: back to the state right after instantiation.
 pub(crate) fn reset(instance: &mut Instance, function: &str) -> Result<(), FmuError> {
     instance.sim.reset()?;
-    instance.stage = Stage::Instantiated;
-    instance.event(&format!("{function}: back to the start values"));
-    Ok(())
+    instance.enter(
+        Stage::Instantiated,
+        &format!("{function}: back to the start values"),
+    )
 }

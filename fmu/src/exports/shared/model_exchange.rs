@@ -1,7 +1,5 @@
-//! The Model Exchange bodies of FMI 2.0 and FMI 3.0: the importer's solver sets time and
-//! continuous states, reads derivatives and event indicators, and calls the event functions.
-//! Each mask refuses a Co-Simulation instance; NULL pointers and wrong array lengths are
-//! refused with a log line, never a crash.
+//! The Model Exchange bodies of FMI 2.0 and FMI 3.0 (each mask refuses a Co-Simulation
+//! instance).
 
 use crate::error::FmuError;
 use crate::exports::guard::write_out;
@@ -24,8 +22,7 @@ pub(crate) fn enter_continuous_time_mode(
 }
 
 /// The discrete changes of the event at the current time, logged as `function`'s event:
-/// whether the continuous states changed, and the next time event (the part of
-/// fmi2NewDiscreteStates and fmi3UpdateDiscreteStates that is not C arguments).
+/// whether the continuous states changed, and the next time event.
 pub(crate) fn discrete_update(
     instance: &mut Instance,
     function: &str,
