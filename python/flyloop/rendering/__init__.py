@@ -13,10 +13,9 @@ this package does not import pygame: each view's constructor does.
 from .camera import OrbitCamera
 from .lander import LanderScene, LanderView, lander_scene
 from .quadrotor import QuadrotorView, QuadScene, quad_scene
-from .recording import FrameRecorder, Recording, record_episode, save_video
+from .recording import Recording, record_episode, save_video
 
 __all__ = [
-    "FrameRecorder",
     "LanderScene",
     "LanderView",
     "OrbitCamera",

@@ -91,33 +91,6 @@ def _save_ffmpeg(frames: list[np.ndarray], path: Path, fps: float) -> None:
         writer.close()
 
 
-class FrameRecorder:
-    """Collects frames (e.g. each env.render() in rgb_array mode) and saves them at the end."""
-
-    def __init__(self, max_frames: int | None = None) -> None:
-        if max_frames is not None and max_frames < 1:
-            raise ValueError(f"max_frames must be >= 1, got {max_frames}")
-        self.max_frames = max_frames
-        self.frames: list[np.ndarray] = []
-
-    def add(self, frame: np.ndarray | None) -> None:
-        """Keep a copy of frame; None (a human-mode render) is refused with a clear error."""
-        if frame is None:
-            raise ValueError("got no frame: record with render_mode='rgb_array'")
-        if self.max_frames is not None and len(self.frames) >= self.max_frames:
-            return
-        self.frames.append(np.array(frame, dtype=np.uint8, copy=True))
-
-    def __len__(self) -> int:
-        return len(self.frames)
-
-    def save(self, path: str | Path, fps: float = 30.0) -> Path:
-        return save_video(self.frames, path, fps)
-
-    def clear(self) -> None:
-        self.frames.clear()
-
-
 @dataclass(frozen=True)
 class Recording:
     path: Path
@@ -146,16 +119,15 @@ def record_episode(
             f"got {getattr(env, 'render_mode', None)!r}"
         )
     rate = fps if fps is not None else float(env.metadata.get("render_fps") or 30)
-    recorder = FrameRecorder()
     observation, _ = env.reset(seed=seed)
-    recorder.add(env.render())
+    frames = [env.render()]
     steps, total = 0, 0.0
     while max_steps is None or steps < max_steps:
         action = policy(observation) if policy is not None else env.action_space.sample()
         observation, reward, terminated, truncated, _ = env.step(action)
-        recorder.add(env.render())
+        frames.append(env.render())
         steps += 1
         total += float(reward)
         if terminated or truncated:
             break
-    return Recording(recorder.save(path, rate), len(recorder), steps, total)
+    return Recording(save_video(frames, path, rate), len(frames), steps, total)
