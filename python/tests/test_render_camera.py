@@ -7,15 +7,19 @@ import pytest
 
 from flyloop.rendering.camera import OrbitCamera, clip_polygon_near
 from flyloop.rendering.lander import PlaneView
-from flyloop.rendering.quadrotor import (
-    ROTOR_SPIN,
-    euler_rpy,
-    quaternion_from_euler,
-    rotation_matrix,
-    rotor_positions_body,
-)
+from flyloop.rendering.quadrotor import ROTOR_SPIN, euler_rpy, rotation_matrix
 
 W, H = 800, 600
+
+
+def quaternion_from_euler(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """The unit quaternion [w, x, y, z] of intrinsic Z-Y-X angles in radians."""
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    w, x = cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy
+    y, z = cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy
+    return np.array([w, x, y, z])
 
 
 def test_look_at_point_lands_in_the_frame_centre():
@@ -110,14 +114,7 @@ def test_bad_camera_is_refused_by_name():
         OrbitCamera(fov_deg=180.0)
 
 
-def test_rotor_layout_is_px4_quad_x():
-    r = rotor_positions_body(0.1)
-    lever = 0.1 / math.sqrt(2)
-    # 0 front-right, 1 rear-left, 2 front-left, 3 rear-right (body FLU: +x front, +y left).
-    np.testing.assert_allclose(r[0], [lever, -lever, 0])
-    np.testing.assert_allclose(r[1], [-lever, lever, 0])
-    np.testing.assert_allclose(r[2], [lever, lever, 0])
-    np.testing.assert_allclose(r[3], [-lever, -lever, 0])
+def test_rotor_spin_is_px4_quad_x():
     assert ROTOR_SPIN == (-1, -1, 1, 1)  # CCW, CCW, CW, CW as core/src/quadrotor/dynamics.rs
 
 

@@ -110,7 +110,6 @@ def test_quad_scene_from_a_waypoints_step():
     np.testing.assert_allclose(s.position, [0.5, 0.6, 1.7])
     np.testing.assert_allclose(s.velocity, [1, 2, 3])
     np.testing.assert_allclose(s.quaternion, [0, 0, 0, 1])
-    np.testing.assert_allclose(s.body_rates, [0.1, 0.2, 0.3])
     np.testing.assert_allclose(s.wind, [4, 0, -1])
     np.testing.assert_allclose(s.motors, [0.1, 0.2, 0.3, 0.4])
     np.testing.assert_allclose(s.target, [1, 1, 2])

@@ -66,23 +66,6 @@ def euler_rpy(q_wxyz: np.ndarray) -> tuple[float, float, float]:
     return roll, pitch, yaw
 
 
-def quaternion_from_euler(roll: float, pitch: float, yaw: float) -> np.ndarray:
-    """The unit quaternion [w, x, y, z] of intrinsic Z-Y-X angles in radians."""
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    w, x = cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy
-    y, z = cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy
-    return np.array([w, x, y, z])
-
-
-def rotor_positions_body(arm_length: float) -> np.ndarray:
-    """(4, 3) rotor centres in the body frame, metres, in PX4 motor order."""
-    out = np.zeros((4, 3))
-    out[:, :2] = ROTOR_POSITION_SIGNS * (arm_length / math.sqrt(2.0))
-    return out
-
-
 @dataclass(eq=False)
 class QuadScene:
     """One frame of the quadrotor: plain per-step data in the core's frames and units."""
@@ -93,7 +76,6 @@ class QuadScene:
     velocity: np.ndarray  # (3,) m/s, world ENU
     quaternion: np.ndarray  # (4,) [w, x, y, z], body FLU -> world ENU; normalised here
     motors: np.ndarray = field(default_factory=lambda: np.zeros(4))  # (4,) states, [0, 1]
-    body_rates: np.ndarray = field(default_factory=lambda: np.zeros(3))  # (3,) rad/s, body FLU
     wind: np.ndarray = field(default_factory=lambda: np.zeros(3))  # (3,) m/s, world ENU
     target: np.ndarray | None = None  # (3,) m, world ENU: the current target / waypoint
     next_waypoint: np.ndarray | None = None  # (3,) m, the waypoint after the target
@@ -104,10 +86,9 @@ class QuadScene:
     arm_length: float = _CORE["arm_length"]  # m, centre to rotor
     waypoints_reached: int | None = None  # Waypoints task only
     status: str = ""  # e.g. "crashed", "out of bounds"; empty while flying
-    extras: tuple[tuple[str, str], ...] = ()  # more (label, text) lines for the info panel
 
     def __post_init__(self) -> None:
-        for name in ("position", "velocity", "body_rates", "wind", "target", "next_waypoint"):
+        for name in ("position", "velocity", "wind", "target", "next_waypoint"):
             if getattr(self, name) is not None:
                 setattr(self, name, vector(getattr(self, name)))
         q = vector(self.quaternion)
@@ -117,8 +98,6 @@ class QuadScene:
         self.time_s, self.step = float(self.time_s), int(self.step)
         if self.waypoints_reached is not None:
             self.waypoints_reached = int(self.waypoints_reached)
-        items = self.extras.items() if isinstance(self.extras, Mapping) else self.extras
-        self.extras = tuple((str(k), str(v)) for k, v in items)
 
 
 def quad_scene(
@@ -147,7 +126,6 @@ def quad_scene(
         position=info["position"],
         velocity=obs[at["velocity"]],
         quaternion=part("quaternion", (1.0, 0.0, 0.0, 0.0)),
-        body_rates=obs[at["body_rates"]],
         wind=part("wind", np.zeros(3)),
         motors=part("motor_states", np.zeros(4)),
         target=info.get("target_position"),
@@ -232,7 +210,7 @@ def drone(p: Painter, pr: Projector, scene: QuadScene, scale: float) -> None:
     rot = rotation_matrix(scene.quaternion)
     pos = scene.position
     arm = scene.arm_length * scale
-    rotors = pos + rotor_positions_body(arm) @ rot.T
+    rotors = pos + np.c_[ROTOR_POSITION_SIGNS * (arm / math.sqrt(2.0)), np.zeros(4)] @ rot.T
     rotor_radius = 0.38 * arm
     disc_axes = rot.T[:2]  # body x and y in world coordinates
     cam = pr.camera
@@ -330,7 +308,6 @@ def info_lines(scene: QuadScene) -> list[tuple[str, tuple[int, int, int]]]:
         lines.append((f"Waypoints reached {scene.waypoints_reached}", TEXT))
     if scene.status:
         lines.append((scene.status[:1].upper() + scene.status[1:], BAD))
-    lines.extend((f"{label}: {text}", TEXT) for label, text in scene.extras)
     return lines
 
 
@@ -472,12 +449,6 @@ class QuadrotorView(View):
         self._moves = dict(zip(keys, moves, strict=True))
         self._held: set[int] = set()
         self._dragging = False
-
-    def world_to_screen(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Pixels (..., 2) of world points (..., 3) and whether each is in front of the camera."""
-        if self.camera is None:
-            raise RuntimeError("the camera is set up by the first render (or pass camera=...)")
-        return self.camera.project(points, *self.size)
 
     def reset(self) -> None:
         """Forget the trail (an env calls this from reset())."""
