@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from flyloop.rendering.camera import OrbitCamera, clip_polygon_near
+from flyloop.rendering.camera import OrbitCamera, Projector, clip_polygon_near
 from flyloop.rendering.lander import PlaneView
 from flyloop.rendering.quadrotor import ROTOR_SPIN, euler_rpy, rotation_matrix
 
@@ -62,24 +62,28 @@ def test_basis_is_orthonormal_and_right_handed_at_any_pose():
 
 def test_perspective_shrinks_with_depth():
     cam = OrbitCamera(look_at=np.zeros(3), distance=4.0, azimuth_deg=0, elevation_deg=0)
-    near_r = cam.pixel_radius(0.1, 2.0, H)
-    far_r = cam.pixel_radius(0.1, 8.0, H)
-    assert near_r == pytest.approx(4 * far_r)
-    # A 1 m offset at depth 4 spans the projected distance that pixel_radius predicts.
+    pr = Projector(cam, (W, H))
+    assert pr.radius(0.1, 2.0) == pytest.approx(4 * pr.radius(0.1, 8.0))
+    # A 1 m offset at depth 4 spans the projected distance that radius predicts.
     (u0, _), _ = cam.project(np.zeros(3), W, H)
     (u1, _), _ = cam.project(np.array([1.0, 0, 0]), W, H)
-    assert u1 - u0 == pytest.approx(cam.pixel_radius(1.0, 4.0, H))
+    assert u1 - u0 == pytest.approx(pr.radius(1.0, 4.0))
 
 
 def test_points_behind_the_camera_are_not_visible_and_segments_are_clipped():
+    # Looking north from (0, -5, 0): camera right = +x, up = +z, depth = y + 5.
     cam = OrbitCamera(look_at=np.zeros(3), distance=5.0, azimuth_deg=0, elevation_deg=0)
-    behind = cam.position() - np.array([0.0, 1.0, 0.0])
+    pr = Projector(cam, (W, H))
+    behind = np.array([1.0, -6.0, 0.5])  # depth -1
     _, visible = cam.project(behind, W, H)
     assert not visible
-    assert cam.clip_segment(behind, behind - [0, 1, 0]) is None
-    a, b = cam.clip_segment(behind, np.zeros(3))
-    assert a[2] == pytest.approx(cam.near)
-    assert b[2] == pytest.approx(5.0)
+    assert pr.segment(behind, behind - [0, 1, 0]) is None
+    a, b = pr.segment(behind, np.zeros(3))
+    np.testing.assert_allclose(b, [W / 2, H / 2])
+    # Cut where the depth is `near`: 1.05 / 6 of the way from (1, 0.5) at depth -1 to (0, 0).
+    right, up = np.array([1.0, 0.5]) * (1 - 1.05 / 6)
+    focal = (H / 2) / math.tan(math.radians(cam.fov_deg) / 2)
+    np.testing.assert_allclose(a, [W / 2 + focal * right / cam.near, H / 2 - focal * up / cam.near])
 
 
 def test_near_plane_polygon_clipping():
@@ -150,8 +154,6 @@ def test_plane_fits_the_world_and_round_trips():
 
 
 def test_batched_segments_match_one_by_one_clipping():
-    from flyloop.rendering.camera import Projector
-
     cam = OrbitCamera(look_at=np.zeros(3), distance=3.0, azimuth_deg=20, elevation_deg=10)
     pr = Projector(cam, (W, H))
     rng = np.random.default_rng(7)

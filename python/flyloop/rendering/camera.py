@@ -43,10 +43,6 @@ class OrbitCamera:
         rows = self._view()[0]
         return rows[0].copy(), rows[1].copy(), rows[2].copy()
 
-    def position(self) -> np.ndarray:
-        """Where the camera sits in the world, metres."""
-        return self._view()[1].copy()
-
     def to_camera(self, points: np.ndarray) -> np.ndarray:
         """World points (..., 3) to camera coordinates (..., 3): right, up, depth."""
         rows, position = self._view()
@@ -65,39 +61,10 @@ class OrbitCamera:
             self._cache_key = key
         return self._cache
 
-    def focal_px(self, height: int) -> float:
-        """Pixels per unit of (lateral offset / depth)."""
-        return (height / 2.0) / math.tan(math.radians(self.fov_deg) / 2.0)
-
-    def project_camera(self, cam: np.ndarray, width: int, height: int) -> np.ndarray:
-        """Camera points (..., 3) with depth >= near to screen pixels (..., 2), float."""
-        cam = np.asarray(cam, dtype=float)
-        f = self.focal_px(height)
-        depth = np.maximum(cam[..., 2], self.near)
-        u = width / 2.0 + f * cam[..., 0] / depth
-        v = height / 2.0 - f * cam[..., 1] / depth
-        return np.stack([u, v], axis=-1)
-
     def project(self, points: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
         """World points (..., 3) to (pixels (..., 2), visible (...)): visible = in front of near."""
         cam = self.to_camera(points)
-        return self.project_camera(cam, width, height), cam[..., 2] >= self.near
-
-    def clip_segment(self, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-        """The part of world segment a-b in front of the near plane, in camera coordinates."""
-        ca, cb = self.to_camera(np.stack([a, b]))
-        da, db = ca[2] - self.near, cb[2] - self.near
-        if da < 0 and db < 0:
-            return None
-        if da < 0:
-            ca = ca + (cb - ca) * (da / (da - db))
-        elif db < 0:
-            cb = cb + (ca - cb) * (db / (db - da))
-        return ca, cb
-
-    def pixel_radius(self, radius_m: float, depth: float, height: int) -> float:
-        """On-screen radius in pixels of a sphere of radius_m at this depth."""
-        return self.focal_px(height) * radius_m / max(depth, self.near)
+        return Projector(self, (width, height)).pixels(cam), cam[..., 2] >= self.near
 
     def orbit(self, d_azimuth_deg: float, d_elevation_deg: float) -> None:
         """Turn around the look-at point; elevation stays short of straight up/down."""
@@ -148,33 +115,43 @@ class Projector:
     def __init__(self, camera: OrbitCamera, size: tuple[int, int]) -> None:
         self.camera = camera
         self.width, self.height = size
+        # Pixels per unit of (lateral offset / depth).
+        self.focal = (self.height / 2.0) / math.tan(math.radians(camera.fov_deg) / 2.0)
 
-    def _pixels(self, cam: np.ndarray) -> np.ndarray:
-        return self.camera.project_camera(cam, self.width, self.height)
+    def pixels(self, cam: np.ndarray) -> np.ndarray:
+        """Camera points (..., 3) to screen pixels (..., 2); depth is floored at near."""
+        depth = np.maximum(cam[..., 2], self.camera.near)
+        u = self.width / 2.0 + self.focal * cam[..., 0] / depth
+        v = self.height / 2.0 - self.focal * cam[..., 1] / depth
+        return np.stack([u, v], axis=-1)
 
     def point(self, p: np.ndarray) -> tuple[np.ndarray, float] | None:
         cam = self.camera.to_camera(p)
-        return None if cam[2] < self.camera.near else (self._pixels(cam), float(cam[2]))
+        return None if cam[2] < self.camera.near else (self.pixels(cam), float(cam[2]))
 
     def segment(self, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-        clipped = self.camera.clip_segment(np.asarray(a, float), np.asarray(b, float))
-        return None if clipped is None else tuple(self._pixels(np.stack(clipped)))
+        ca, cb = self.camera.to_camera(np.stack([np.asarray(a, float), np.asarray(b, float)]))
+        clipped = self._clip(ca[None], cb[None])
+        return clipped[0] if clipped else None
 
     def segments(self, a: np.ndarray, b: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
         """Many world segments a[i]-b[i] at once: the visible, near-clipped ones in pixels."""
+        return self._clip(self.camera.to_camera(np.asarray(a, float)), self.camera.to_camera(b))
+
+    def _clip(self, ca: np.ndarray, cb: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
         near = self.camera.near
-        ca, cb = self.camera.to_camera(np.asarray(a, float)), self.camera.to_camera(b)
         da, db = ca[:, 2:3] - near, cb[:, 2:3] - near
         keep = ((da >= 0) | (db >= 0))[:, 0]
         with np.errstate(divide="ignore", invalid="ignore"):
             t = np.where(da - db != 0, da / (da - db), 0.0)
         ca2 = np.where(da < 0, ca + (cb - ca) * t, ca)
         cb2 = np.where(db < 0, cb + (ca - cb) * (db / np.where(db - da != 0, db - da, 1)), cb)
-        return list(zip(self._pixels(ca2[keep]), self._pixels(cb2[keep]), strict=True))
+        return list(zip(self.pixels(ca2[keep]), self.pixels(cb2[keep]), strict=True))
 
     def polygon(self, points: np.ndarray) -> np.ndarray:
         cam = clip_polygon_near(self.camera.to_camera(points), self.camera.near)
-        return self._pixels(cam) if len(cam) >= 3 else np.zeros((0, 2))
+        return self.pixels(cam) if len(cam) >= 3 else np.zeros((0, 2))
 
     def radius(self, radius_m: float, depth: float) -> float:
-        return self.camera.pixel_radius(radius_m, depth, self.height)
+        """On-screen radius in pixels of a sphere of radius_m at this depth."""
+        return self.focal * radius_m / max(depth, self.camera.near)
