@@ -1,4 +1,4 @@
-"""Camera, frame-convention and 2D-plane math of flyloop.rendering (pure numpy, no pygame)."""
+"""Camera and frame-convention math of flyloop.rendering (pure numpy, no pygame)."""
 
 import math
 
@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 from flyloop.rendering.camera import OrbitCamera, Projector, clip_polygon_near
-from flyloop.rendering.lander import PlaneView
 from flyloop.rendering.quadrotor import ROTOR_SPIN, euler_rpy, rotation_matrix
 
 W, H = 800, 600
@@ -135,22 +134,6 @@ def test_quaternion_rotation_and_euler_round_trip():
         np.testing.assert_allclose(euler_rpy(q), angles, atol=1e-9)
         m = rotation_matrix(q)
         np.testing.assert_allclose(m @ m.T, np.eye(3), atol=1e-12)
-
-
-def test_plane_fits_the_world_and_round_trips():
-    plane = PlaneView.fit_world(50.0, 50.0, (800, 800), margin_px=12)
-    assert plane.scale == pytest.approx(776 / 50)
-    np.testing.assert_allclose(plane.to_screen((0.0, 0.0)), [12, 788])
-    np.testing.assert_allclose(plane.to_screen((50.0, 50.0)), [788, 12])
-    wide = PlaneView.fit_world(100.0, 20.0, (800, 400), margin_px=0)
-    np.testing.assert_allclose(wide.to_screen((50.0, 10.0)), [400, 200])
-    pts = np.array([[3.0, 4.0], [25.0, 40.0]])
-    np.testing.assert_allclose(plane.to_world(plane.to_screen(pts)), pts)
-    zoom = PlaneView.centred_on(np.array([25.0, 40.0]), 48.0, (250, 180))
-    np.testing.assert_allclose(zoom.to_screen((25.0, 40.0)), [125, 90])
-    np.testing.assert_allclose(zoom.to_screen((26.0, 41.0)) - [125, 90], [48, -48])
-    with pytest.raises(ValueError, match="cannot fit"):
-        PlaneView.fit_world(50.0, 50.0, (20, 20), margin_px=12)
 
 
 def test_batched_segments_match_one_by_one_clipping():

@@ -141,40 +141,24 @@ def lander_scene(
     )
 
 
+@dataclass
 class PlaneView:
-    """A uniform scale (px per metre) and the pixel (u0, v0) where world (0, 0) lands."""
+    """Metres to pixels: a uniform scale (px per metre) and the pixel (u0, v0) of (0, 0)."""
 
-    def __init__(self, scale: float, u0: float, v0: float) -> None:
-        self.scale, self.u0, self.v0 = float(scale), float(u0), float(v0)
-
-    @classmethod
-    def fit_world(cls, world_width: float, world_height: float, size, margin_px=12) -> PlaneView:
-        """The world box (0, 0)-(W, H), centred, filling the frame less margin_px per side."""
-        width, height = size
-        usable_w, usable_h = width - 2 * margin_px, height - 2 * margin_px
-        if usable_w <= 0 or usable_h <= 0 or world_width <= 0 or world_height <= 0:
-            raise ValueError(
-                f"cannot fit a {world_width} x {world_height} m world in {width} x {height} px"
-            )
-        scale = min(usable_w / world_width, usable_h / world_height)
-        return cls(
-            scale, (width - world_width * scale) / 2.0, (height + world_height * scale) / 2.0
-        )
-
-    @classmethod
-    def centred_on(cls, center: np.ndarray, scale: float, size: tuple[int, int]) -> PlaneView:
-        """World point `center` at the middle of a frame of `size` pixels."""
-        return cls(scale, size[0] / 2.0 - center[0] * scale, size[1] / 2.0 + center[1] * scale)
+    scale: float
+    u0: float
+    v0: float
 
     def to_screen(self, points: np.ndarray) -> np.ndarray:
         p = np.asarray(points, dtype=float)
         return np.stack([self.u0 + p[..., 0] * self.scale, self.v0 - p[..., 1] * self.scale], -1)
 
-    def to_world(self, pixels: np.ndarray) -> np.ndarray:
-        q = np.asarray(pixels, dtype=float)
-        return np.stack(
-            [(q[..., 0] - self.u0) / self.scale, (self.v0 - q[..., 1]) / self.scale], -1
-        )
+
+def fit_world(s: LanderScene, size: tuple[int, int], margin_px: int = 12) -> PlaneView:
+    """The world box (0, 0)-(W, H), centred, filling the frame less margin_px per side."""
+    (width, height), w, h = size, s.world_width, s.world_height
+    scale = min((width - 2 * margin_px) / w, (height - 2 * margin_px) / h)
+    return PlaneView(scale, (width - w * scale) / 2.0, (height + h * scale) / 2.0)
 
 
 def rotate2d(points: np.ndarray, angle: float) -> np.ndarray:
@@ -348,7 +332,8 @@ def close_up(
     width, height = p.surface.get_size()
     # The drone sits a little low so its thrust bars fit above it.
     center = np.array(s.position) + np.array([0.0, 0.12 * height / CLOSE_UP_SCALE])
-    plane = PlaneView.centred_on(center, CLOSE_UP_SCALE, (width, height))
+    u0, v0 = width / 2.0 - center[0] * CLOSE_UP_SCALE, height / 2.0 + center[1] * CLOSE_UP_SCALE
+    plane = PlaneView(CLOSE_UP_SCALE, u0, v0)
     world(p, plane, s, shade_poses, path_points, spawn=False, close_up=True)
     p.pg.draw.rect(p.surface, (40, 40, 50), (0, 0, width, height), 2)
     p.text(f"close-up ×{zoom:.0f}", (8, 6), TEXT, 18, bold=True)
@@ -387,11 +372,6 @@ class LanderView(View):
         if show_close_up and width >= 3 * cw and height >= 3 * ch:  # else it has no room
             self._close_up = Painter(self._pg, self._surface.subsurface((20, 20, cw, ch)))
 
-    def world_to_screen(self, scene: LanderScene, points: np.ndarray) -> np.ndarray:
-        """Pixels (u, v) where world points (..., 2) in metres are drawn for this scene."""
-        plane = PlaneView.fit_world(scene.world_width, scene.world_height, self.size)
-        return plane.to_screen(points)
-
     def reset(self) -> None:
         """Forget the flight path and shades (an env calls this from reset())."""
         self._path.clear()
@@ -405,7 +385,7 @@ class LanderView(View):
             self._shades.poses.clear()
         self._shades.update(scene.position, scene.angle)
         s, p = scene, self._painter
-        plane = PlaneView.fit_world(s.world_width, s.world_height, self.size)
+        plane = fit_world(s, self.size)
         shade_poses = self._shades.poses if self.show_shades else ()
         path_points = self._path.points if self.show_path else np.zeros((0, 2))
         world(p, plane, s, shade_poses, path_points, self.show_spawn_zone, close_up=False)
