@@ -10,7 +10,7 @@ import pytest
 
 import flyloop
 from flyloop.rendering import LanderScene, QuadScene, lander_scene, quad_scene
-from flyloop.rendering.canvas import FlightPath, Shades
+from flyloop.rendering.canvas import FlightPath
 
 
 def quad(**over):
@@ -71,17 +71,6 @@ def test_flight_path_restarts_with_each_episode_and_records_a_step_once():
     assert path.points.tolist() == [[7.0, 7.0]]
     path.clear()
     assert len(path.points) == 0
-
-
-def test_shades_drop_every_spacing():
-    shades = Shades(spacing_m=2.0)
-    for x in np.arange(0.0, 10.01, 0.5):
-        shades.update((x, 20.0), 0.1)
-    # First pose, then each time the drone is more than 2 m past the last shade.
-    assert [x for x, _, _ in shades.poses] == [0.0, 2.5, 5.0, 7.5, 10.0]
-    assert all(angle == 0.1 for _, _, angle in shades.poses)
-    with pytest.raises(ValueError, match="shade spacing"):
-        Shades(0.0)
 
 
 def test_quad_scene_from_a_waypoints_step():

@@ -1,10 +1,8 @@
-"""What both views draw with: View (the frame: an off-screen surface for "rgb_array" or the
-window for "human"), Painter (2D primitives over a surface) and the per-episode history
-(flight path, shades).
+"""What both views draw with: View (an off-screen surface for "rgb_array" or the window for
+"human"), Painter (2D primitives in float pixels) and FlightPath (the episode's positions).
 
-pygame is imported by `import_pygame`, on a view's first use, so `import flyloop.rendering`
-stays free of it. Coordinates are float pixels, clamped to a range pygame accepts (a
-blown-up state would give huge integers).
+pygame is imported by a view's constructor, so `import flyloop.rendering` stays free of it.
+Pixels are clamped to a range pygame accepts: a blown-up state would give huge integers.
 """
 
 from __future__ import annotations
@@ -53,7 +51,6 @@ class Painter:
         self.pg = pg
         self.surface = surface
         self._fonts: dict[tuple[int, bool], Any] = {}
-        self._gradient: tuple[tuple, Any] | None = None
 
     def font(self, size: int, bold: bool = False) -> Any:
         """A font whose capitals are about size * 0.45 px tall (pygame's default font scale)."""
@@ -71,19 +68,14 @@ class Painter:
             self._fonts[size, bold] = font
         return self._fonts[size, bold]
 
-    def vertical_gradient(self, top: Color, bottom: Color) -> None:
-        """Fill with a top-to-bottom gradient (drawn once per size and colours, then blitted)."""
-        size = self.surface.get_size()
-        key = (size, top, bottom)
-        if self._gradient is None or self._gradient[0] != key:
-            layer = self.pg.Surface(size)
-            width, height = size
-            for y in range(0, height, 4):
-                t = y / max(1, height - 1)
-                color = tuple(round(a + (b - a) * t) for a, b in zip(top, bottom, strict=True))
-                self.pg.draw.rect(layer, color, (0, y, width, 4))
-            self._gradient = (key, layer)
-        self.surface.blit(self._gradient[1], (0, 0))
+    def gradient(self, box: tuple[int, int, int, int], v_top, v_bottom, top, bottom) -> None:
+        """Fill box (left, top, right, bottom) in 4 px bands, shading from colour `top` at
+        row v_top to `bottom` at row v_bottom."""
+        left, y0, right, y1 = box
+        for v in range(y0, y1, 4):
+            t = (v - v_top) / max(1.0, v_bottom - v_top)
+            color = tuple(round(a + (b - a) * t) for a, b in zip(top, bottom, strict=True))
+            self.pg.draw.rect(self.surface, color, (left, v, right - left, min(4, y1 - v)))
 
     def line(self, a: Point, b: Point, color: Color, width: int = 1) -> None:
         if width <= 1:
@@ -119,10 +111,7 @@ class Painter:
         ends = a_ + np.outer(np.arange(2 * first, 2 * last) / (2 * n), b_ - a_)
         ends = np.clip(ends, -_LIMIT, _LIMIT).round().astype(int).tolist()
         for i in range(0, len(ends), 2):
-            if width <= 1:
-                self.pg.draw.aaline(self.surface, color, ends[i], ends[i + 1])
-            else:
-                self.pg.draw.line(self.surface, color, ends[i], ends[i + 1], width)
+            self.line(ends[i], ends[i + 1], color, width)
 
     def arrow(self, start: Point, end: Point, color: Color, width: int, head_px=11.0) -> None:
         s, e = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
@@ -221,45 +210,15 @@ class FlightPath:
         return np.array(self._points) if self._points else np.zeros((0, 0))
 
 
-class Shades:
-    """Poses where the drone left a shade: the first pose of the episode, then every time it
-    is more than `spacing_m` away from the last shade (the reference's shade_distance_m,
-    docs/reference/lander2d.md)."""
-
-    def __init__(self, spacing_m: float = 2.0, max_shades: int = 500) -> None:
-        if not spacing_m > 0:
-            raise ValueError(f"shade spacing must be > 0 m, got {spacing_m}")
-        self.spacing_m = float(spacing_m)
-        self.poses: deque[tuple[float, float, float]] = deque(maxlen=max_shades)
-
-    def update(self, position: np.ndarray, angle: float) -> None:
-        x, y = float(position[0]), float(position[1])
-        if self.poses:
-            lx, ly, _ = self.poses[-1]
-            if np.hypot(x - lx, y - ly) <= self.spacing_m:
-                return
-        self.poses.append((x, y, float(angle)))
-
-
 class View:
-    """What both views share: the frame (shown in a window in human mode) and its Painter,
-    the scene type they draw, closing. pygame is imported by the constructor, not before."""
-
-    SCENE: type
+    """What both views share: the frame (shown in a window in human mode), its Painter and
+    closing."""
 
     def __init__(self, render_mode: str, size: tuple[int, int], caption: str, fps: float) -> None:
         global _window_owner
         if render_mode not in RENDER_MODES:
-            raise ValueError(
-                f"render_mode must be one of {RENDER_MODES}, got {render_mode!r} "
-                "(with render_mode None an env needs no view at all)"
-            )
-        width, height = int(size[0]), int(size[1])
-        if width < 64 or height < 64:
-            raise ValueError(f"the frame must be at least 64 x 64 pixels, got {width} x {height}")
-        if fps < 0:
-            raise ValueError(f"fps must be >= 0 (0 = as fast as possible), got {fps}")
-        self.render_mode, self.size, self.fps = render_mode, (width, height), float(fps)
+            raise ValueError(f"render_mode must be one of {RENDER_MODES}, got {render_mode!r}")
+        self.render_mode, self.size, self.fps = render_mode, (int(size[0]), int(size[1])), fps
         self._pg = pg = import_pygame(render_mode)
         pg.font.init()
         if render_mode == "human":
@@ -285,16 +244,12 @@ class View:
         # is_open turns False also when the user closes the window; _closed only by close().
         self.is_open, self._closed = True, False
 
-    def _events(self, scene: Any) -> list[Any] | None:
+    def _events(self) -> list[Any] | None:
         """This frame's window events; None when the user closed the window (on QUIT or
         Escape)."""
-        name = type(self).__name__
         if self._closed:
+            name = type(self).__name__
             raise RuntimeError(f"this {name} is closed; create a new one to render again")
-        if not isinstance(scene, self.SCENE):
-            raise TypeError(
-                f"{name}.render needs a {self.SCENE.__name__}, got {type(scene).__name__}"
-            )
         if self.render_mode != "human" or not self.is_open:
             return [] if self.is_open else None
         pg = self._pg

@@ -6,6 +6,7 @@ World metres, x right, y up, angles counter-clockwise.
 from __future__ import annotations
 
 import math
+from collections import deque
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -14,7 +15,7 @@ import numpy as np
 
 from .. import _native
 from ..tasks import LANDING, observation_slices
-from .canvas import FlightPath, Painter, Shades, View, vector
+from .canvas import FlightPath, Painter, View, vector
 
 SKY_TOP, SKY_BOTTOM, OUTSIDE = (196, 220, 246), (226, 238, 250), (120, 130, 145)
 GROUND, GROUND_EDGE, BOUNDS, SPAWN = (96, 148, 82), (62, 112, 58), (200, 70, 70), (178, 160, 80)
@@ -265,12 +266,13 @@ def world(p: Painter, plane: PlaneView, s: LanderScene, poses, path, spawn, clos
     width, height = p.surface.get_size()
     corners = np.array([[0.0, s.world_height], [s.world_width, 0.0]])
     (u0, v_top), (u1, v_bottom) = plane.to_screen(corners)
-    left, right = max(0, round(u0)), min(width, round(u1))
-    top, bottom = max(0, round(v_top)), min(height, round(v_bottom))
-    for v in range(top, bottom, 4):
-        t = (v - v_top) / max(1.0, v_bottom - v_top)
-        color = tuple(round(a + (b - a) * t) for a, b in zip(SKY_TOP, SKY_BOTTOM, strict=True))
-        p.pg.draw.rect(p.surface, color, (left, v, right - left, min(4, bottom - v)))
+    box = (
+        max(0, round(u0)),
+        max(0, round(v_top)),
+        min(width, round(u1)),
+        min(height, round(v_bottom)),
+    )
+    p.gradient(box, v_top, v_bottom, SKY_TOP, SKY_BOTTOM)
     r = s.spawn_half_range
     if spawn and r > 0:
         lo = plane.to_screen((s.spawn_center[0] - r, s.spawn_center[1] + r))
@@ -346,8 +348,6 @@ class LanderView(View):
     both restart when a scene's step goes backwards (a new episode) or on `reset()`.
     """
 
-    SCENE = LanderScene
-
     def __init__(
         self,
         render_mode: str,
@@ -364,8 +364,9 @@ class LanderView(View):
     ) -> None:
         self.show_path, self.show_shades = show_path, show_shades
         self.show_spawn_zone, self.show_overlay = show_spawn_zone, show_overlay
+        self.shade_distance_m = shade_distance_m
         self._path = FlightPath()
-        self._shades = Shades(shade_distance_m)
+        self._shades: deque[tuple[float, float, float]] = deque(maxlen=500)  # x, y, angle
         super().__init__(render_mode, (width, height), "flyloop - Lander2D", fps)
         self._close_up: Painter | None = None
         cw, ch = CLOSE_UP_SIZE
@@ -375,18 +376,23 @@ class LanderView(View):
     def reset(self) -> None:
         """Forget the flight path and shades (an env calls this from reset())."""
         self._path.clear()
-        self._shades.poses.clear()
+        self._shades.clear()
 
     def render(self, scene: LanderScene) -> np.ndarray | None:
         """Draw one frame: returns it in rgb_array mode, None in human mode."""
-        if self._events(scene) is None:
+        if self._events() is None:
             return None  # the user closed the window: nothing to draw on any more
         if self._path.update(scene.step, scene.position):
-            self._shades.poses.clear()
-        self._shades.update(scene.position, scene.angle)
+            self._shades.clear()
+        # A shade at the first pose, then each time the drone is shade_distance_m past the
+        # last one (the reference's shade_distance_m, docs/reference/lander2d.md).
+        x, y = float(scene.position[0]), float(scene.position[1])
+        last = self._shades[-1] if self._shades else None
+        if last is None or np.hypot(x - last[0], y - last[1]) > self.shade_distance_m:
+            self._shades.append((x, y, float(scene.angle)))
         s, p = scene, self._painter
         plane = fit_world(s, self.size)
-        shade_poses = self._shades.poses if self.show_shades else ()
+        shade_poses = self._shades if self.show_shades else ()
         path_points = self._path.points if self.show_path else np.zeros((0, 2))
         world(p, plane, s, shade_poses, path_points, self.show_spawn_zone, close_up=False)
         zoom = CLOSE_UP_SCALE / plane.scale

@@ -424,8 +424,6 @@ class QuadrotorView(View):
     positions of the episode and restarts when the step number goes backwards or on reset().
     """
 
-    SCENE = QuadScene
-
     def __init__(
         self,
         render_mode: str,
@@ -438,8 +436,6 @@ class QuadrotorView(View):
         trail_steps: int = 400,
         hud: bool = True,
     ) -> None:
-        if not drone_scale > 0:
-            raise ValueError(f"drone_scale must be > 0, got {drone_scale}")
         self.drone_scale, self.hud, self.camera = float(drone_scale), hud, camera
         self._trail = FlightPath(max(2, trail_steps))
         super().__init__(render_mode, (width, height), "flyloop - Quadrotor 3D", fps)
@@ -489,7 +485,7 @@ class QuadrotorView(View):
 
     def render(self, scene: QuadScene) -> np.ndarray | None:
         """Draw one frame: returns it in rgb_array mode, None in human mode."""
-        events = self._events(scene)
+        events = self._events()
         if self.camera is None:
             # Looking at the middle of the target box from the south-west, the box in view.
             h = scene.bounds_half_size
@@ -499,7 +495,8 @@ class QuadrotorView(View):
         self._steer(self.camera, events)
         self._trail.update(scene.step, scene.position)
         p = self._painter
-        p.vertical_gradient(BACKGROUND_TOP, BACKGROUND_BOTTOM)
+        width, height = self.size
+        p.gradient((0, 0, width, height), 0, height - 1, BACKGROUND_TOP, BACKGROUND_BOTTOM)
         trail = self._trail.points
         world(p, Projector(self.camera, self.size), scene, trail, self.drone_scale)
         if self.hud:
@@ -509,6 +506,5 @@ class QuadrotorView(View):
             wind_dial(p, scene, self.camera)
             legend(p)
             if self.render_mode == "human":  # bottom centre: how to move the camera
-                width, height = self.size
                 p.text(HINT, (width / 2, height - 8), (90, 90, 100), 17, "midbottom")
         return self._present()
