@@ -11,8 +11,8 @@ this package does not import pygame: each view's constructor does.
 """
 
 from .camera import OrbitCamera
-from .lander import LanderScene, LanderView, lander_scene
-from .quadrotor import QuadrotorView, QuadScene, quad_scene
+from .lander import LanderScene, LanderView
+from .quadrotor import QuadrotorView, QuadScene
 from .recording import Recording, record_episode, save_video
 
 __all__ = [
@@ -22,8 +22,6 @@ __all__ = [
     "QuadScene",
     "QuadrotorView",
     "Recording",
-    "lander_scene",
-    "quad_scene",
     "record_episode",
     "save_video",
 ]

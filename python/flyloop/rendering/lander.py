@@ -7,14 +7,11 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
-from .. import _native
-from ..tasks import LANDING, observation_slices
+from ..tasks import LANDING
 from .canvas import FlightPath, Painter, View, vector
 
 SKY_TOP, SKY_BOTTOM, OUTSIDE = (196, 220, 246), (226, 238, 250), (120, 130, 145)
@@ -29,20 +26,6 @@ CLOSE_UP_SIZE = (250, 180)
 CLOSE_UP_SCALE = 48.0  # px per metre: a 1 m drone is 48 px wide
 # What the scene shows when not told: the Landing task's defaults, read from the core.
 _CORE = LANDING.defaults
-# Where a moving platform's vx / platform_speed sits in the observation (the core's layout).
-_MOVING = _native.describe("landing", {"moving_platform": 1.0})
-_PLATFORM_VX = observation_slices(_MOVING)["platform_velocity"].start
-_OUTCOMES = (
-    ("lost_control", "lost control"),
-    ("out_of_bounds", "out of bounds"),
-    ("battery_empty", "battery empty"),
-    ("time_limit", "time limit reached"),
-)
-# The model's sizes a scene takes from the env's parameters (else the core's defaults).
-_WORLD = (
-    "world_width world_height ground_height platform_width platform_height drone_width "
-    "drone_height max_thrust initial_battery"
-).split()
 
 
 @dataclass(eq=False)
@@ -97,49 +80,6 @@ class LanderScene:
         """Distance from the drone centre to the platform's top centre, m."""
         tx, ty = self.platform_top
         return math.hypot(tx - self.position[0], ty - self.position[1])
-
-
-def lander_scene(
-    info: Mapping[str, Any],
-    observation: Any = None,
-    *,
-    dt: float | None = None,
-    reward: float | None = None,
-    episode_return: float | None = None,
-    max_steps: int | None = None,
-    params: Mapping[str, Any] | None = None,
-) -> LanderScene:
-    """A LanderScene from a Landing info dict and its observation (a moving platform's
-    vx / platform_speed). `params`: the env's core parameters by name (missing
-    ones: the core's defaults)."""
-    p = {**_CORE, **(params or {})}
-    step = int(info["step"])
-    obs = () if observation is None else np.asarray(observation, dtype=float).reshape(-1)
-    return LanderScene(
-        time_s=step * (p["dt"] if dt is None else dt),
-        step=step,
-        position=info["position"],
-        velocity=info["velocity"],
-        angle=float(info["angle"]),
-        angular_velocity=float(info["angular_velocity"]),
-        thrust=info["thrust"],
-        battery=float(info["battery"]),
-        platform_x=float(info["platform_position"][0]),
-        platform_vx=float(obs[_PLATFORM_VX]) * float(p["platform_speed"])
-        if len(obs) > _PLATFORM_VX
-        else 0.0,
-        wind_force=info.get("wind_force", (0.0, 0.0)),
-        wind_speed=float(p["wind_speed"]) if p["wind_enabled"] else 0.0,
-        landed=bool(info.get("landed", False)),
-        crashed=bool(info.get("crashed", False)),
-        outcome=next((text for key, text in _OUTCOMES if info.get(key)), ""),
-        max_steps=max_steps,
-        reward=reward,
-        episode_return=episode_return,
-        spawn_center=(float(p["spawn_x"]), float(p["spawn_y"])),
-        spawn_half_range=float(p["initial_pos_random_range_m"]),
-        **{name: float(p[name]) for name in _WORLD},
-    )
 
 
 @dataclass

@@ -13,14 +13,12 @@ pygame.key.get_pressed) so the same events drive the camera in a test as from a 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from .. import _native
-from ..tasks import observation_slices, parameter_values
+from ..tasks import HOVER
 from .camera import OrbitCamera, Projector
 from .canvas import FlightPath, Painter, View, vector
 
@@ -43,9 +41,8 @@ VELOCITY_SECONDS = 0.5  # the velocity arrow shows where the drone is in this ma
 WIND_M_PER_MPS = 0.12  # wind arrow length per m/s of wind
 DEGREES_PER_PIXEL, ZOOM_STEP, MIN_DISTANCE, MAX_DISTANCE = 0.3, 0.9, 0.5, 200.0
 MOVE_FRACTION = 0.012  # per frame, of the camera distance
-# What a scene shows when not told: the hover task with the core's defaults.
-_HOVER = _native.describe("hover")
-_CORE = parameter_values(_HOVER)
+# What a scene shows when not told: the Hover task's defaults, read from the core.
+_CORE = HOVER.defaults
 
 
 def rotation_matrix(q_wxyz: np.ndarray) -> np.ndarray:
@@ -98,45 +95,6 @@ class QuadScene:
         self.time_s, self.step = float(self.time_s), int(self.step)
         if self.waypoints_reached is not None:
             self.waypoints_reached = int(self.waypoints_reached)
-
-
-def quad_scene(
-    observation: Any,
-    info: Mapping[str, Any],
-    *,
-    reward: float | None = None,
-    episode_return: float | None = None,
-    core: Mapping[str, Any] = _HOVER,
-) -> QuadScene:
-    """A QuadScene from a Hover/Waypoints observation and its info (the task frame's names);
-    `core`: the env's `describe` result (observation layout, parameters). An observation
-    without attitude or motors (the rates interface) is drawn level with motors at 0."""
-    obs = np.asarray(observation, dtype=float).reshape(-1)
-    at, values = observation_slices(core), parameter_values(core)
-
-    def part(name: str, otherwise: Any) -> Any:
-        return obs[at[name]] if name in at else otherwise
-
-    status = (
-        "crashed" if info.get("crashed") else "out of bounds" if info.get("out_of_bounds") else ""
-    )
-    return QuadScene(
-        time_s=info["episode_time"],
-        step=info["step_count"],
-        position=info["position"],
-        velocity=obs[at["velocity"]],
-        quaternion=part("quaternion", (1.0, 0.0, 0.0, 0.0)),
-        wind=part("wind", np.zeros(3)),
-        motors=part("motor_states", np.zeros(4)),
-        target=info.get("target_position"),
-        next_waypoint=info.get("next_waypoint_pos"),
-        reward=reward,
-        episode_return=episode_return,
-        bounds_half_size=float(values["space_side_length"]) / 2.0,
-        arm_length=float(values["arm_length"]),
-        waypoints_reached=info.get("waypoints_reached"),
-        status=status,
-    )
 
 
 def rotor_color(index: int) -> tuple[int, int, int]:
