@@ -1,10 +1,7 @@
-"""The quadrotor view's 3D camera, pure numpy: a perspective orbit camera and a Projector
-(the camera bound to a frame size, near-plane clipped).
-
-``azimuth_deg`` is the compass direction the camera looks toward (0 = north/+y, 90 = east/+x);
-``elevation_deg`` is how far it looks down from the horizon. Camera space: x right, y up,
-z (depth) forward. Screen: pixels, origin top-left, v downward; ``fov_deg`` is the vertical
-field of view.
+"""The quadrotor view's 3D camera, pure numpy: an orbit camera and a Projector (the camera
+bound to a frame size, near-plane clipped). ``azimuth_deg``: the compass direction looked
+toward (0 = north/+y, 90 = east/+x); ``elevation_deg``: down from the horizon; ``fov_deg``:
+vertical. Camera space: x right, y up, z depth; pixels from the top-left, v down.
 """
 
 from __future__ import annotations

@@ -27,19 +27,6 @@ _font_files: dict[bool, str | None] = {}
 _window_owner: View | None = None
 
 
-def import_pygame(render_mode: str) -> Any:
-    """pygame, with SDL told to draw off-screen when there is no display for rgb_array."""
-    has_display = sys.platform in ("win32", "darwin") or bool(
-        os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
-    )
-    if render_mode == "rgb_array" and not has_display:
-        os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
-    os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
-    import pygame
-
-    return pygame
-
-
 def _px(point: Point) -> tuple[int, int]:
     x = min(max(float(point[0]), -_LIMIT), _LIMIT)
     y = min(max(float(point[1]), -_LIMIT), _LIMIT)
@@ -179,9 +166,8 @@ def vector(value: Any) -> np.ndarray:
 
 
 class FlightPath:
-    """Positions of the current episode, one per step, the oldest dropped past max_points.
-    A view is only handed the current step, so a step number lower than the last one seen
-    means a new episode began; rendering the same step twice records it once."""
+    """The episode's positions, one per step (the oldest dropped past max_points). A view
+    sees only the current step: a lower step number than the last means a new episode."""
 
     def __init__(self, max_points: int = 5000) -> None:
         self._points: deque[np.ndarray] = deque(maxlen=max_points)
@@ -219,7 +205,15 @@ class View:
         if render_mode not in RENDER_MODES:
             raise ValueError(f"render_mode must be one of {RENDER_MODES}, got {render_mode!r}")
         self.render_mode, self.size, self.fps = render_mode, (int(size[0]), int(size[1])), fps
-        self._pg = pg = import_pygame(render_mode)
+        has_display = sys.platform in ("win32", "darwin") or bool(
+            os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+        )
+        if render_mode == "rgb_array" and not has_display:  # SDL draws off-screen
+            os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+        os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
+        import pygame as pg
+
+        self._pg = pg
         pg.font.init()
         if render_mode == "human":
             if _window_owner is not None:
@@ -245,8 +239,7 @@ class View:
         self.is_open, self._closed = True, False
 
     def _events(self) -> list[Any] | None:
-        """This frame's window events; None when the user closed the window (on QUIT or
-        Escape)."""
+        """This frame's window events; None once the user closed the window (QUIT, Escape)."""
         if self._closed:
             name = type(self).__name__
             raise RuntimeError(f"this {name} is closed; create a new one to render again")

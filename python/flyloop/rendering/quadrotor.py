@@ -1,13 +1,9 @@
-"""The quadrotor view (tasks Hover and Waypoints): its scene, the 3D world drawn through an
-orbit camera, the overlays (info panel, motor bars, axis gizmo, wind dial, legend) and
-QuadrotorView with its window controls.
-
-Frames as the core: world ENU (x east, y north, z up), body FLU (x forward, y left, z up),
-quaternion [w, x, y, z] rotating body to world; motors in PX4's quad-X order (0 front-right,
-1 rear-left, 2 front-left, 3 rear-right). The world is drawn with a painter's algorithm: the
-ground and lines first, then solid things far to near, the drone's hub last (its pixels are
-what tests track). The window's held keys are tracked from KEYDOWN/KEYUP events (not
-pygame.key.get_pressed) so the same events drive the camera in a test as from a person.
+"""The quadrotor view (tasks Hover and Waypoints): its scene, the 3D world through an orbit
+camera, the overlays and QuadrotorView with its window controls. Frames as the core: world
+ENU, body FLU, quaternion [w, x, y, z] body to world, motors in PX4's quad-X order. Painter's
+algorithm: ground and lines first, then solids far to near, the drone's hub last (tests
+track its pixels). Held keys come from KEYDOWN/KEYUP events, not pygame.key.get_pressed, so
+posted events drive the camera in a test as a person's do.
 """
 
 from __future__ import annotations
@@ -35,6 +31,7 @@ WAYPOINT, UP, VELOCITY, WIND = (150, 60, 200), (255, 150, 0), (230, 0, 220), (20
 DROP, SHADOW, TRAIL = (128, 128, 128), (40, 40, 40), (60, 140, 220)
 TEXT, PANEL, BAD, BACKGROUND_TOP = (20, 20, 30), (255, 255, 236), (200, 0, 0), (232, 238, 248)
 BACKGROUND_BOTTOM = (246, 246, 250)
+ROTOR_COLORS = tuple(ROTOR_CCW if spin < 0 else ROTOR_CW for spin in ROTOR_SPIN)
 AXES = ((AXIS_X, "x E"), (AXIS_Y, "y N"), (AXIS_Z, "z"))
 TARGET_RADIUS_M, WAYPOINT_RADIUS_M, UP_ARROW_M, MAX_ARROW_M = 0.08, 0.06, 0.5, 2.0
 VELOCITY_SECONDS = 0.5  # the velocity arrow shows where the drone is in this many seconds
@@ -97,10 +94,6 @@ class QuadScene:
             self.waypoints_reached = int(self.waypoints_reached)
 
 
-def rotor_color(index: int) -> tuple[int, int, int]:
-    return ROTOR_CCW if ROTOR_SPIN[index] < 0 else ROTOR_CW
-
-
 def _line(p: Painter, pr: Projector, a, b, color, width: int = 1) -> None:
     seg = pr.segment(a, b)
     if seg is not None:
@@ -161,10 +154,8 @@ def next_waypoint(p: Painter, pr: Projector, scene: QuadScene) -> None:
 
 
 def drone(p: Painter, pr: Projector, scene: QuadScene, scale: float) -> None:
-    """Arms, rotor discs (coloured by spin, in the body plane), nose, vectors, hub on top.
-
-    Drawn `scale` times the real size so a 0.1 m arm stays visible in a metres-wide box.
-    """
+    """Arms, rotor discs (coloured by spin, in the body plane), nose, vectors, hub on top;
+    `scale` times the real size, so a 0.1 m arm stays visible in a metres-wide box."""
     rot = rotation_matrix(scene.quaternion)
     pos = scene.position
     arm = scene.arm_length * scale
@@ -177,12 +168,12 @@ def drone(p: Painter, pr: Projector, scene: QuadScene, scale: float) -> None:
         _line(p, pr, pos, rotors[i], ARM, 4)
         poly = pr.polygon(_circle_points(rotors[i], rotor_radius, disc_axes))
         if len(poly):
-            color = rotor_color(int(i))
+            color = ROTOR_COLORS[i]
             p.translucent_polygon(poly, color, 150)
             p.polyline(np.vstack([poly, poly[:1]]), tuple(int(c * 0.6) for c in color), 2)
         level = pr.polygon(_circle_points(rotors[i], rotor_radius * scene.motors[i], disc_axes))
         if len(level) and scene.motors[i] > 0.02:
-            p.translucent_polygon(level, rotor_color(int(i)), 170)
+            p.translucent_polygon(level, ROTOR_COLORS[i], 170)
     _arrow(p, pr, pos, rot[:, 2] * UP_ARROW_M, UP, 3)
     for vec, m_per_unit, color, width in (
         (scene.velocity, VELOCITY_SECONDS, VELOCITY, 3),
@@ -293,7 +284,7 @@ def motor_bars(p: Painter, scene: QuadScene) -> None:
         p.pg.draw.rect(p.surface, color, (x, y0 + bar_h - fill, bar_w, fill))
         p.pg.draw.rect(p.surface, (0, 0, 0), (x, y0, bar_w, bar_h), 1)
         p.text(f"{round(float(level) * 100)}%", (x + bar_w / 2, y0 - 6), TEXT, 17, "midbottom")
-        p.disc((x + bar_w / 2, y0 - 26), 5, rotor_color(i))
+        p.disc((x + bar_w / 2, y0 - 26), 5, ROTOR_COLORS[i])
         spin = "CCW" if ROTOR_SPIN[i] < 0 else "CW"
         p.text(f"M{i} {ROTOR_NAMES[i]}", (x + bar_w / 2, y0 + bar_h + 4), TEXT, 17, "midtop")
         p.text(spin, (x + bar_w / 2, y0 + bar_h + 20), TEXT, 15, "midtop")
@@ -375,11 +366,9 @@ HINT = "drag: rotate   wheel: zoom   W/A/S/D: move   Q/E: down/up   R: reset   E
 class QuadrotorView(View):
     """Draws QuadScene frames: a window ("human") or (H, W, 3) uint8 arrays ("rgb_array").
 
-    In a window: drag with the left mouse button to orbit, wheel to zoom, W/A/S/D to move
-    along the ground, Q/E down/up, R to reset the camera, Esc or the close box to close.
-    The vehicle is drawn `drone_scale` times its real size (a 0.1 m arm would be a few
-    pixels); its centre is at its true position. The trail keeps the last `trail_steps`
-    positions of the episode and restarts when the step number goes backwards or on reset().
+    In a window: drag to orbit, wheel to zoom, W/A/S/D to move, Q/E down/up, R to reset the
+    camera, Esc to close. The vehicle is drawn `drone_scale` times its size at its true
+    position; the trail keeps the episode's last `trail_steps` positions.
     """
 
     def __init__(
