@@ -56,9 +56,15 @@ class Painter:
         return self._fonts[size, bold]
 
     def gradient(self, box: tuple[int, int, int, int], v_top, v_bottom, top, bottom) -> None:
-        """Fill box (left, top, right, bottom) in 4 px bands, shading from colour `top` at
-        row v_top to `bottom` at row v_bottom."""
-        left, y0, right, y1 = box
+        """Fill box (left, top, right, bottom; clipped to the frame) in 4 px bands, shading
+        from colour `top` at row v_top to `bottom` at row v_bottom."""
+        width, height = self.surface.get_size()
+        left, y0, right, y1 = (
+            max(0, box[0]),
+            max(0, box[1]),
+            min(width, box[2]),
+            min(height, box[3]),
+        )
         for v in range(y0, y1, 4):
             t = (v - v_top) / max(1.0, v_bottom - v_top)
             color = tuple(round(a + (b - a) * t) for a, b in zip(top, bottom, strict=True))

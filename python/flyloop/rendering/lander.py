@@ -157,25 +157,19 @@ def overlay(p: Painter, plane: PlaneView, s: LanderScene) -> None:
     reward = "Reward: -" if s.reward is None else f"Reward: {s.reward:+.3f}"
     if s.episode_return is not None:
         reward += f"  (return {s.episode_return:.1f})"
-    columns = [
-        [
-            (f"Battery: {s.battery:.1f} / {s.initial_battery:.0f}", TEXT),
-            (f"Status: {status}", status_color),
-            (f"Step: {steps}   t = {s.time_s:.2f} s", TEXT),
-            (reward, TEXT),
-        ],
-        [
-            (f"Position: ({s.position[0]:.2f}, {s.position[1]:.2f}) m", TEXT),
-            (f"Velocity: ({s.velocity[0]:+.2f}, {s.velocity[1]:+.2f}) m/s", TEXT),
-            (f"Angle: {angle_deg:+.1f}°", TEXT),
-            (f"Angular velocity: {s.angular_velocity:+.2f} rad/s", TEXT),
-        ],
-        [
-            (f"Distance to platform: {s.distance_to_platform:.2f} m", TEXT),
-            (f"Thrust L: {s.thrust[0]:.1f} N", TEXT),
-            (f"Thrust R: {s.thrust[1]:.1f} N", TEXT),
-            (f"Platform: x {s.platform_x:.1f} m, {s.platform_vx:+.1f} m/s", TEXT),
-        ],
+    lines = [
+        f"Battery: {s.battery:.1f} / {s.initial_battery:.0f}",
+        f"Status: {status}",
+        f"Step: {steps}   t = {s.time_s:.2f} s",
+        reward,
+        f"Position: ({s.position[0]:.2f}, {s.position[1]:.2f}) m",
+        f"Velocity: ({s.velocity[0]:+.2f}, {s.velocity[1]:+.2f}) m/s",
+        f"Angle: {angle_deg:+.1f}°",
+        f"Angular velocity: {s.angular_velocity:+.2f} rad/s",
+        f"Distance to platform: {s.distance_to_platform:.2f} m",
+        f"Thrust L: {s.thrust[0]:.1f} N",
+        f"Thrust R: {s.thrust[1]:.1f} N",
+        f"Platform: x {s.platform_x:.1f} m, {s.platform_vx:+.1f} m/s",
     ]
     width, height = p.surface.get_size()
     line_h, pad = 22, 10
@@ -185,10 +179,9 @@ def overlay(p: Painter, plane: PlaneView, s: LanderScene) -> None:
     rect = (16, round(top), width - 32, panel_h)
     p.panel(rect, (255, 255, 248))
     col_w = (rect[2] - 2 * pad) // 3
-    for c, lines in enumerate(columns):
-        x = rect[0] + pad + c * col_w
-        for i, (text, color) in enumerate(lines):
-            p.text(text, (x, rect[1] + pad + i * line_h), color, 19, bold=(c == 0 and i == 1))
+    for i, text in enumerate(lines):  # three columns of four; the status bold, in colour
+        at = (rect[0] + pad + i // 4 * col_w, rect[1] + pad + i % 4 * line_h)
+        p.text(text, at, status_color if i == 1 else TEXT, 19, bold=i == 1)
     bar_x = rect[0] + pad + 2 * col_w + 120
     for i, thrust in enumerate(s.thrust):
         bar = (bar_x, rect[1] + pad + (i + 1) * line_h + 2, col_w - 130, 11)
@@ -203,16 +196,11 @@ def world(p: Painter, plane: PlaneView, s: LanderScene, poses, path, spawn, clos
     label and longer thrust bars."""
     # Grey outside the world, a sky gradient (by altitude) inside it.
     p.surface.fill(OUTSIDE)
-    width, height = p.surface.get_size()
     corners = np.array([[0.0, s.world_height], [s.world_width, 0.0]])
     (u0, v_top), (u1, v_bottom) = plane.to_screen(corners)
-    box = (
-        max(0, round(u0)),
-        max(0, round(v_top)),
-        min(width, round(u1)),
-        min(height, round(v_bottom)),
+    p.gradient(
+        (round(u0), round(v_top), round(u1), round(v_bottom)), v_top, v_bottom, SKY_TOP, SKY_BOTTOM
     )
-    p.gradient(box, v_top, v_bottom, SKY_TOP, SKY_BOTTOM)
     r = s.spawn_half_range
     if spawn and r > 0:
         lo = plane.to_screen((s.spawn_center[0] - r, s.spawn_center[1] + r))
