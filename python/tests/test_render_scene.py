@@ -64,10 +64,10 @@ def test_flight_path_restarts_with_each_episode_and_records_a_step_once():
     path = FlightPath(max_points=3)
     for step in range(5):
         assert path.update(step, (step, 0.0)) is False
-    assert path.points[:, 0].tolist() == [2, 3, 4]  # bounded, oldest dropped
+    assert np.array(path.points)[:, 0].tolist() == [2, 3, 4]  # bounded, oldest dropped
     path.update(4, (40.0, 0.0))  # the same step rendered again replaces, not appends
-    assert path.points[:, 0].tolist() == [2, 3, 40]
+    assert np.array(path.points)[:, 0].tolist() == [2, 3, 40]
     assert path.update(0, (7.0, 7.0)) is True  # step went back: a new episode
-    assert path.points.tolist() == [[7.0, 7.0]]
+    assert np.array(path.points).tolist() == [[7.0, 7.0]]
     path.clear()
     assert len(path.points) == 0

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-MAX_ELEVATION_DEG = 89.0
+MAX_ELEVATION_DEG = 89.0  # short of straight up or down, where the view would flip
 
 
 @dataclass(eq=False)
@@ -37,8 +37,7 @@ class OrbitCamera:
 
     def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Unit vectors (right, up, forward) of the camera in world coordinates."""
-        rows = self._view()[0]
-        return rows[0].copy(), rows[1].copy(), rows[2].copy()
+        return tuple(self._view()[0].copy())
 
     def to_camera(self, points: np.ndarray) -> np.ndarray:
         """World points (..., 3) to camera coordinates (..., 3): right, up, depth."""

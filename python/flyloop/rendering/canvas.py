@@ -176,30 +176,23 @@ class FlightPath:
     sees only the current step: a lower step number than the last means a new episode."""
 
     def __init__(self, max_points: int = 5000) -> None:
-        self._points: deque[np.ndarray] = deque(maxlen=max_points)
+        self.points: deque[np.ndarray] = deque(maxlen=max_points)
         self._last_step: int | None = None
 
     def update(self, step: int, position: np.ndarray) -> bool:
-        """Record the position of `step`; True when this step started a new episode."""
+        """Record the position of `step` (replaced if seen); True when it began an episode."""
         new_episode = self._last_step is not None and step < self._last_step
         if new_episode:
-            self._points.clear()
-        point = np.array(position, dtype=float)
-        if self._last_step == step and self._points:
-            self._points[-1] = point
-        else:
-            self._points.append(point)
+            self.points.clear()
+        elif self._last_step == step and self.points:
+            self.points.pop()
+        self.points.append(np.array(position, dtype=float))
         self._last_step = step
         return new_episode
 
     def clear(self) -> None:
-        self._points.clear()
+        self.points.clear()
         self._last_step = None
-
-    @property
-    def points(self) -> np.ndarray:
-        """(N, dims) positions, oldest first; (0, 0) when empty."""
-        return np.array(self._points) if self._points else np.zeros((0, 0))
 
 
 class View:

@@ -321,7 +321,7 @@ class LanderView(View):
         s, p = scene, self._painter
         plane = fit_world(s, self.size)
         shade_poses = self._shades if self.show_shades else ()
-        path_points = self._path.points if self.show_path else np.zeros((0, 2))
+        path_points = np.array(self._path.points) if self.show_path else ()
         world(p, plane, s, shade_poses, path_points, self.show_spawn_zone, close_up=False)
         zoom = CLOSE_UP_SCALE / plane.scale
         if self._close_up is not None and zoom >= 1.5:  # in a small world it adds nothing

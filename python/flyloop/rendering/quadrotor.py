@@ -444,7 +444,7 @@ class QuadrotorView(View):
         p = self._painter
         width, height = self.size
         p.gradient((0, 0, width, height), 0, height - 1, BACKGROUND_TOP, BACKGROUND_BOTTOM)
-        trail = self._trail.points
+        trail = np.array(self._trail.points)
         world(p, Projector(self.camera, self.size), scene, trail, self.drone_scale)
         if self.hud:
             info_panel(p, scene)

@@ -42,10 +42,8 @@ def _save_gif(frames: list[np.ndarray], path: Path, fps: float, colors: int = 12
     """A looping GIF with ONE palette drawn from a sample of the frames, so Pillow can store
     each frame as its difference to the last (a few kB a frame for these scenes, against
     ~50 kB with a palette of its own per frame)."""
-    try:
-        from PIL import Image
-    except ImportError as exc:
-        raise ImportError("saving a GIF needs Pillow: pip install pillow") from exc
+    from PIL import Image  # the "render" extra's, as pygame
+
     images = [Image.fromarray(f) for f in frames]
     sample = images[:: max(1, len(images) // 10)]
     width, height = images[0].size
