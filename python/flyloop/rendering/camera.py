@@ -16,6 +16,8 @@ MAX_ELEVATION_DEG = 89.0  # short of straight up or down, where the view would f
 
 @dataclass(eq=False)
 class OrbitCamera:
+    """A perspective camera orbiting `look_at` at `distance` metres; angles in degrees."""
+
     look_at: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
     distance: float = 6.5
     azimuth_deg: float = 35.0
@@ -25,15 +27,9 @@ class OrbitCamera:
 
     def __post_init__(self) -> None:
         self.look_at = np.asarray(self.look_at, dtype=float).reshape(3)
-        if not (self.distance > 0 and 0 < self.fov_deg < 180 and self.near > 0):
-            raise ValueError(
-                f"camera needs distance > 0, 0 < fov_deg < 180 and near > 0, got "
-                f"distance={self.distance}, fov_deg={self.fov_deg}, near={self.near}"
-            )
         self.elevation_deg = _clamp_elevation(self.elevation_deg)
         self._home = (self.look_at.copy(), self.distance, self.azimuth_deg, self.elevation_deg)
-        self._cache_key: tuple | None = None
-        self._cache: tuple[np.ndarray, np.ndarray] = (np.eye(3), np.zeros(3))
+        self._cache_key: tuple | None = None  # the pose _view last computed
 
     def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Unit vectors (right, up, forward) of the camera in world coordinates."""

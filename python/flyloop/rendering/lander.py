@@ -60,9 +60,7 @@ class LanderScene:
     drone_width: float = _CORE["drone_width"]  # m, tip to tip
     drone_height: float = _CORE["drone_height"]  # m, side of each square motor
     # (2,) m, centre of the spawn square, and its half side (0 = fixed start)
-    spawn_center: np.ndarray = field(
-        default_factory=lambda: np.array([_CORE["spawn_x"], _CORE["spawn_y"]])
-    )
+    spawn_center: np.ndarray = (_CORE["spawn_x"], _CORE["spawn_y"])
     spawn_half_range: float = _CORE["initial_pos_random_range_m"]
 
     def __post_init__(self) -> None:
@@ -255,9 +253,7 @@ def world(p: Painter, plane: PlaneView, s: LanderScene, poses, path, spawn, clos
             p.line(start, start + up * full_px * fraction, THRUST, 3)
 
 
-def close_up(
-    p: Painter, s: LanderScene, shade_poses: list, path_points: np.ndarray, zoom: float
-) -> None:
+def close_up(p: Painter, s: LanderScene, shade_poses, path_points, zoom: float) -> None:
     """A zoomed window on the drone (top-left), framed and titled; p draws on that window."""
     width, height = p.surface.get_size()
     # The drone sits a little low so its thrust bars fit above it.

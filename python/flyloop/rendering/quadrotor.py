@@ -75,8 +75,7 @@ class QuadScene:
     next_waypoint: np.ndarray | None = None  # (3,) m, the waypoint after the target
     reward: float | None = None  # reward of the last step
     episode_return: float | None = None  # sum of rewards since reset
-    # m: targets live in x, y in [-h, h], z in [0, 2h]
-    bounds_half_size: float = _CORE["space_side_length"] / 2.0
+    bounds_half_size: float = _CORE["space_side_length"] / 2.0  # m: x, y in [-h, h], z in [0, 2h]
     arm_length: float = _CORE["arm_length"]  # m, centre to rotor
     waypoints_reached: int | None = None  # Waypoints task only
     status: str = ""  # e.g. "crashed", "out of bounds"; empty while flying
@@ -403,10 +402,8 @@ class QuadrotorView(View):
         pg = self._pg
         tapped: set[int] = set()
         for event in events:
-            if event.type == pg.MOUSEBUTTONDOWN and event.button == 1:
-                self._dragging = True
-            elif event.type == pg.MOUSEBUTTONUP and event.button == 1:
-                self._dragging = False
+            if event.type in (pg.MOUSEBUTTONDOWN, pg.MOUSEBUTTONUP) and event.button == 1:
+                self._dragging = event.type == pg.MOUSEBUTTONDOWN
             elif event.type == pg.MOUSEMOTION and self._dragging:
                 dx, dy = event.rel
                 # Dragging right turns the world right; dragging down looks from higher up.
