@@ -204,6 +204,20 @@ def test_far_and_behind_camera_states_do_not_break_drawing(view):
         assert frame.shape == (480, 640, 3)
 
 
+def test_the_trail_restarts_with_each_episode_and_records_a_step_once():
+    v = QuadrotorView("rgb_array", width=160, height=120, trail_steps=3)
+    for step in range(5):
+        v.render(scene(step=step, position=(step, 0.0, 1.0)))
+    assert [p[0] for p in v.path] == [2, 3, 4]  # bounded, oldest dropped
+    v.render(scene(step=4, position=(40.0, 0.0, 1.0)))  # the same step again replaces it
+    assert [p[0] for p in v.path] == [2, 3, 40]
+    v.render(scene(step=0, position=(7.0, 7.0, 1.0)))  # the step went back: a new episode
+    assert np.array(v.path).tolist() == [[7.0, 7.0, 1.0]]
+    v.reset()
+    assert len(v.path) == 0
+    v.close()
+
+
 def test_close_is_idempotent_and_render_after_close_is_an_error():
     v = QuadrotorView("rgb_array", width=200, height=150)
     v.render(scene())

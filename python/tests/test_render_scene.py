@@ -1,4 +1,4 @@
-"""Scenes and per-episode history of flyloop.rendering (no pygame)."""
+"""The scenes of flyloop.rendering (no pygame)."""
 
 import os
 import subprocess
@@ -10,7 +10,6 @@ import pytest
 
 import flyloop
 from flyloop.rendering import LanderScene, QuadScene
-from flyloop.rendering.canvas import FlightPath
 
 
 def quad(**over):
@@ -58,16 +57,3 @@ def test_lander_scene_derives_the_sensor_target():
     s = lander(position=(28.0, 14.5), platform_x=25.0)
     assert s.platform_top == (25.0, 10.5)
     assert s.distance_to_platform == pytest.approx(5.0)
-
-
-def test_flight_path_restarts_with_each_episode_and_records_a_step_once():
-    path = FlightPath(max_points=3)
-    for step in range(5):
-        assert path.update(step, (step, 0.0)) is False
-    assert np.array(path.points)[:, 0].tolist() == [2, 3, 4]  # bounded, oldest dropped
-    path.update(4, (40.0, 0.0))  # the same step rendered again replaces, not appends
-    assert np.array(path.points)[:, 0].tolist() == [2, 3, 40]
-    assert path.update(0, (7.0, 7.0)) is True  # step went back: a new episode
-    assert np.array(path.points).tolist() == [[7.0, 7.0]]
-    path.clear()
-    assert len(path.points) == 0

@@ -1,5 +1,5 @@
 """What both views draw with: View (an off-screen surface for "rgb_array" or the window for
-"human"), Painter (2D primitives in float pixels) and FlightPath (the episode's positions).
+"human") with the episode's path, and Painter (2D primitives in float pixels).
 
 pygame is imported by a view's constructor, so `import flyloop.rendering` stays free of it.
 Pixels are clamped to a range pygame accepts: a blown-up state would give huge integers.
@@ -58,13 +58,8 @@ class Painter:
     def gradient(self, box: tuple[int, int, int, int], v_top, v_bottom, top, bottom) -> None:
         """Fill box (left, top, right, bottom; clipped to the frame) in 4 px bands, shading
         from colour `top` at row v_top to `bottom` at row v_bottom."""
-        width, height = self.surface.get_size()
-        left, y0, right, y1 = (
-            max(0, box[0]),
-            max(0, box[1]),
-            min(width, box[2]),
-            min(height, box[3]),
-        )
+        (width, height), (left, y0, right, y1) = self.surface.get_size(), box
+        left, y0, right, y1 = max(0, left), max(0, y0), min(width, right), min(height, y1)
         for v in range(y0, y1, 4):
             t = (v - v_top) / max(1.0, v_bottom - v_top)
             color = tuple(round(a + (b - a) * t) for a, b in zip(top, bottom, strict=True))
@@ -171,36 +166,17 @@ def vector(value: Any) -> np.ndarray:
     return np.array(value, dtype=float).reshape(-1)
 
 
-class FlightPath:
-    """The episode's positions, one per step (the oldest dropped past max_points). A view
-    sees only the current step: a lower step number than the last means a new episode."""
-
-    def __init__(self, max_points: int = 5000) -> None:
-        self.points: deque[np.ndarray] = deque(maxlen=max_points)
-        self._last_step: int | None = None
-
-    def update(self, step: int, position: np.ndarray) -> bool:
-        """Record the position of `step` (replaced if seen); True when it began an episode."""
-        new_episode = self._last_step is not None and step < self._last_step
-        if new_episode:
-            self.points.clear()
-        elif self._last_step == step and self.points:
-            self.points.pop()
-        self.points.append(np.array(position, dtype=float))
-        self._last_step = step
-        return new_episode
-
-    def clear(self) -> None:
-        self.points.clear()
-        self._last_step = None
-
-
 class View:
-    """What both views share: the frame (shown in a window in human mode), its Painter and
+    """What both views share: the frame (shown in a window in human mode), its Painter, the
+    episode's path (`path`, one position per step, the oldest dropped past `path_steps`) and
     closing."""
 
-    def __init__(self, render_mode: str, size: tuple[int, int], caption: str, fps: float) -> None:
+    def __init__(
+        self, render_mode: str, size: tuple[int, int], caption: str, fps: float, path_steps: int
+    ) -> None:
         global _window_owner
+        self.path: deque[np.ndarray] = deque(maxlen=path_steps)
+        self._last_step: int | None = None
         if render_mode not in RENDER_MODES:
             raise ValueError(f"render_mode must be one of {RENDER_MODES}, got {render_mode!r}")
         self.render_mode, self.size, self.fps = render_mode, (int(size[0]), int(size[1])), fps
@@ -236,6 +212,23 @@ class View:
         self._painter = Painter(pg, self._surface)
         # is_open turns False also when the user closes the window; _closed only by close().
         self.is_open, self._closed = True, False
+
+    def reset(self) -> None:
+        """Forget the episode's history (an env calls this from reset())."""
+        self.path.clear()
+        self._last_step = None
+
+    def _follow(self, step: int, position: np.ndarray) -> bool:
+        """Record the position of `step` (replaced if seen); True when it began an episode: a
+        view sees only the current step, so a lower step number than the last means a new one."""
+        new_episode = self._last_step is not None and step < self._last_step
+        if new_episode:
+            self.path.clear()
+        elif self._last_step == step and self.path:
+            self.path.pop()
+        self.path.append(np.array(position, dtype=float))
+        self._last_step = step
+        return new_episode
 
     def _events(self) -> list[Any] | None:
         """This frame's window events; None once the user closed the window (QUIT, Escape)."""

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..tasks import LANDING
-from .canvas import FlightPath, Painter, View, vector
+from .canvas import Painter, View, vector
 
 SKY_TOP, SKY_BOTTOM, OUTSIDE = (196, 220, 246), (226, 238, 250), (120, 130, 145)
 GROUND, GROUND_EDGE, BOUNDS, SPAWN = (96, 148, 82), (62, 112, 58), (200, 70, 70), (178, 160, 80)
@@ -289,9 +289,8 @@ class LanderView(View):
         self.show_path, self.show_shades = show_path, show_shades
         self.show_spawn_zone, self.show_overlay = show_spawn_zone, show_overlay
         self.shade_distance_m = shade_distance_m
-        self._path = FlightPath()
         self._shades: deque[tuple[float, float, float]] = deque(maxlen=500)  # x, y, angle
-        super().__init__(render_mode, (width, height), "flyloop - Lander2D", fps)
+        super().__init__(render_mode, (width, height), "flyloop - Lander2D", fps, 5000)
         self._close_up: Painter | None = None
         cw, ch = CLOSE_UP_SIZE
         if show_close_up and width >= 3 * cw and height >= 3 * ch:  # else it has no room
@@ -299,14 +298,14 @@ class LanderView(View):
 
     def reset(self) -> None:
         """Forget the flight path and shades (an env calls this from reset())."""
-        self._path.clear()
+        super().reset()
         self._shades.clear()
 
     def render(self, scene: LanderScene) -> np.ndarray | None:
         """Draw one frame: returns it in rgb_array mode, None in human mode."""
         if self._events() is None:
             return None  # the user closed the window: nothing to draw on any more
-        if self._path.update(scene.step, scene.position):
+        if self._follow(scene.step, scene.position):
             self._shades.clear()
         # A shade at the first pose, then each time the drone is shade_distance_m past the
         # last one (the reference's shade_distance_m, docs/reference/lander2d.md).
@@ -317,7 +316,7 @@ class LanderView(View):
         s, p = scene, self._painter
         plane = fit_world(s, self.size)
         shade_poses = self._shades if self.show_shades else ()
-        path_points = np.array(self._path.points) if self.show_path else ()
+        path_points = np.array(self.path) if self.show_path else ()
         world(p, plane, s, shade_poses, path_points, self.show_spawn_zone, close_up=False)
         zoom = CLOSE_UP_SCALE / plane.scale
         if self._close_up is not None and zoom >= 1.5:  # in a small world it adds nothing

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..tasks import HOVER
 from .camera import OrbitCamera, Projector
-from .canvas import FlightPath, Painter, View, vector
+from .canvas import Painter, View, vector
 
 # Rotor i sits at (forward, left) * L/sqrt(2) in the body frame: PX4 quad-X order.
 ROTOR_POSITION_SIGNS = np.array([(1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (-1.0, -1.0)])
@@ -383,18 +383,14 @@ class QuadrotorView(View):
         hud: bool = True,
     ) -> None:
         self.drone_scale, self.hud, self.camera = float(drone_scale), hud, camera
-        self._trail = FlightPath(max(2, trail_steps))
-        super().__init__(render_mode, (width, height), "flyloop - Quadrotor 3D", fps)
+        title = "flyloop - Quadrotor 3D"
+        super().__init__(render_mode, (width, height), title, fps, max(2, trail_steps))
         pg = self._pg
         keys = (pg.K_w, pg.K_s, pg.K_d, pg.K_a, pg.K_e, pg.K_q)
         moves = ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))
         self._moves = dict(zip(keys, moves, strict=True))
         self._held: set[int] = set()
         self._dragging = False
-
-    def reset(self) -> None:
-        """Forget the trail (an env calls this from reset())."""
-        self._trail.clear()
 
     def _steer(self, camera: OrbitCamera, events: list[Any]) -> None:
         """Apply this frame's events, then one frame of movement for each key held or pressed
@@ -437,11 +433,11 @@ class QuadrotorView(View):
         if events is None:
             return None  # the user closed the window
         self._steer(self.camera, events)
-        self._trail.update(scene.step, scene.position)
+        self._follow(scene.step, scene.position)
         p = self._painter
         width, height = self.size
         p.gradient((0, 0, width, height), 0, height - 1, BACKGROUND_TOP, BACKGROUND_BOTTOM)
-        trail = np.array(self._trail.points)
+        trail = np.array(self.path)
         world(p, Projector(self.camera, self.size), scene, trail, self.drone_scale)
         if self.hud:
             info_panel(p, scene)
