@@ -5,8 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from flyloop.rendering.camera import OrbitCamera, Projector, clip_polygon_near
-from flyloop.rendering.quadrotor import ROTOR_SPIN, euler_rpy, rotation_matrix
+from flyloop.rendering import QuadScene
+from flyloop.rendering.camera import OrbitCamera, Projector
+from flyloop.rendering.quadrotor import ROTOR_SPIN, info_lines, rotation_matrix
 
 W, H = 800, 600
 
@@ -85,13 +86,17 @@ def test_points_behind_the_camera_are_not_visible_and_segments_are_clipped():
     np.testing.assert_allclose(a, [W / 2 + focal * right / cam.near, H / 2 - focal * up / cam.near])
 
 
-def test_near_plane_polygon_clipping():
-    square = np.array([[-1, -1, -1.0], [1, -1, -1.0], [1, 1, 3.0], [-1, 1, 3.0]])
-    out = clip_polygon_near(square, 1.0)
-    assert len(out) == 4
-    assert np.all(out[:, 2] >= 1.0 - 1e-12)
-    assert sorted(np.round(out[:, 2], 9)) == [1.0, 1.0, 3.0, 3.0]
-    assert len(clip_polygon_near(square - [0, 0, 10], 1.0)) == 0
+def test_a_polygon_crossing_the_near_plane_is_cut_there():
+    # Looking north from (0, -5, 0): camera right = +x, up = +z, depth = y + 5.
+    cam = OrbitCamera(look_at=np.zeros(3), distance=5.0, azimuth_deg=0, elevation_deg=0)
+    pr = Projector(cam, (W, H))
+    square = np.array([[-1, -6, -1.0], [1, -6, -1.0], [1, -2, 1.0], [-1, -2, 1.0]])
+    t = (cam.near + 1) / 4  # depth -1 to 3 along the sides: near is crossed a fraction t in
+    corners = [(x, -1 + 2 * t, cam.near) for x in (-1, 1)] + [(x, 1, 3.0) for x in (-1, 1)]
+    focal = (H / 2) / math.tan(math.radians(cam.fov_deg) / 2)
+    expected = sorted((W / 2 + focal * x / d, H / 2 - focal * u / d) for x, u, d in corners)
+    np.testing.assert_allclose(sorted(map(tuple, pr.polygon(square))), expected)
+    assert len(pr.polygon(square - [0, 10, 0])) == 0  # wholly behind
 
 
 def test_orbit_move_and_reset():
@@ -121,10 +126,13 @@ def test_quaternion_rotation_and_euler_round_trip():
     roll = quaternion_from_euler(0.3, 0.0, 0.0)
     # Positive roll about the forward axis lifts the left (+y) side: body z tips toward -y.
     assert (rotation_matrix(roll) @ [0, 0, 1])[1] < -0.25
-    for angles in [(0.1, -0.2, 0.3), (-1.0, 0.7, -2.5), (0.0, 1.2, 3.0)]:
+    for angles in [(0.1, -0.2, 0.3), (-1.0, 0.7, -2.5), (0.05, 1.2, 3.0)]:
         q = quaternion_from_euler(*angles)
         assert np.linalg.norm(q) == pytest.approx(1.0)
-        np.testing.assert_allclose(euler_rpy(q), angles, atol=1e-9)
+        # The info panel reads the angles back.
+        s = QuadScene(time_s=0, step=0, position=(0, 0, 1), velocity=(0, 0, 0), quaternion=q)
+        roll, pitch, yaw = np.degrees(angles)
+        assert info_lines(s)[3][0] == f"Roll {roll:+.1f}°  Pitch {pitch:+.1f}°  Yaw {yaw:+.1f}°"
         m = rotation_matrix(q)
         np.testing.assert_allclose(m @ m.T, np.eye(3), atol=1e-12)
 

@@ -84,23 +84,6 @@ def _clamp_elevation(value: float) -> float:
     return max(-MAX_ELEVATION_DEG, min(MAX_ELEVATION_DEG, float(value)))
 
 
-def clip_polygon_near(cam_points: np.ndarray, near: float) -> np.ndarray:
-    """The part of a convex camera-space polygon (N, 3) with depth >= near (Sutherland-Hodgman
-    against one plane); (0, 3) when it lies wholly behind."""
-    out: list[np.ndarray] = []
-    pts = np.asarray(cam_points, dtype=float)
-    for i in range(len(pts)):
-        a, b = pts[i - 1], pts[i]
-        da, db = a[2] - near, b[2] - near
-        if db >= 0:
-            if da < 0:
-                out.append(a + (b - a) * (da / (da - db)))
-            out.append(b)
-        elif da >= 0:
-            out.append(a + (b - a) * (da / (da - db)))
-    return np.array(out) if out else np.zeros((0, 3))
-
-
 class Projector:
     """A camera bound to a frame size: world points to pixels, near-plane clipped."""
 
@@ -141,8 +124,19 @@ class Projector:
         return list(zip(self.pixels(ca2[keep]), self.pixels(cb2[keep]), strict=True))
 
     def polygon(self, points: np.ndarray) -> np.ndarray:
-        cam = clip_polygon_near(self.camera.to_camera(points), self.camera.near)
-        return self.pixels(cam) if len(cam) >= 3 else np.zeros((0, 2))
+        """A convex world polygon's pixels, cut where it crosses the near plane (Sutherland-
+        Hodgman against one plane); (0, 2) when fewer than 3 corners are left."""
+        cam, near, out = self.camera.to_camera(points), self.camera.near, []
+        for i in range(len(cam)):
+            a, b = cam[i - 1], cam[i]
+            da, db = a[2] - near, b[2] - near
+            if db >= 0:
+                if da < 0:
+                    out.append(a + (b - a) * (da / (da - db)))
+                out.append(b)
+            elif da >= 0:
+                out.append(a + (b - a) * (da / (da - db)))
+        return self.pixels(np.array(out)) if len(out) >= 3 else np.zeros((0, 2))
 
     def radius(self, radius_m: float, depth: float) -> float:
         """On-screen radius in pixels of a sphere of radius_m at this depth."""

@@ -51,15 +51,6 @@ def rotation_matrix(q_wxyz: np.ndarray) -> np.ndarray:
     return np.array([row_x, row_y, row_z])
 
 
-def euler_rpy(q_wxyz: np.ndarray) -> tuple[float, float, float]:
-    """Roll, pitch, yaw in radians (intrinsic Z-Y-X) of a unit quaternion [w, x, y, z]."""
-    w, x, y, z = q_wxyz
-    roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
-    pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
-    yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-    return roll, pitch, yaw
-
-
 @dataclass(eq=False)
 class QuadScene:
     """One frame of the quadrotor: plain per-step data in the core's frames and units."""
@@ -237,7 +228,10 @@ def world(p: Painter, pr: Projector, scene: QuadScene, trail: np.ndarray, scale:
 
 def info_lines(scene: QuadScene) -> list[tuple[str, tuple[int, int, int]]]:
     """The info panel's text: time, step, distance, height, speed, wind, attitude, reward."""
-    roll, pitch, yaw = (math.degrees(a) for a in euler_rpy(scene.quaternion))
+    w, x, y, z = scene.quaternion  # to roll, pitch, yaw (intrinsic Z-Y-X)
+    roll = math.degrees(math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y)))
+    pitch = math.degrees(math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x)))))
+    yaw = math.degrees(math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
     distance = (
         "-" if scene.target is None else f"{np.linalg.norm(scene.target - scene.position):.2f} m"
     )

@@ -1,8 +1,5 @@
-"""Save rgb_array frames as a GIF (Pillow) or a video (ffmpeg from imageio-ffmpeg).
-
-gymnasium's own `gymnasium.wrappers.RecordVideo` also works with flyloop's envs in
-render_mode="rgb_array" (it needs moviepy); these helpers need neither.
-"""
+"""Save rgb_array frames as a GIF (Pillow) or a video (imageio-ffmpeg's ffmpeg); unlike
+gymnasium's `RecordVideo` wrapper, which also works with flyloop's envs, without moviepy."""
 
 from __future__ import annotations
 
@@ -91,6 +88,8 @@ def _save_ffmpeg(frames: list[np.ndarray], path: Path, fps: float) -> None:
 
 @dataclass(frozen=True)
 class Recording:
+    """What record_episode saved: where, how many frames and steps, and the episode's return."""
+
     path: Path
     frames: int
     steps: int
@@ -106,16 +105,11 @@ def record_episode(
     max_steps: int | None = None,
     fps: float | None = None,
 ) -> Recording:
-    """Run one episode of a gymnasium env made with render_mode="rgb_array" and save it.
-
-    policy(observation) -> action; random actions when None. fps defaults to the env's
-    metadata["render_fps"] (30 if absent). One frame after reset and one per step.
-    """
-    if getattr(env, "render_mode", None) != "rgb_array":
-        raise ValueError(
-            f"record_episode needs an env made with render_mode='rgb_array', "
-            f"got {getattr(env, 'render_mode', None)!r}"
-        )
+    """Run one episode of a gymnasium env made with render_mode="rgb_array" and save a frame
+    after reset and one per step. policy(observation) -> action (random when None); fps: the
+    env's metadata["render_fps"] (30 if absent) unless given."""
+    if (mode := getattr(env, "render_mode", None)) != "rgb_array":
+        raise ValueError(f"record_episode needs an env made with render_mode='rgb_array': {mode!r}")
     rate = fps if fps is not None else float(env.metadata.get("render_fps") or 30)
     observation, _ = env.reset(seed=seed)
     frames = [env.render()]
