@@ -1,9 +1,6 @@
-"""What both views draw with: View (an off-screen surface for "rgb_array" or the window for
-"human") with the episode's path, and Painter (2D primitives in float pixels).
-
-pygame is imported by a view's constructor, so `import flyloop.rendering` stays free of it.
-Pixels are clamped to a range pygame accepts: a blown-up state would give huge integers.
-"""
+"""What both views draw with: View (the frame, off-screen or a window, and the episode's path)
+and Painter (2D primitives in float pixels, clamped to a range pygame accepts: a blown-up
+state would give huge integers)."""
 
 from __future__ import annotations
 
@@ -131,9 +128,8 @@ class Painter:
 
     def translucent_polygon(self, points: Sequence[Point], color: Color, alpha: int) -> None:
         pts = np.array([_px(p) for p in points])
-        # The layer spans only the polygon's part of the frame (and a margin, where pygame's
-        # clipping leaves its marks): a vertex far off screen (a shadow seen from a turned
-        # camera) would otherwise ask for gigabytes.
+        # Only the polygon's part of the frame (and a margin where pygame's clipping leaves
+        # marks): a vertex far off screen (a turned camera's shadow) would ask for gigabytes.
         lo = np.maximum(pts.min(axis=0), -8)
         size = np.minimum(pts.max(axis=0), np.array(self.surface.get_size()) + 8) - lo + 1
         if np.any(size <= 0):
@@ -167,9 +163,8 @@ def vector(value: Any) -> np.ndarray:
 
 
 class View:
-    """What both views share: the frame (shown in a window in human mode), its Painter, the
-    episode's path (`path`, one position per step, the oldest dropped past `path_steps`) and
-    closing."""
+    """The frame (a window in human mode), its Painter, closing and the episode's `path`: one
+    position per step, the oldest dropped past `path_steps`. Imports pygame, not before."""
 
     def __init__(
         self, render_mode: str, size: tuple[int, int], caption: str, fps: float, path_steps: int

@@ -1,7 +1,5 @@
-"""The Lander2D view (task Landing): its scene, the plane (metres to pixels), the picture
-(the world back to front, a close-up, the wind dial and the text panel) and LanderView.
-World metres, x right, y up, angles counter-clockwise.
-"""
+"""The Lander2D view (task Landing): its scene, metres to pixels, the world back to front, a
+close-up, the wind dial, the text panel and LanderView. x right, y up, angles CCW."""
 
 from __future__ import annotations
 
@@ -266,11 +264,8 @@ def close_up(p: Painter, s: LanderScene, shade_poses, path_points, zoom: float) 
 
 
 class LanderView(View):
-    """Draws LanderScene frames: a window ("human") or (H, W, 3) uint8 arrays ("rgb_array").
-
-    Keeps the episode's flight path and shades (a shade every `shade_distance_m` travelled);
-    both restart when a scene's step goes backwards (a new episode) or on `reset()`.
-    """
+    """Draws LanderScene frames: a window ("human") or (H, W, 3) uint8 arrays ("rgb_array"),
+    with the episode's path and a shade every `shade_distance_m` travelled."""
 
     def __init__(
         self,

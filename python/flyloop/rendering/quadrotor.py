@@ -1,10 +1,7 @@
 """The quadrotor view (tasks Hover and Waypoints): its scene, the 3D world through an orbit
-camera, the overlays and QuadrotorView with its window controls. Frames as the core: world
-ENU, body FLU, quaternion [w, x, y, z] body to world, motors in PX4's quad-X order. Painter's
-algorithm: ground and lines first, then solids far to near, the drone's hub last (tests
-track its pixels). Held keys come from KEYDOWN/KEYUP events, not pygame.key.get_pressed, so
-posted events drive the camera in a test as a person's do.
-"""
+camera, the overlays and QuadrotorView with its window controls; the core's frames (world
+ENU, body FLU, quaternion [w, x, y, z]) and PX4's motor order. Painter's algorithm: ground
+and lines, then solids far to near, the hub last (tests track its pixels)."""
 
 from __future__ import annotations
 
@@ -32,6 +29,7 @@ DROP, SHADOW, TRAIL = (128, 128, 128), (40, 40, 40), (60, 140, 220)
 TEXT, PANEL, BAD, BACKGROUND_TOP = (20, 20, 30), (255, 255, 236), (200, 0, 0), (232, 238, 248)
 BACKGROUND_BOTTOM = (246, 246, 250)
 ROTOR_COLORS = tuple(ROTOR_CCW if spin < 0 else ROTOR_CW for spin in ROTOR_SPIN)
+SPIN_NAMES = tuple("CCW" if spin < 0 else "CW" for spin in ROTOR_SPIN)
 AXES = ((AXIS_X, "x E"), (AXIS_Y, "y N"), (AXIS_Z, "z"))
 TARGET_RADIUS_M, WAYPOINT_RADIUS_M, UP_ARROW_M, MAX_ARROW_M = 0.08, 0.06, 0.5, 2.0
 VELOCITY_SECONDS = 0.5  # the velocity arrow shows where the drone is in this many seconds
@@ -84,16 +82,12 @@ class QuadScene:
             self.waypoints_reached = int(self.waypoints_reached)
 
 
-def _line(p: Painter, pr: Projector, a, b, color, width: int = 1) -> None:
+def _line(p: Painter, pr: Projector, a, b, color, width: int = 1, dashed=False) -> None:
     seg = pr.segment(a, b)
-    if seg is not None:
-        p.line(seg[0], seg[1], color, width)
-
-
-def _dashed(p: Painter, pr: Projector, a, b, color, width: int = 1) -> None:
-    seg = pr.segment(a, b)
-    if seg is not None:
+    if seg is not None and dashed:
         p.dashed_line(seg[0], seg[1], color, width, dash_px=5)
+    elif seg is not None:
+        p.line(seg[0], seg[1], color, width)
 
 
 def _arrow(p: Painter, pr: Projector, start, vector, color, width: int = 3) -> None:
@@ -111,7 +105,7 @@ def shadow(p: Painter, pr: Projector, position: np.ndarray, radius: float) -> No
     """A soft dark disc on the ground under a point, and a dashed drop line to it."""
     foot = np.array([position[0], position[1], 0.0])
     if position[2] > 0:
-        _dashed(p, pr, position, foot, DROP, 1)
+        _line(p, pr, position, foot, DROP, 1, dashed=True)
     ring = pr.polygon(_circle_points(foot, radius, np.eye(3)[:2]))
     if len(ring):
         p.translucent_polygon(ring, SHADOW, 60)
@@ -135,7 +129,7 @@ def next_waypoint(p: Painter, pr: Projector, scene: QuadScene) -> None:
     if scene.next_waypoint is None:
         return
     if scene.target is not None:
-        _dashed(p, pr, scene.target, scene.next_waypoint, WAYPOINT, 1)
+        _line(p, pr, scene.target, scene.next_waypoint, WAYPOINT, 1, dashed=True)
     hit = pr.point(scene.next_waypoint)
     if hit is not None:
         r = max(4.0, pr.radius(WAYPOINT_RADIUS_M, hit[1]))
@@ -208,7 +202,7 @@ def world(p: Painter, pr: Projector, scene: QuadScene, trail: np.ndarray, scale:
     for i, a in enumerate(corners):
         for b in corners[i + 1 :]:
             if np.count_nonzero(np.abs(a - b) > 1e-9) == 1:  # an edge, not a diagonal
-                _dashed(p, pr, a, b, BOUNDS, 1)
+                _line(p, pr, a, b, BOUNDS, 1, dashed=True)
     for point, radius in ((scene.target, 0.1), (scene.next_waypoint, 0.07)):
         if point is not None:
             shadow(p, pr, point, radius)
@@ -278,9 +272,8 @@ def motor_bars(p: Painter, scene: QuadScene) -> None:
         p.pg.draw.rect(p.surface, (0, 0, 0), (x, y0, bar_w, bar_h), 1)
         p.text(f"{round(float(level) * 100)}%", (x + bar_w / 2, y0 - 6), TEXT, 17, "midbottom")
         p.disc((x + bar_w / 2, y0 - 26), 5, ROTOR_COLORS[i])
-        spin = "CCW" if ROTOR_SPIN[i] < 0 else "CW"
         p.text(f"M{i} {ROTOR_NAMES[i]}", (x + bar_w / 2, y0 + bar_h + 4), TEXT, 17, "midtop")
-        p.text(spin, (x + bar_w / 2, y0 + bar_h + 20), TEXT, 15, "midtop")
+        p.text(SPIN_NAMES[i], (x + bar_w / 2, y0 + bar_h + 20), TEXT, 15, "midtop")
 
 
 def axis_gizmo(p: Painter, camera: OrbitCamera) -> None:
@@ -379,16 +372,16 @@ class QuadrotorView(View):
         self.drone_scale, self.hud, self.camera = float(drone_scale), hud, camera
         title = "flyloop - Quadrotor 3D"
         super().__init__(render_mode, (width, height), title, fps, max(2, trail_steps))
-        pg = self._pg
-        keys = (pg.K_w, pg.K_s, pg.K_d, pg.K_a, pg.K_e, pg.K_q)
+        # W/S forward/back, D/A right/left, E/Q up/down.
         moves = ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))
-        self._moves = dict(zip(keys, moves, strict=True))
+        self._moves = {getattr(self._pg, f"K_{k}"): m for k, m in zip("wsdaeq", moves, strict=True)}
         self._held: set[int] = set()
         self._dragging = False
 
     def _steer(self, camera: OrbitCamera, events: list[Any]) -> None:
-        """Apply this frame's events, then one frame of movement for each key held or pressed
-        in this frame (a tap shorter than a frame still moves once)."""
+        """Apply this frame's events, then move for each key held or pressed in this frame (a
+        tap shorter than a frame still moves once). Held keys come from KEYDOWN/KEYUP events,
+        not pygame.key.get_pressed, so posted events move the camera as a person's do."""
         pg = self._pg
         tapped: set[int] = set()
         for event in events:
