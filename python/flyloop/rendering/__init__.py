@@ -4,8 +4,7 @@
     frame = view.render(QuadScene(...))  # (720, 960, 3) uint8; None in human mode
 
 One file per view (quadrotor.py, lander.py), the 3D camera (camera.py), what both draw
-with (canvas.py), recording.py. pygame is imported by a view's constructor, not here.
-"""
+with (canvas.py), recording.py. pygame is imported by a view's constructor, not here."""
 
 from .camera import OrbitCamera
 from .lander import LanderScene, LanderView

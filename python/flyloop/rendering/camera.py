@@ -1,8 +1,7 @@
 """The quadrotor view's 3D camera, pure numpy: an orbit camera and a Projector (the camera
 bound to a frame size, near-plane clipped). ``azimuth_deg``: the compass direction looked
 toward (0 = north/+y, 90 = east/+x); ``elevation_deg``: down from the horizon; ``fov_deg``:
-vertical. Camera space: x right, y up, z depth; pixels from the top-left, v down.
-"""
+vertical. Camera space: x right, y up, z depth; pixels from the top-left, v down."""
 
 from __future__ import annotations
 
@@ -41,8 +40,7 @@ class OrbitCamera:
         return (np.asarray(points, dtype=float) - position) @ rows.T
 
     def _view(self) -> tuple[np.ndarray, np.ndarray]:
-        """(3x3 rows right/up/forward, position), recomputed only when the pose changed: a
-        frame projects thousands of points through the same pose."""
+        """(rows right/up/forward, position), cached: a frame projects thousands of points."""
         key = (self.azimuth_deg, self.elevation_deg, self.distance, *self.look_at.tolist())
         if self._cache_key != key:
             az, el = math.radians(self.azimuth_deg), math.radians(self.elevation_deg)

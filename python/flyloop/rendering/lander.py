@@ -145,8 +145,7 @@ def status_text(s: LanderScene) -> tuple[str, tuple[int, int, int]]:
 
 
 def overlay(p: Painter, plane: PlaneView, s: LanderScene) -> None:
-    """Text panel over the ground band: battery, status, step, position, velocity, angle,
-    angular velocity, distance, and the two motor force bars."""
+    """The text panel over the ground band: the state in three columns, the force bars."""
     steps = f"{s.step} / {s.max_steps}" if s.max_steps is not None else f"{s.step}"
     angle_deg = math.degrees(math.remainder(s.angle, math.tau))
     status, status_color = status_text(s)
@@ -187,9 +186,8 @@ def overlay(p: Painter, plane: PlaneView, s: LanderScene) -> None:
     p.bar((rect[0] + pad + 175, rect[1] + pad + 2, col_w - 190, 11), fraction, fill)
 
 
-def world(p: Painter, plane: PlaneView, s: LanderScene, poses, path, spawn, close_up) -> None:
-    """Everything that lives in world coordinates, back to front; a close-up has no distance
-    label and longer thrust bars."""
+def world(p: Painter, plane: PlaneView, s: LanderScene, poses, path, spawn=False, close_up=False):
+    """The world back to front; a close-up has longer thrust bars and no distance label."""
     # Grey outside the world, a sky gradient (by altitude) inside it.
     p.surface.fill(OUTSIDE)
     corners = np.array([[0.0, s.world_height], [s.world_width, 0.0]])
@@ -251,18 +249,6 @@ def world(p: Painter, plane: PlaneView, s: LanderScene, poses, path, spawn, clos
             p.line(start, start + up * full_px * fraction, THRUST, 3)
 
 
-def close_up(p: Painter, s: LanderScene, shade_poses, path_points, zoom: float) -> None:
-    """A zoomed window on the drone (top-left), framed and titled; p draws on that window."""
-    width, height = p.surface.get_size()
-    # The drone sits a little low so its thrust bars fit above it.
-    center = np.array(s.position) + np.array([0.0, 0.12 * height / CLOSE_UP_SCALE])
-    u0, v0 = width / 2.0 - center[0] * CLOSE_UP_SCALE, height / 2.0 + center[1] * CLOSE_UP_SCALE
-    plane = PlaneView(CLOSE_UP_SCALE, u0, v0)
-    world(p, plane, s, shade_poses, path_points, spawn=False, close_up=True)
-    p.pg.draw.rect(p.surface, (40, 40, 50), (0, 0, width, height), 2)
-    p.text(f"close-up ×{zoom:.0f}", (8, 6), TEXT, 18, bold=True)
-
-
 class LanderView(View):
     """Draws LanderScene frames: a window ("human") or (H, W, 3) uint8 arrays ("rgb_array"),
     with the episode's path and a shade every `shade_distance_m` travelled."""
@@ -312,10 +298,16 @@ class LanderView(View):
         plane = fit_world(s, self.size)
         shade_poses = self._shades if self.show_shades else ()
         path_points = np.array(self.path) if self.show_path else ()
-        world(p, plane, s, shade_poses, path_points, self.show_spawn_zone, close_up=False)
+        world(p, plane, s, shade_poses, path_points, spawn=self.show_spawn_zone)
         zoom = CLOSE_UP_SCALE / plane.scale
         if self._close_up is not None and zoom >= 1.5:  # in a small world it adds nothing
-            close_up(self._close_up, s, shade_poses, path_points, zoom)
+            # The drone a little low in the close-up, so its thrust bars fit above it.
+            (cw, ch), q = CLOSE_UP_SIZE, self._close_up
+            center = s.position + (0.0, 0.12 * ch / CLOSE_UP_SCALE)
+            u0, v0 = cw / 2.0 - center[0] * CLOSE_UP_SCALE, ch / 2.0 + center[1] * CLOSE_UP_SCALE
+            world(q, PlaneView(CLOSE_UP_SCALE, u0, v0), s, shade_poses, path_points, close_up=True)
+            q.pg.draw.rect(q.surface, (40, 40, 50), (0, 0, cw, ch), 2)
+            q.text(f"close-up ×{zoom:.0f}", (8, 6), TEXT, 18, bold=True)
         wind_indicator(p, s)
         if self.show_overlay:
             overlay(p, plane, s)

@@ -138,8 +138,7 @@ def next_waypoint(p: Painter, pr: Projector, scene: QuadScene) -> None:
 
 
 def drone(p: Painter, pr: Projector, scene: QuadScene, scale: float) -> None:
-    """Arms, rotor discs (coloured by spin, in the body plane), nose, vectors, hub on top;
-    `scale` times the real size, so a 0.1 m arm stays visible in a metres-wide box."""
+    """Arms, spin-coloured rotor discs, nose, vectors, hub on top; `scale` times its size."""
     rot = rotation_matrix(scene.quaternion)
     pos = scene.position
     arm = scene.arm_length * scale
@@ -296,8 +295,8 @@ def axis_gizmo(p: Painter, camera: OrbitCamera) -> None:
 
 
 def wind_dial(p: Painter, scene: QuadScene, camera: OrbitCamera) -> None:
-    """Top-right: the horizontal wind seen from above, turned so 'up' is where the camera
-    looks; its length grows with speed (full radius at 5 m/s)."""
+    """Top-right: the horizontal wind from above, up = where the camera looks; longer when
+    faster (full radius at 5 m/s)."""
     width = p.surface.get_width()
     center = np.array([width - 70.0, 72.0])
     radius = 44.0
@@ -351,11 +350,9 @@ HINT = "drag: rotate   wheel: zoom   W/A/S/D: move   Q/E: down/up   R: reset   E
 
 class QuadrotorView(View):
     """Draws QuadScene frames: a window ("human") or (H, W, 3) uint8 arrays ("rgb_array").
-
     In a window: drag to orbit, wheel to zoom, W/A/S/D to move, Q/E down/up, R to reset the
-    camera, Esc to close. The vehicle is drawn `drone_scale` times its size at its true
-    position; the trail keeps the episode's last `trail_steps` positions.
-    """
+    camera, Esc to close. The vehicle is drawn `drone_scale` times its size (a 0.1 m arm
+    stays visible); the trail keeps the episode's last `trail_steps` positions."""
 
     def __init__(
         self,

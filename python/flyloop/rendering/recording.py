@@ -36,9 +36,8 @@ def save_video(frames: Iterable[np.ndarray], path: str | Path, fps: float = 30.0
 
 
 def _save_gif(frames: list[np.ndarray], path: Path, fps: float, colors: int = 128) -> None:
-    """A looping GIF with ONE palette drawn from a sample of the frames, so Pillow can store
-    each frame as its difference to the last (a few kB a frame for these scenes, against
-    ~50 kB with a palette of its own per frame)."""
+    """A looping GIF with ONE palette from a sample of the frames: Pillow then stores each
+    frame as its change from the last (a few kB, against ~50 kB with a palette per frame)."""
     from PIL import Image  # the "render" extra's, as pygame
 
     images = [Image.fromarray(f) for f in frames]
