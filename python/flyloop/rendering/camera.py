@@ -103,16 +103,21 @@ class Projector:
         return None if cam[2] < self.camera.near else (self.pixels(cam), float(cam[2]))
 
     def segment(self, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """One segment's pixels, near-clipped, or None (scalar steps: faster than segments)."""
         ca, cb = self.camera.to_camera(np.stack([np.asarray(a, float), np.asarray(b, float)]))
-        clipped = self._clip(ca[None], cb[None])
-        return clipped[0] if clipped else None
+        da, db = ca[2] - self.camera.near, cb[2] - self.camera.near
+        if da < 0 and db < 0:
+            return None
+        if da < 0:
+            ca = ca + (cb - ca) * (da / (da - db))
+        elif db < 0:
+            cb = cb + (ca - cb) * (db / (db - da))
+        return tuple(self.pixels(np.stack([ca, cb])))
 
     def segments(self, a: np.ndarray, b: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
         """Many world segments a[i]-b[i] at once: the visible, near-clipped ones in pixels."""
-        return self._clip(self.camera.to_camera(np.asarray(a, float)), self.camera.to_camera(b))
-
-    def _clip(self, ca: np.ndarray, cb: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
         near = self.camera.near
+        ca, cb = self.camera.to_camera(np.asarray(a, float)), self.camera.to_camera(b)
         da, db = ca[:, 2:3] - near, cb[:, 2:3] - near
         keep = ((da >= 0) | (db >= 0))[:, 0]
         with np.errstate(divide="ignore", invalid="ignore"):

@@ -32,8 +32,7 @@ def _px(point: Point) -> tuple[int, int]:
 
 class Painter:
     def __init__(self, pg: Any, surface: Any) -> None:
-        self.pg = pg
-        self.surface = surface
+        self.pg, self.surface = pg, surface
         self._fonts: dict[tuple[int, bool], Any] = {}
 
     def font(self, size: int, bold: bool = False) -> Any:
@@ -95,8 +94,11 @@ class Painter:
         # Rounded in one go: a long dashed line has hundreds of dashes.
         ends = a_ + np.outer(np.arange(2 * first, 2 * last) / (2 * n), b_ - a_)
         ends = np.clip(ends, -_LIMIT, _LIMIT).round().astype(int).tolist()
-        for i in range(0, len(ends), 2):
-            self.line(ends[i], ends[i + 1], color, width)
+        for i in range(0, len(ends), 2):  # already pixels: line()'s clamping would be slow
+            if width <= 1:
+                self.pg.draw.aaline(self.surface, color, ends[i], ends[i + 1])
+            else:
+                self.pg.draw.line(self.surface, color, ends[i], ends[i + 1], width)
 
     def arrow(self, start: Point, end: Point, color: Color, width: int, head_px=11.0) -> None:
         s, e = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
@@ -156,10 +158,6 @@ class Painter:
         filled = (rect[0], rect[1], round(rect[2] * fraction), rect[3])
         self.pg.draw.rect(self.surface, color, filled)
         self.pg.draw.rect(self.surface, (10, 10, 20), rect, 1)
-
-
-def vector(value: Any) -> np.ndarray:
-    return np.array(value, dtype=float).reshape(-1)
 
 
 class View:
@@ -228,8 +226,7 @@ class View:
     def _events(self) -> list[Any] | None:
         """This frame's window events; None once the user closed the window (QUIT, Escape)."""
         if self._closed:
-            name = type(self).__name__
-            raise RuntimeError(f"this {name} is closed; create a new one to render again")
+            raise RuntimeError(f"this {type(self).__name__} is closed; create a new one to render")
         if self.render_mode != "human" or not self.is_open:
             return [] if self.is_open else None
         pg = self._pg

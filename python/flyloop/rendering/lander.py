@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..tasks import LANDING
-from .canvas import Painter, View, vector
+from .canvas import Painter, View
 
 SKY_TOP, SKY_BOTTOM, OUTSIDE = (196, 220, 246), (226, 238, 250), (120, 130, 145)
 GROUND, GROUND_EDGE, BOUNDS, SPAWN = (96, 148, 82), (62, 112, 58), (200, 70, 70), (178, 160, 80)
@@ -22,8 +22,7 @@ WIND, TEXT, GOOD, BAD = (50, 50, 200), (15, 15, 25), (0, 140, 0), (200, 0, 0)
 THRUST_BAR_PX = 40  # a full-thrust bar's length, as the reference (docs/reference/lander2d.md)
 CLOSE_UP_SIZE = (250, 180)
 CLOSE_UP_SCALE = 48.0  # px per metre: a 1 m drone is 48 px wide
-# What the scene shows when not told: the Landing task's defaults, read from the core.
-_CORE = LANDING.defaults
+_CORE = LANDING.defaults  # what a scene shows when not told
 
 
 @dataclass(eq=False)
@@ -63,7 +62,7 @@ class LanderScene:
 
     def __post_init__(self) -> None:
         for name in ("position", "velocity", "thrust", "wind_force", "spawn_center"):
-            setattr(self, name, vector(getattr(self, name)))
+            setattr(self, name, np.array(getattr(self, name), float).ravel())
         self.step = int(self.step)
 
     @property

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..tasks import HOVER
 from .camera import OrbitCamera, Projector
-from .canvas import Painter, View, vector
+from .canvas import Painter, View
 
 # Rotor i sits at (forward, left) * L/sqrt(2) in the body frame: PX4 quad-X order.
 ROTOR_POSITION_SIGNS = np.array([(1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (-1.0, -1.0)])
@@ -36,8 +36,7 @@ VELOCITY_SECONDS = 0.5  # the velocity arrow shows where the drone is in this ma
 WIND_M_PER_MPS = 0.12  # wind arrow length per m/s of wind
 DEGREES_PER_PIXEL, ZOOM_STEP, MIN_DISTANCE, MAX_DISTANCE = 0.3, 0.9, 0.5, 200.0
 MOVE_FRACTION = 0.012  # per frame, of the camera distance
-# What a scene shows when not told: the Hover task's defaults, read from the core.
-_CORE = HOVER.defaults
+_CORE = HOVER.defaults  # what a scene shows when not told
 
 
 def rotation_matrix(q_wxyz: np.ndarray) -> np.ndarray:
@@ -72,11 +71,11 @@ class QuadScene:
     def __post_init__(self) -> None:
         for name in ("position", "velocity", "wind", "target", "next_waypoint"):
             if getattr(self, name) is not None:
-                setattr(self, name, vector(getattr(self, name)))
-        q = vector(self.quaternion)
+                setattr(self, name, np.array(getattr(self, name), float).ravel())
+        q = np.array(self.quaternion, float).ravel()
         self.quaternion = q / float(np.linalg.norm(q))
         # Lagged motor states may overshoot by rounding; the bars show [0, 1].
-        self.motors = np.clip(vector(self.motors), 0.0, 1.0)
+        self.motors = np.clip(np.array(self.motors, float).ravel(), 0.0, 1.0)
         self.time_s, self.step = float(self.time_s), int(self.step)
         if self.waypoints_reached is not None:
             self.waypoints_reached = int(self.waypoints_reached)
