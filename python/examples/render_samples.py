@@ -16,9 +16,18 @@ import numpy as np
 from PIL import Image
 
 from flyloop.rendering import LanderScene, LanderView, QuadrotorView, QuadScene, save_video
-from flyloop.rendering.quadrotor import quaternion_from_euler
 
 REPO = Path(__file__).resolve().parents[2]
+
+
+def quaternion_from_euler(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """The unit quaternion [w, x, y, z] of intrinsic Z-Y-X angles in radians."""
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    w, x = cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy
+    y, z = cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy
+    return np.array([w, x, y, z])
 
 
 def quad_scenes(steps: int = 90) -> list[QuadScene]:
@@ -41,7 +50,6 @@ def quad_scenes(steps: int = 90) -> list[QuadScene]:
                 velocity=velocity,
                 quaternion=quaternion_from_euler(0.16, -0.22, math.radians(30 + 25 * t)),
                 motors=(0.58, 0.49, 0.52, 0.61),
-                body_rates=(0.1, -0.05, 0.2),
                 wind=(2.1, -1.4, 0.15),
                 target=target,
                 next_waypoint=(-0.9, 1.1, 2.6),

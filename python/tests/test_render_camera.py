@@ -1,21 +1,25 @@
-"""Camera, frame-convention and 2D-plane math of flyloop.rendering (pure numpy, no pygame)."""
+"""Camera and frame-convention math of flyloop.rendering (pure numpy, no pygame)."""
 
 import math
 
 import numpy as np
 import pytest
 
-from flyloop.rendering.camera import OrbitCamera, clip_polygon_near
-from flyloop.rendering.lander import PlaneView
-from flyloop.rendering.quadrotor import (
-    ROTOR_SPIN,
-    euler_rpy,
-    quaternion_from_euler,
-    rotation_matrix,
-    rotor_positions_body,
-)
+from flyloop.rendering import QuadScene
+from flyloop.rendering.camera import OrbitCamera, Projector
+from flyloop.rendering.quadrotor import ROTOR_SPIN, info_lines, rotation_matrix
 
 W, H = 800, 600
+
+
+def quaternion_from_euler(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """The unit quaternion [w, x, y, z] of intrinsic Z-Y-X angles in radians."""
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    w, x = cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy
+    y, z = cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy
+    return np.array([w, x, y, z])
 
 
 def test_look_at_point_lands_in_the_frame_centre():
@@ -58,33 +62,41 @@ def test_basis_is_orthonormal_and_right_handed_at_any_pose():
 
 def test_perspective_shrinks_with_depth():
     cam = OrbitCamera(look_at=np.zeros(3), distance=4.0, azimuth_deg=0, elevation_deg=0)
-    near_r = cam.pixel_radius(0.1, 2.0, H)
-    far_r = cam.pixel_radius(0.1, 8.0, H)
-    assert near_r == pytest.approx(4 * far_r)
-    # A 1 m offset at depth 4 spans the projected distance that pixel_radius predicts.
+    pr = Projector(cam, (W, H))
+    assert pr.radius(0.1, 2.0) == pytest.approx(4 * pr.radius(0.1, 8.0))
+    # A 1 m offset at depth 4 spans the projected distance that radius predicts.
     (u0, _), _ = cam.project(np.zeros(3), W, H)
     (u1, _), _ = cam.project(np.array([1.0, 0, 0]), W, H)
-    assert u1 - u0 == pytest.approx(cam.pixel_radius(1.0, 4.0, H))
+    assert u1 - u0 == pytest.approx(pr.radius(1.0, 4.0))
 
 
 def test_points_behind_the_camera_are_not_visible_and_segments_are_clipped():
+    # Looking north from (0, -5, 0): camera right = +x, up = +z, depth = y + 5.
     cam = OrbitCamera(look_at=np.zeros(3), distance=5.0, azimuth_deg=0, elevation_deg=0)
-    behind = cam.position() - np.array([0.0, 1.0, 0.0])
+    pr = Projector(cam, (W, H))
+    behind = np.array([1.0, -6.0, 0.5])  # depth -1
     _, visible = cam.project(behind, W, H)
     assert not visible
-    assert cam.clip_segment(behind, behind - [0, 1, 0]) is None
-    a, b = cam.clip_segment(behind, np.zeros(3))
-    assert a[2] == pytest.approx(cam.near)
-    assert b[2] == pytest.approx(5.0)
+    assert pr.segment(behind, behind - [0, 1, 0]) is None
+    a, b = pr.segment(behind, np.zeros(3))
+    np.testing.assert_allclose(b, [W / 2, H / 2])
+    # Cut where the depth is `near`: 1.05 / 6 of the way from (1, 0.5) at depth -1 to (0, 0).
+    right, up = np.array([1.0, 0.5]) * (1 - 1.05 / 6)
+    focal = (H / 2) / math.tan(math.radians(cam.fov_deg) / 2)
+    np.testing.assert_allclose(a, [W / 2 + focal * right / cam.near, H / 2 - focal * up / cam.near])
 
 
-def test_near_plane_polygon_clipping():
-    square = np.array([[-1, -1, -1.0], [1, -1, -1.0], [1, 1, 3.0], [-1, 1, 3.0]])
-    out = clip_polygon_near(square, 1.0)
-    assert len(out) == 4
-    assert np.all(out[:, 2] >= 1.0 - 1e-12)
-    assert sorted(np.round(out[:, 2], 9)) == [1.0, 1.0, 3.0, 3.0]
-    assert len(clip_polygon_near(square - [0, 0, 10], 1.0)) == 0
+def test_a_polygon_crossing_the_near_plane_is_cut_there():
+    # Looking north from (0, -5, 0): camera right = +x, up = +z, depth = y + 5.
+    cam = OrbitCamera(look_at=np.zeros(3), distance=5.0, azimuth_deg=0, elevation_deg=0)
+    pr = Projector(cam, (W, H))
+    square = np.array([[-1, -6, -1.0], [1, -6, -1.0], [1, -2, 1.0], [-1, -2, 1.0]])
+    t = (cam.near + 1) / 4  # depth -1 to 3 along the sides: near is crossed a fraction t in
+    corners = [(x, -1 + 2 * t, cam.near) for x in (-1, 1)] + [(x, 1, 3.0) for x in (-1, 1)]
+    focal = (H / 2) / math.tan(math.radians(cam.fov_deg) / 2)
+    expected = sorted((W / 2 + focal * x / d, H / 2 - focal * u / d) for x, u, d in corners)
+    np.testing.assert_allclose(sorted(map(tuple, pr.polygon(square))), expected)
+    assert len(pr.polygon(square - [0, 10, 0])) == 0  # wholly behind
 
 
 def test_orbit_move_and_reset():
@@ -103,21 +115,7 @@ def test_orbit_move_and_reset():
     assert (cam.azimuth_deg, cam.elevation_deg, cam.distance) == (10, 20, 6.5)
 
 
-def test_bad_camera_is_refused_by_name():
-    with pytest.raises(ValueError, match="distance"):
-        OrbitCamera(distance=0.0)
-    with pytest.raises(ValueError, match="fov_deg"):
-        OrbitCamera(fov_deg=180.0)
-
-
-def test_rotor_layout_is_px4_quad_x():
-    r = rotor_positions_body(0.1)
-    lever = 0.1 / math.sqrt(2)
-    # 0 front-right, 1 rear-left, 2 front-left, 3 rear-right (body FLU: +x front, +y left).
-    np.testing.assert_allclose(r[0], [lever, -lever, 0])
-    np.testing.assert_allclose(r[1], [-lever, lever, 0])
-    np.testing.assert_allclose(r[2], [lever, lever, 0])
-    np.testing.assert_allclose(r[3], [-lever, -lever, 0])
+def test_rotor_spin_is_px4_quad_x():
     assert ROTOR_SPIN == (-1, -1, 1, 1)  # CCW, CCW, CW, CW as core/src/quadrotor/dynamics.rs
 
 
@@ -128,33 +126,18 @@ def test_quaternion_rotation_and_euler_round_trip():
     roll = quaternion_from_euler(0.3, 0.0, 0.0)
     # Positive roll about the forward axis lifts the left (+y) side: body z tips toward -y.
     assert (rotation_matrix(roll) @ [0, 0, 1])[1] < -0.25
-    for angles in [(0.1, -0.2, 0.3), (-1.0, 0.7, -2.5), (0.0, 1.2, 3.0)]:
+    for angles in [(0.1, -0.2, 0.3), (-1.0, 0.7, -2.5), (0.05, 1.2, 3.0)]:
         q = quaternion_from_euler(*angles)
         assert np.linalg.norm(q) == pytest.approx(1.0)
-        np.testing.assert_allclose(euler_rpy(q), angles, atol=1e-9)
+        # The info panel reads the angles back.
+        s = QuadScene(time_s=0, step=0, position=(0, 0, 1), velocity=(0, 0, 0), quaternion=q)
+        roll, pitch, yaw = np.degrees(angles)
+        assert info_lines(s)[3][0] == f"Roll {roll:+.1f}°  Pitch {pitch:+.1f}°  Yaw {yaw:+.1f}°"
         m = rotation_matrix(q)
         np.testing.assert_allclose(m @ m.T, np.eye(3), atol=1e-12)
 
 
-def test_plane_fits_the_world_and_round_trips():
-    plane = PlaneView.fit_world(50.0, 50.0, (800, 800), margin_px=12)
-    assert plane.scale == pytest.approx(776 / 50)
-    np.testing.assert_allclose(plane.to_screen((0.0, 0.0)), [12, 788])
-    np.testing.assert_allclose(plane.to_screen((50.0, 50.0)), [788, 12])
-    wide = PlaneView.fit_world(100.0, 20.0, (800, 400), margin_px=0)
-    np.testing.assert_allclose(wide.to_screen((50.0, 10.0)), [400, 200])
-    pts = np.array([[3.0, 4.0], [25.0, 40.0]])
-    np.testing.assert_allclose(plane.to_world(plane.to_screen(pts)), pts)
-    zoom = PlaneView.centred_on(np.array([25.0, 40.0]), 48.0, (250, 180))
-    np.testing.assert_allclose(zoom.to_screen((25.0, 40.0)), [125, 90])
-    np.testing.assert_allclose(zoom.to_screen((26.0, 41.0)) - [125, 90], [48, -48])
-    with pytest.raises(ValueError, match="cannot fit"):
-        PlaneView.fit_world(50.0, 50.0, (20, 20), margin_px=12)
-
-
 def test_batched_segments_match_one_by_one_clipping():
-    from flyloop.rendering.camera import Projector
-
     cam = OrbitCamera(look_at=np.zeros(3), distance=3.0, azimuth_deg=20, elevation_deg=10)
     pr = Projector(cam, (W, H))
     rng = np.random.default_rng(7)

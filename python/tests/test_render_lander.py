@@ -36,6 +36,12 @@ def scene(**over):
     return LanderScene(**base)
 
 
+def to_px(point):
+    """Where the 800 x 800 view draws a point of the SMALL world: 12 px margins, 77.6 px/m."""
+    x, y = np.asarray(point, dtype=float)
+    return np.array([12 + 77.6 * x, 788 - 77.6 * y])
+
+
 def mask_of(frame, *colors):
     out = np.zeros(frame.shape[:2], dtype=bool)
     for c in colors:
@@ -87,7 +93,7 @@ def test_default_world_frame_and_moving_changes_it():
 )
 def test_drone_pixels_follow_position_and_angle(view, position, angle):
     frame = view.render(scene(position=position, angle=angle))
-    expected = view.world_to_screen(scene(), np.array(position))
+    expected = to_px(position)
     got, count = centroid(mask_of(frame, ld.FRAME, ld.MOTOR))
     assert count > 300
     assert np.hypot(*(got - expected)) < 1.5, (got, expected)  # vertices snap to pixels
@@ -105,7 +111,7 @@ def test_platform_is_where_the_scene_says(view, platform_x):
     s = scene(platform_x=platform_x)
     frame = view.render(s)
     got, count = centroid(mask_of(frame, ld.PLATFORM))
-    expected = view.world_to_screen(s, np.array([platform_x, 2.25]))
+    expected = to_px([platform_x, 2.25])
     assert count > 1000
     assert np.hypot(*(got - expected)) < 1.5, (got, expected)
 
@@ -113,8 +119,8 @@ def test_platform_is_where_the_scene_says(view, platform_x):
 def test_sensor_line_runs_from_the_drone_to_the_platform_top(view):
     s = scene(position=(2.0, 8.0), platform_x=7.0)
     frame = view.render(s)
-    a = view.world_to_screen(s, np.array(s.position))
-    b = view.world_to_screen(s, np.array(s.platform_top))
+    a = to_px(s.position)
+    b = to_px(s.platform_top)
     sensor = mask_of(frame, ld.SENSOR)
 
     def hits(p0, p1):
@@ -127,7 +133,7 @@ def test_sensor_line_runs_from_the_drone_to_the_platform_top(view):
 
 
 def test_thrust_bars_grow_from_the_firing_motor(view):
-    centre = view.world_to_screen(scene(), np.array([4.0, 6.0]))
+    centre = to_px([4.0, 6.0])
     for thrust, side in (((0.0, 15.0), 1), ((15.0, 0.0), -1), ((7.5, 0.0), -1)):
         frame = view.render(scene(thrust=thrust))
         ys, xs = np.nonzero(mask_of(frame, ld.THRUST))
@@ -166,12 +172,12 @@ def test_path_and_shades_mark_past_positions_and_restart_each_episode():
     differs = np.any(a != b, axis=-1)
     # Between consecutive early poses (far from the drone now) the path is drawn...
     for p0, p1 in zip(poses[:10], poses[1:11], strict=True):
-        mid = with_history.world_to_screen(scene(), (np.array(p0) + p1) / 2)
+        mid = to_px((np.array(p0) + p1) / 2)
         u, v = np.round(mid).astype(int)
         assert differs[v - 1 : v + 2, u - 1 : u + 2].any()
     # ...and a shade sits at the first pose and every >1 m after it.
     for pose in (poses[0], poses[5]):
-        u, v = np.round(with_history.world_to_screen(scene(), np.array(pose))).astype(int)
+        u, v = np.round(to_px(pose)).astype(int)
         assert differs[v - 3 : v + 4, u - 20 : u + 21].sum() > 50
     # A lower step number is a new episode: the old path and shades are gone.
     a = with_history.render(scene(step=0, position=(8.0, 8.0)))

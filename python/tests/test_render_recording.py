@@ -8,7 +8,6 @@ import pytest
 from PIL import Image
 
 from flyloop.rendering import (
-    FrameRecorder,
     LanderScene,
     LanderView,
     QuadrotorView,
@@ -125,20 +124,6 @@ def test_bad_input_is_refused_before_writing(tmp_path):
     with pytest.raises(ValueError, match="fps"):
         save_video(frames, tmp_path / "a.gif", fps=0)
     assert not list(tmp_path.iterdir())
-    recorder = FrameRecorder(max_frames=1)
-    with pytest.raises(ValueError, match="rgb_array"):
-        recorder.add(None)
-
-
-def test_frame_recorder_copies_and_caps():
-    recorder = FrameRecorder(max_frames=2)
-    frame = np.zeros((4, 4, 3), np.uint8)
-    recorder.add(frame)
-    frame[:] = 255
-    recorder.add(frame)
-    recorder.add(frame)
-    assert len(recorder) == 2
-    assert recorder.frames[0].max() == 0  # a copy, not the caller's buffer
 
 
 def test_record_episode_saves_one_frame_per_step(tmp_path):

@@ -5,8 +5,21 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..tasks import LANDING, LANDING_V1, parameter_values
+from ..tasks import LANDING, LANDING_V1, observation_slices, parameter_values
 from .base import FlyloopEnv
+
+# Endings other than landed and crashed, as the view's text panel names them.
+OUTCOMES = (
+    ("lost_control", "lost control"),
+    ("out_of_bounds", "out of bounds"),
+    ("battery_empty", "battery empty"),
+    ("time_limit", "time limit reached"),
+)
+# The model's sizes the view draws.
+WORLD = (
+    "world_width world_height ground_height platform_width platform_height drone_width "
+    "drone_height max_thrust initial_battery"
+).split()
 
 
 class Lander2DEnv(FlyloopEnv):
@@ -151,17 +164,35 @@ class Lander2DEnv(FlyloopEnv):
         return LanderView(render_mode, fps=self.metadata["render_fps"], **self._render_options)
 
     def _scene(self, obs, info, reward):
-        from ..rendering import lander_scene
+        from ..rendering import LanderScene
 
-        values = parameter_values(self.core)
-        return lander_scene(
-            info,
-            obs,
-            dt=self.dt,
+        p, at, step = parameter_values(self.core), observation_slices(self.core), int(info["step"])
+        # A moving platform's velocity is observed as a fraction of platform_speed.
+        moving = "platform_velocity" in at
+        return LanderScene(
+            time_s=step * self.dt,
+            step=step,
+            position=info["position"],
+            velocity=info["velocity"],
+            angle=float(info["angle"]),
+            angular_velocity=float(info["angular_velocity"]),
+            thrust=info["thrust"],
+            battery=float(info["battery"]),
+            platform_x=float(info["platform_position"][0]),
+            platform_vx=float(obs[at["platform_velocity"]][0]) * float(p["platform_speed"])
+            if moving
+            else 0.0,
+            wind_force=info["wind_force"],
+            wind_speed=float(p["wind_speed"]) if p["wind_enabled"] else 0.0,
+            landed=bool(info["landed"]),
+            crashed=bool(info["crashed"]),
+            outcome=next((text for key, text in OUTCOMES if info[key]), ""),
+            max_steps=int(p["max_steps"]),
             reward=reward,
             episode_return=self._episode_return,
-            max_steps=int(values["max_steps"]),
-            params=values,
+            spawn_center=(float(p["spawn_x"]), float(p["spawn_y"])),
+            spawn_half_range=float(p["initial_pos_random_range_m"]),
+            **{name: float(p[name]) for name in WORLD},
         )
 
 

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from ..tasks import HOVER
+import numpy as np
+
+from ..tasks import HOVER, observation_slices, parameter_values
 from .base import FlyloopEnv
 
 
@@ -119,8 +121,30 @@ class QuadHoverEnv(FlyloopEnv):
         return QuadrotorView(render_mode, fps=self.metadata["render_fps"])
 
     def _scene(self, obs, info, reward):
-        from ..rendering import quad_scene
+        from ..rendering import QuadScene
 
-        return quad_scene(
-            obs, info, reward=reward, episode_return=self._episode_return, core=self.core
+        obs = np.asarray(obs, dtype=float)
+        at, values = observation_slices(self.core), parameter_values(self.core)
+
+        def part(name, otherwise):
+            # The rates interface observes neither attitude nor motors: drawn level, at 0.
+            return obs[at[name]] if name in at else otherwise
+
+        crashed, out = info.get("crashed"), info.get("out_of_bounds")
+        return QuadScene(
+            time_s=info["episode_time"],
+            step=info["step_count"],
+            position=info["position"],
+            velocity=obs[at["velocity"]],
+            quaternion=part("quaternion", (1.0, 0.0, 0.0, 0.0)),
+            wind=part("wind", np.zeros(3)),
+            motors=part("motor_states", np.zeros(4)),
+            target=info.get("target_position"),
+            next_waypoint=info.get("next_waypoint_pos"),
+            reward=reward,
+            episode_return=self._episode_return,
+            bounds_half_size=float(values["space_side_length"]) / 2.0,
+            arm_length=float(values["arm_length"]),
+            waypoints_reached=info.get("waypoints_reached"),
+            status="crashed" if crashed else "out of bounds" if out else "",
         )

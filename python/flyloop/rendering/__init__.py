@@ -1,30 +1,23 @@
-"""Rendering for flyloop's envs: pygame views fed with plain per-step scene data.
+"""Rendering for flyloop's envs: pygame views of per-step scenes, and saving frames.
 
-    from flyloop.rendering import QuadrotorView, QuadScene
-    view = QuadrotorView("rgb_array")          # or "human" for a window
-    frame = view.render(QuadScene(...))        # (720, 960, 3) uint8; None in human mode
-    view.close()
+    view = QuadrotorView("rgb_array")    # or "human" for a window
+    frame = view.render(QuadScene(...))  # (720, 960, 3) uint8; None in human mode
 
-One file per view (quadrotor.py, lander.py: scene, drawing, view), the 3D camera
-(camera.py), what both draw with (canvas.py) and saving frames (recording.py). Importing
-this package does not import pygame: each view's constructor does.
-"""
+One file per view (quadrotor.py, lander.py), the 3D camera (camera.py), what both draw
+with (canvas.py), recording.py. pygame is imported by a view's constructor, not here."""
 
 from .camera import OrbitCamera
-from .lander import LanderScene, LanderView, lander_scene
-from .quadrotor import QuadrotorView, QuadScene, quad_scene
-from .recording import FrameRecorder, Recording, record_episode, save_video
+from .lander import LanderScene, LanderView
+from .quadrotor import QuadrotorView, QuadScene
+from .recording import Recording, record_episode, save_video
 
 __all__ = [
-    "FrameRecorder",
     "LanderScene",
     "LanderView",
     "OrbitCamera",
     "QuadScene",
     "QuadrotorView",
     "Recording",
-    "lander_scene",
-    "quad_scene",
     "record_episode",
     "save_video",
 ]

@@ -1,11 +1,7 @@
-"""The quadrotor view's 3D camera, pure numpy: a perspective orbit camera and a Projector
-(the camera bound to a frame size, near-plane clipped).
-
-``azimuth_deg`` is the compass direction the camera looks toward (0 = north/+y, 90 = east/+x);
-``elevation_deg`` is how far it looks down from the horizon. Camera space: x right, y up,
-z (depth) forward. Screen: pixels, origin top-left, v downward; ``fov_deg`` is the vertical
-field of view.
-"""
+"""The quadrotor view's 3D camera, pure numpy: an orbit camera and a Projector (the camera
+bound to a frame size, near-plane clipped). ``azimuth_deg``: the compass direction looked
+toward (0 = north/+y, 90 = east/+x); ``elevation_deg``: down from the horizon; ``fov_deg``:
+vertical. Camera space: x right, y up, z depth; pixels from the top-left, v down."""
 
 from __future__ import annotations
 
@@ -14,11 +10,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-MAX_ELEVATION_DEG = 89.0
+MAX_ELEVATION_DEG = 89.0  # short of straight up or down, where the view would flip
 
 
 @dataclass(eq=False)
 class OrbitCamera:
+    """A perspective camera orbiting `look_at` at `distance` metres; angles in degrees."""
+
     look_at: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
     distance: float = 6.5
     azimuth_deg: float = 35.0
@@ -28,24 +26,13 @@ class OrbitCamera:
 
     def __post_init__(self) -> None:
         self.look_at = np.asarray(self.look_at, dtype=float).reshape(3)
-        if not (self.distance > 0 and 0 < self.fov_deg < 180 and self.near > 0):
-            raise ValueError(
-                f"camera needs distance > 0, 0 < fov_deg < 180 and near > 0, got "
-                f"distance={self.distance}, fov_deg={self.fov_deg}, near={self.near}"
-            )
         self.elevation_deg = _clamp_elevation(self.elevation_deg)
         self._home = (self.look_at.copy(), self.distance, self.azimuth_deg, self.elevation_deg)
-        self._cache_key: tuple | None = None
-        self._cache: tuple[np.ndarray, np.ndarray] = (np.eye(3), np.zeros(3))
+        self._cache_key: tuple | None = None  # the pose _view last computed
 
     def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Unit vectors (right, up, forward) of the camera in world coordinates."""
-        rows = self._view()[0]
-        return rows[0].copy(), rows[1].copy(), rows[2].copy()
-
-    def position(self) -> np.ndarray:
-        """Where the camera sits in the world, metres."""
-        return self._view()[1].copy()
+        return tuple(self._view()[0].copy())
 
     def to_camera(self, points: np.ndarray) -> np.ndarray:
         """World points (..., 3) to camera coordinates (..., 3): right, up, depth."""
@@ -53,8 +40,7 @@ class OrbitCamera:
         return (np.asarray(points, dtype=float) - position) @ rows.T
 
     def _view(self) -> tuple[np.ndarray, np.ndarray]:
-        """(3x3 rows right/up/forward, position), recomputed only when the pose changed: a
-        frame projects thousands of points through the same pose."""
+        """(rows right/up/forward, position), cached: a frame projects thousands of points."""
         key = (self.azimuth_deg, self.elevation_deg, self.distance, *self.look_at.tolist())
         if self._cache_key != key:
             az, el = math.radians(self.azimuth_deg), math.radians(self.elevation_deg)
@@ -65,39 +51,10 @@ class OrbitCamera:
             self._cache_key = key
         return self._cache
 
-    def focal_px(self, height: int) -> float:
-        """Pixels per unit of (lateral offset / depth)."""
-        return (height / 2.0) / math.tan(math.radians(self.fov_deg) / 2.0)
-
-    def project_camera(self, cam: np.ndarray, width: int, height: int) -> np.ndarray:
-        """Camera points (..., 3) with depth >= near to screen pixels (..., 2), float."""
-        cam = np.asarray(cam, dtype=float)
-        f = self.focal_px(height)
-        depth = np.maximum(cam[..., 2], self.near)
-        u = width / 2.0 + f * cam[..., 0] / depth
-        v = height / 2.0 - f * cam[..., 1] / depth
-        return np.stack([u, v], axis=-1)
-
     def project(self, points: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
         """World points (..., 3) to (pixels (..., 2), visible (...)): visible = in front of near."""
         cam = self.to_camera(points)
-        return self.project_camera(cam, width, height), cam[..., 2] >= self.near
-
-    def clip_segment(self, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-        """The part of world segment a-b in front of the near plane, in camera coordinates."""
-        ca, cb = self.to_camera(np.stack([a, b]))
-        da, db = ca[2] - self.near, cb[2] - self.near
-        if da < 0 and db < 0:
-            return None
-        if da < 0:
-            ca = ca + (cb - ca) * (da / (da - db))
-        elif db < 0:
-            cb = cb + (ca - cb) * (db / (db - da))
-        return ca, cb
-
-    def pixel_radius(self, radius_m: float, depth: float, height: int) -> float:
-        """On-screen radius in pixels of a sphere of radius_m at this depth."""
-        return self.focal_px(height) * radius_m / max(depth, self.near)
+        return Projector(self, (width, height)).pixels(cam), cam[..., 2] >= self.near
 
     def orbit(self, d_azimuth_deg: float, d_elevation_deg: float) -> None:
         """Turn around the look-at point; elevation stays short of straight up/down."""
@@ -125,40 +82,37 @@ def _clamp_elevation(value: float) -> float:
     return max(-MAX_ELEVATION_DEG, min(MAX_ELEVATION_DEG, float(value)))
 
 
-def clip_polygon_near(cam_points: np.ndarray, near: float) -> np.ndarray:
-    """The part of a convex camera-space polygon (N, 3) with depth >= near (Sutherland-Hodgman
-    against one plane); (0, 3) when it lies wholly behind."""
-    out: list[np.ndarray] = []
-    pts = np.asarray(cam_points, dtype=float)
-    for i in range(len(pts)):
-        a, b = pts[i - 1], pts[i]
-        da, db = a[2] - near, b[2] - near
-        if db >= 0:
-            if da < 0:
-                out.append(a + (b - a) * (da / (da - db)))
-            out.append(b)
-        elif da >= 0:
-            out.append(a + (b - a) * (da / (da - db)))
-    return np.array(out) if out else np.zeros((0, 3))
-
-
 class Projector:
     """A camera bound to a frame size: world points to pixels, near-plane clipped."""
 
     def __init__(self, camera: OrbitCamera, size: tuple[int, int]) -> None:
         self.camera = camera
         self.width, self.height = size
+        # Pixels per unit of (lateral offset / depth).
+        self.focal = (self.height / 2.0) / math.tan(math.radians(camera.fov_deg) / 2.0)
 
-    def _pixels(self, cam: np.ndarray) -> np.ndarray:
-        return self.camera.project_camera(cam, self.width, self.height)
+    def pixels(self, cam: np.ndarray) -> np.ndarray:
+        """Camera points (..., 3) to screen pixels (..., 2); depth is floored at near."""
+        depth = np.maximum(cam[..., 2], self.camera.near)
+        u = self.width / 2.0 + self.focal * cam[..., 0] / depth
+        v = self.height / 2.0 - self.focal * cam[..., 1] / depth
+        return np.stack([u, v], axis=-1)
 
     def point(self, p: np.ndarray) -> tuple[np.ndarray, float] | None:
         cam = self.camera.to_camera(p)
-        return None if cam[2] < self.camera.near else (self._pixels(cam), float(cam[2]))
+        return None if cam[2] < self.camera.near else (self.pixels(cam), float(cam[2]))
 
     def segment(self, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-        clipped = self.camera.clip_segment(np.asarray(a, float), np.asarray(b, float))
-        return None if clipped is None else tuple(self._pixels(np.stack(clipped)))
+        """One segment's pixels, near-clipped, or None (scalar steps: faster than segments)."""
+        ca, cb = self.camera.to_camera(np.stack([np.asarray(a, float), np.asarray(b, float)]))
+        da, db = ca[2] - self.camera.near, cb[2] - self.camera.near
+        if da < 0 and db < 0:
+            return None
+        if da < 0:
+            ca = ca + (cb - ca) * (da / (da - db))
+        elif db < 0:
+            cb = cb + (ca - cb) * (db / (db - da))
+        return tuple(self.pixels(np.stack([ca, cb])))
 
     def segments(self, a: np.ndarray, b: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
         """Many world segments a[i]-b[i] at once: the visible, near-clipped ones in pixels."""
@@ -170,11 +124,23 @@ class Projector:
             t = np.where(da - db != 0, da / (da - db), 0.0)
         ca2 = np.where(da < 0, ca + (cb - ca) * t, ca)
         cb2 = np.where(db < 0, cb + (ca - cb) * (db / np.where(db - da != 0, db - da, 1)), cb)
-        return list(zip(self._pixels(ca2[keep]), self._pixels(cb2[keep]), strict=True))
+        return list(zip(self.pixels(ca2[keep]), self.pixels(cb2[keep]), strict=True))
 
     def polygon(self, points: np.ndarray) -> np.ndarray:
-        cam = clip_polygon_near(self.camera.to_camera(points), self.camera.near)
-        return self._pixels(cam) if len(cam) >= 3 else np.zeros((0, 2))
+        """A convex world polygon's pixels, cut where it crosses the near plane (Sutherland-
+        Hodgman against one plane); (0, 2) when fewer than 3 corners are left."""
+        cam, near, out = self.camera.to_camera(points), self.camera.near, []
+        for i in range(len(cam)):
+            a, b = cam[i - 1], cam[i]
+            da, db = a[2] - near, b[2] - near
+            if db >= 0:
+                if da < 0:
+                    out.append(a + (b - a) * (da / (da - db)))
+                out.append(b)
+            elif da >= 0:
+                out.append(a + (b - a) * (da / (da - db)))
+        return self.pixels(np.array(out)) if len(out) >= 3 else np.zeros((0, 2))
 
     def radius(self, radius_m: float, depth: float) -> float:
-        return self.camera.pixel_radius(radius_m, depth, self.height)
+        """On-screen radius in pixels of a sphere of radius_m at this depth."""
+        return self.focal * radius_m / max(depth, self.camera.near)

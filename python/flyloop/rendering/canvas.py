@@ -1,11 +1,6 @@
-"""What both views draw with: View (the frame: an off-screen surface for "rgb_array" or the
-window for "human"), Painter (2D primitives over a surface) and the per-episode history
-(flight path, shades).
-
-pygame is imported by `import_pygame`, on a view's first use, so `import flyloop.rendering`
-stays free of it. Coordinates are float pixels, clamped to a range pygame accepts (a
-blown-up state would give huge integers).
-"""
+"""What both views draw with: View (the frame, off-screen or a window, and the episode's path)
+and Painter (2D primitives in float pixels, clamped to a range pygame accepts: a blown-up
+state would give huge integers)."""
 
 from __future__ import annotations
 
@@ -29,19 +24,6 @@ _font_files: dict[bool, str | None] = {}
 _window_owner: View | None = None
 
 
-def import_pygame(render_mode: str) -> Any:
-    """pygame, with SDL told to draw off-screen when there is no display for rgb_array."""
-    has_display = sys.platform in ("win32", "darwin") or bool(
-        os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
-    )
-    if render_mode == "rgb_array" and not has_display:
-        os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
-    os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
-    import pygame
-
-    return pygame
-
-
 def _px(point: Point) -> tuple[int, int]:
     x = min(max(float(point[0]), -_LIMIT), _LIMIT)
     y = min(max(float(point[1]), -_LIMIT), _LIMIT)
@@ -50,10 +32,8 @@ def _px(point: Point) -> tuple[int, int]:
 
 class Painter:
     def __init__(self, pg: Any, surface: Any) -> None:
-        self.pg = pg
-        self.surface = surface
+        self.pg, self.surface = pg, surface
         self._fonts: dict[tuple[int, bool], Any] = {}
-        self._gradient: tuple[tuple, Any] | None = None
 
     def font(self, size: int, bold: bool = False) -> Any:
         """A font whose capitals are about size * 0.45 px tall (pygame's default font scale)."""
@@ -71,19 +51,15 @@ class Painter:
             self._fonts[size, bold] = font
         return self._fonts[size, bold]
 
-    def vertical_gradient(self, top: Color, bottom: Color) -> None:
-        """Fill with a top-to-bottom gradient (drawn once per size and colours, then blitted)."""
-        size = self.surface.get_size()
-        key = (size, top, bottom)
-        if self._gradient is None or self._gradient[0] != key:
-            layer = self.pg.Surface(size)
-            width, height = size
-            for y in range(0, height, 4):
-                t = y / max(1, height - 1)
-                color = tuple(round(a + (b - a) * t) for a, b in zip(top, bottom, strict=True))
-                self.pg.draw.rect(layer, color, (0, y, width, 4))
-            self._gradient = (key, layer)
-        self.surface.blit(self._gradient[1], (0, 0))
+    def gradient(self, box: tuple[int, int, int, int], v_top, v_bottom, top, bottom) -> None:
+        """Fill box (left, top, right, bottom; clipped to the frame) in 4 px bands, shading
+        from colour `top` at row v_top to `bottom` at row v_bottom."""
+        (width, height), (left, y0, right, y1) = self.surface.get_size(), box
+        left, y0, right, y1 = max(0, left), max(0, y0), min(width, right), min(height, y1)
+        for v in range(y0, y1, 4):
+            t = (v - v_top) / max(1.0, v_bottom - v_top)
+            color = tuple(round(a + (b - a) * t) for a, b in zip(top, bottom, strict=True))
+            self.pg.draw.rect(self.surface, color, (left, v, right - left, min(4, y1 - v)))
 
     def line(self, a: Point, b: Point, color: Color, width: int = 1) -> None:
         if width <= 1:
@@ -118,7 +94,7 @@ class Painter:
         # Rounded in one go: a long dashed line has hundreds of dashes.
         ends = a_ + np.outer(np.arange(2 * first, 2 * last) / (2 * n), b_ - a_)
         ends = np.clip(ends, -_LIMIT, _LIMIT).round().astype(int).tolist()
-        for i in range(0, len(ends), 2):
+        for i in range(0, len(ends), 2):  # already pixels: line()'s clamping would be slow
             if width <= 1:
                 self.pg.draw.aaline(self.surface, color, ends[i], ends[i + 1])
             else:
@@ -154,9 +130,8 @@ class Painter:
 
     def translucent_polygon(self, points: Sequence[Point], color: Color, alpha: int) -> None:
         pts = np.array([_px(p) for p in points])
-        # The layer spans only the polygon's part of the frame (and a margin, where pygame's
-        # clipping leaves its marks): a vertex far off screen (a shadow seen from a turned
-        # camera) would otherwise ask for gigabytes.
+        # Only the polygon's part of the frame (and a margin where pygame's clipping leaves
+        # marks): a vertex far off screen (a turned camera's shadow) would ask for gigabytes.
         lo = np.maximum(pts.min(axis=0), -8)
         size = np.minimum(pts.max(axis=0), np.array(self.surface.get_size()) + 8) - lo + 1
         if np.any(size <= 0):
@@ -185,82 +160,28 @@ class Painter:
         self.pg.draw.rect(self.surface, (10, 10, 20), rect, 1)
 
 
-def vector(value: Any) -> np.ndarray:
-    return np.array(value, dtype=float).reshape(-1)
-
-
-class FlightPath:
-    """Positions of the current episode, one per step, the oldest dropped past max_points.
-    A view is only handed the current step, so a step number lower than the last one seen
-    means a new episode began; rendering the same step twice records it once."""
-
-    def __init__(self, max_points: int = 5000) -> None:
-        self._points: deque[np.ndarray] = deque(maxlen=max_points)
-        self._last_step: int | None = None
-
-    def update(self, step: int, position: np.ndarray) -> bool:
-        """Record the position of `step`; True when this step started a new episode."""
-        new_episode = self._last_step is not None and step < self._last_step
-        if new_episode:
-            self._points.clear()
-        point = np.array(position, dtype=float)
-        if self._last_step == step and self._points:
-            self._points[-1] = point
-        else:
-            self._points.append(point)
-        self._last_step = step
-        return new_episode
-
-    def clear(self) -> None:
-        self._points.clear()
-        self._last_step = None
-
-    @property
-    def points(self) -> np.ndarray:
-        """(N, dims) positions, oldest first; (0, 0) when empty."""
-        return np.array(self._points) if self._points else np.zeros((0, 0))
-
-
-class Shades:
-    """Poses where the drone left a shade: the first pose of the episode, then every time it
-    is more than `spacing_m` away from the last shade (the reference's shade_distance_m,
-    docs/reference/lander2d.md)."""
-
-    def __init__(self, spacing_m: float = 2.0, max_shades: int = 500) -> None:
-        if not spacing_m > 0:
-            raise ValueError(f"shade spacing must be > 0 m, got {spacing_m}")
-        self.spacing_m = float(spacing_m)
-        self.poses: deque[tuple[float, float, float]] = deque(maxlen=max_shades)
-
-    def update(self, position: np.ndarray, angle: float) -> None:
-        x, y = float(position[0]), float(position[1])
-        if self.poses:
-            lx, ly, _ = self.poses[-1]
-            if np.hypot(x - lx, y - ly) <= self.spacing_m:
-                return
-        self.poses.append((x, y, float(angle)))
-
-
 class View:
-    """What both views share: the frame (shown in a window in human mode) and its Painter,
-    the scene type they draw, closing. pygame is imported by the constructor, not before."""
+    """The frame (a window in human mode), its Painter, closing and the episode's `path`: one
+    position per step, the oldest dropped past `path_steps`. Imports pygame, not before."""
 
-    SCENE: type
-
-    def __init__(self, render_mode: str, size: tuple[int, int], caption: str, fps: float) -> None:
+    def __init__(
+        self, render_mode: str, size: tuple[int, int], caption: str, fps: float, path_steps: int
+    ) -> None:
         global _window_owner
+        self.path: deque[np.ndarray] = deque(maxlen=path_steps)
+        self._last_step: int | None = None
         if render_mode not in RENDER_MODES:
-            raise ValueError(
-                f"render_mode must be one of {RENDER_MODES}, got {render_mode!r} "
-                "(with render_mode None an env needs no view at all)"
-            )
-        width, height = int(size[0]), int(size[1])
-        if width < 64 or height < 64:
-            raise ValueError(f"the frame must be at least 64 x 64 pixels, got {width} x {height}")
-        if fps < 0:
-            raise ValueError(f"fps must be >= 0 (0 = as fast as possible), got {fps}")
-        self.render_mode, self.size, self.fps = render_mode, (width, height), float(fps)
-        self._pg = pg = import_pygame(render_mode)
+            raise ValueError(f"render_mode must be one of {RENDER_MODES}, got {render_mode!r}")
+        self.render_mode, self.size, self.fps = render_mode, (int(size[0]), int(size[1])), fps
+        has_display = sys.platform in ("win32", "darwin") or bool(
+            os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+        )
+        if render_mode == "rgb_array" and not has_display:  # SDL draws off-screen
+            os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+        os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
+        import pygame as pg
+
+        self._pg = pg
         pg.font.init()
         if render_mode == "human":
             if _window_owner is not None:
@@ -285,16 +206,27 @@ class View:
         # is_open turns False also when the user closes the window; _closed only by close().
         self.is_open, self._closed = True, False
 
-    def _events(self, scene: Any) -> list[Any] | None:
-        """This frame's window events; None when the user closed the window (on QUIT or
-        Escape)."""
-        name = type(self).__name__
+    def reset(self) -> None:
+        """Forget the episode's history (an env calls this from reset())."""
+        self.path.clear()
+        self._last_step = None
+
+    def _follow(self, step: int, position: np.ndarray) -> bool:
+        """Record the position of `step` (replaced if seen); True when it began an episode: a
+        view sees only the current step, so a lower step number than the last means a new one."""
+        new_episode = self._last_step is not None and step < self._last_step
+        if new_episode:
+            self.path.clear()
+        elif self._last_step == step and self.path:
+            self.path.pop()
+        self.path.append(np.array(position, dtype=float))
+        self._last_step = step
+        return new_episode
+
+    def _events(self) -> list[Any] | None:
+        """This frame's window events; None once the user closed the window (QUIT, Escape)."""
         if self._closed:
-            raise RuntimeError(f"this {name} is closed; create a new one to render again")
-        if not isinstance(scene, self.SCENE):
-            raise TypeError(
-                f"{name}.render needs a {self.SCENE.__name__}, got {type(scene).__name__}"
-            )
+            raise RuntimeError(f"this {type(self).__name__} is closed; create a new one to render")
         if self.render_mode != "human" or not self.is_open:
             return [] if self.is_open else None
         pg = self._pg

@@ -1,20 +1,16 @@
-"""The Lander2D view (task Landing): its scene, the plane (metres to pixels), the picture
-(the world back to front, a close-up, the wind dial and the text panel) and LanderView.
-World metres, x right, y up, angles counter-clockwise.
-"""
+"""The Lander2D view (task Landing): its scene, metres to pixels, the world back to front, a
+close-up, the wind dial, the text panel and LanderView. x right, y up, angles CCW."""
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections import deque
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
-from .. import _native
-from ..tasks import LANDING, observation_slices
-from .canvas import FlightPath, Painter, Shades, View, vector
+from ..tasks import LANDING
+from .canvas import Painter, View
 
 SKY_TOP, SKY_BOTTOM, OUTSIDE = (196, 220, 246), (226, 238, 250), (120, 130, 145)
 GROUND, GROUND_EDGE, BOUNDS, SPAWN = (96, 148, 82), (62, 112, 58), (200, 70, 70), (178, 160, 80)
@@ -26,22 +22,7 @@ WIND, TEXT, GOOD, BAD = (50, 50, 200), (15, 15, 25), (0, 140, 0), (200, 0, 0)
 THRUST_BAR_PX = 40  # a full-thrust bar's length, as the reference (docs/reference/lander2d.md)
 CLOSE_UP_SIZE = (250, 180)
 CLOSE_UP_SCALE = 48.0  # px per metre: a 1 m drone is 48 px wide
-# What the scene shows when not told: the Landing task's defaults, read from the core.
-_CORE = LANDING.defaults
-# Where a moving platform's vx / platform_speed sits in the observation (the core's layout).
-_MOVING = _native.describe("landing", {"moving_platform": 1.0})
-_PLATFORM_VX = observation_slices(_MOVING)["platform_velocity"].start
-_OUTCOMES = (
-    ("lost_control", "lost control"),
-    ("out_of_bounds", "out of bounds"),
-    ("battery_empty", "battery empty"),
-    ("time_limit", "time limit reached"),
-)
-# The model's sizes a scene takes from the env's parameters (else the core's defaults).
-_WORLD = (
-    "world_width world_height ground_height platform_width platform_height drone_width "
-    "drone_height max_thrust initial_battery"
-).split()
+_CORE = LANDING.defaults  # what a scene shows when not told
 
 
 @dataclass(eq=False)
@@ -76,14 +57,12 @@ class LanderScene:
     drone_width: float = _CORE["drone_width"]  # m, tip to tip
     drone_height: float = _CORE["drone_height"]  # m, side of each square motor
     # (2,) m, centre of the spawn square, and its half side (0 = fixed start)
-    spawn_center: np.ndarray = field(
-        default_factory=lambda: np.array([_CORE["spawn_x"], _CORE["spawn_y"]])
-    )
+    spawn_center: np.ndarray = (_CORE["spawn_x"], _CORE["spawn_y"])
     spawn_half_range: float = _CORE["initial_pos_random_range_m"]
 
     def __post_init__(self) -> None:
         for name in ("position", "velocity", "thrust", "wind_force", "spawn_center"):
-            setattr(self, name, vector(getattr(self, name)))
+            setattr(self, name, np.array(getattr(self, name), float).ravel())
         self.step = int(self.step)
 
     @property
@@ -98,83 +77,24 @@ class LanderScene:
         return math.hypot(tx - self.position[0], ty - self.position[1])
 
 
-def lander_scene(
-    info: Mapping[str, Any],
-    observation: Any = None,
-    *,
-    dt: float | None = None,
-    reward: float | None = None,
-    episode_return: float | None = None,
-    max_steps: int | None = None,
-    params: Mapping[str, Any] | None = None,
-) -> LanderScene:
-    """A LanderScene from a Landing info dict and its observation (a moving platform's
-    vx / platform_speed). `params`: the env's core parameters by name (missing
-    ones: the core's defaults)."""
-    p = {**_CORE, **(params or {})}
-    step = int(info["step"])
-    obs = () if observation is None else np.asarray(observation, dtype=float).reshape(-1)
-    return LanderScene(
-        time_s=step * (p["dt"] if dt is None else dt),
-        step=step,
-        position=info["position"],
-        velocity=info["velocity"],
-        angle=float(info["angle"]),
-        angular_velocity=float(info["angular_velocity"]),
-        thrust=info["thrust"],
-        battery=float(info["battery"]),
-        platform_x=float(info["platform_position"][0]),
-        platform_vx=float(obs[_PLATFORM_VX]) * float(p["platform_speed"])
-        if len(obs) > _PLATFORM_VX
-        else 0.0,
-        wind_force=info.get("wind_force", (0.0, 0.0)),
-        wind_speed=float(p["wind_speed"]) if p["wind_enabled"] else 0.0,
-        landed=bool(info.get("landed", False)),
-        crashed=bool(info.get("crashed", False)),
-        outcome=next((text for key, text in _OUTCOMES if info.get(key)), ""),
-        max_steps=max_steps,
-        reward=reward,
-        episode_return=episode_return,
-        spawn_center=(float(p["spawn_x"]), float(p["spawn_y"])),
-        spawn_half_range=float(p["initial_pos_random_range_m"]),
-        **{name: float(p[name]) for name in _WORLD},
-    )
-
-
+@dataclass
 class PlaneView:
-    """A uniform scale (px per metre) and the pixel (u0, v0) where world (0, 0) lands."""
+    """Metres to pixels: a uniform scale (px per metre) and the pixel (u0, v0) of (0, 0)."""
 
-    def __init__(self, scale: float, u0: float, v0: float) -> None:
-        self.scale, self.u0, self.v0 = float(scale), float(u0), float(v0)
-
-    @classmethod
-    def fit_world(cls, world_width: float, world_height: float, size, margin_px=12) -> PlaneView:
-        """The world box (0, 0)-(W, H), centred, filling the frame less margin_px per side."""
-        width, height = size
-        usable_w, usable_h = width - 2 * margin_px, height - 2 * margin_px
-        if usable_w <= 0 or usable_h <= 0 or world_width <= 0 or world_height <= 0:
-            raise ValueError(
-                f"cannot fit a {world_width} x {world_height} m world in {width} x {height} px"
-            )
-        scale = min(usable_w / world_width, usable_h / world_height)
-        return cls(
-            scale, (width - world_width * scale) / 2.0, (height + world_height * scale) / 2.0
-        )
-
-    @classmethod
-    def centred_on(cls, center: np.ndarray, scale: float, size: tuple[int, int]) -> PlaneView:
-        """World point `center` at the middle of a frame of `size` pixels."""
-        return cls(scale, size[0] / 2.0 - center[0] * scale, size[1] / 2.0 + center[1] * scale)
+    scale: float
+    u0: float
+    v0: float
 
     def to_screen(self, points: np.ndarray) -> np.ndarray:
         p = np.asarray(points, dtype=float)
         return np.stack([self.u0 + p[..., 0] * self.scale, self.v0 - p[..., 1] * self.scale], -1)
 
-    def to_world(self, pixels: np.ndarray) -> np.ndarray:
-        q = np.asarray(pixels, dtype=float)
-        return np.stack(
-            [(q[..., 0] - self.u0) / self.scale, (self.v0 - q[..., 1]) / self.scale], -1
-        )
+
+def fit_world(s: LanderScene, size: tuple[int, int], margin_px: int = 12) -> PlaneView:
+    """The world box (0, 0)-(W, H), centred, filling the frame less margin_px per side."""
+    (width, height), w, h = size, s.world_width, s.world_height
+    scale = min((width - 2 * margin_px) / w, (height - 2 * margin_px) / h)
+    return PlaneView(scale, (width - w * scale) / 2.0, (height + h * scale) / 2.0)
 
 
 def rotate2d(points: np.ndarray, angle: float) -> np.ndarray:
@@ -224,33 +144,26 @@ def status_text(s: LanderScene) -> tuple[str, tuple[int, int, int]]:
 
 
 def overlay(p: Painter, plane: PlaneView, s: LanderScene) -> None:
-    """Text panel over the ground band: battery, status, step, position, velocity, angle,
-    angular velocity, distance, and the two motor force bars."""
+    """The text panel over the ground band: the state in three columns, the force bars."""
     steps = f"{s.step} / {s.max_steps}" if s.max_steps is not None else f"{s.step}"
     angle_deg = math.degrees(math.remainder(s.angle, math.tau))
     status, status_color = status_text(s)
     reward = "Reward: -" if s.reward is None else f"Reward: {s.reward:+.3f}"
     if s.episode_return is not None:
         reward += f"  (return {s.episode_return:.1f})"
-    columns = [
-        [
-            (f"Battery: {s.battery:.1f} / {s.initial_battery:.0f}", TEXT),
-            (f"Status: {status}", status_color),
-            (f"Step: {steps}   t = {s.time_s:.2f} s", TEXT),
-            (reward, TEXT),
-        ],
-        [
-            (f"Position: ({s.position[0]:.2f}, {s.position[1]:.2f}) m", TEXT),
-            (f"Velocity: ({s.velocity[0]:+.2f}, {s.velocity[1]:+.2f}) m/s", TEXT),
-            (f"Angle: {angle_deg:+.1f}°", TEXT),
-            (f"Angular velocity: {s.angular_velocity:+.2f} rad/s", TEXT),
-        ],
-        [
-            (f"Distance to platform: {s.distance_to_platform:.2f} m", TEXT),
-            (f"Thrust L: {s.thrust[0]:.1f} N", TEXT),
-            (f"Thrust R: {s.thrust[1]:.1f} N", TEXT),
-            (f"Platform: x {s.platform_x:.1f} m, {s.platform_vx:+.1f} m/s", TEXT),
-        ],
+    lines = [
+        f"Battery: {s.battery:.1f} / {s.initial_battery:.0f}",
+        f"Status: {status}",
+        f"Step: {steps}   t = {s.time_s:.2f} s",
+        reward,
+        f"Position: ({s.position[0]:.2f}, {s.position[1]:.2f}) m",
+        f"Velocity: ({s.velocity[0]:+.2f}, {s.velocity[1]:+.2f}) m/s",
+        f"Angle: {angle_deg:+.1f}°",
+        f"Angular velocity: {s.angular_velocity:+.2f} rad/s",
+        f"Distance to platform: {s.distance_to_platform:.2f} m",
+        f"Thrust L: {s.thrust[0]:.1f} N",
+        f"Thrust R: {s.thrust[1]:.1f} N",
+        f"Platform: x {s.platform_x:.1f} m, {s.platform_vx:+.1f} m/s",
     ]
     width, height = p.surface.get_size()
     line_h, pad = 22, 10
@@ -260,10 +173,9 @@ def overlay(p: Painter, plane: PlaneView, s: LanderScene) -> None:
     rect = (16, round(top), width - 32, panel_h)
     p.panel(rect, (255, 255, 248))
     col_w = (rect[2] - 2 * pad) // 3
-    for c, lines in enumerate(columns):
-        x = rect[0] + pad + c * col_w
-        for i, (text, color) in enumerate(lines):
-            p.text(text, (x, rect[1] + pad + i * line_h), color, 19, bold=(c == 0 and i == 1))
+    for i, text in enumerate(lines):  # three columns of four; the status bold, in colour
+        at = (rect[0] + pad + i // 4 * col_w, rect[1] + pad + i % 4 * line_h)
+        p.text(text, at, status_color if i == 1 else TEXT, 19, bold=i == 1)
     bar_x = rect[0] + pad + 2 * col_w + 120
     for i, thrust in enumerate(s.thrust):
         bar = (bar_x, rect[1] + pad + (i + 1) * line_h + 2, col_w - 130, 11)
@@ -273,20 +185,15 @@ def overlay(p: Painter, plane: PlaneView, s: LanderScene) -> None:
     p.bar((rect[0] + pad + 175, rect[1] + pad + 2, col_w - 190, 11), fraction, fill)
 
 
-def world(p: Painter, plane: PlaneView, s: LanderScene, poses, path, spawn, close_up) -> None:
-    """Everything that lives in world coordinates, back to front; a close-up has no distance
-    label and longer thrust bars."""
+def world(p: Painter, plane: PlaneView, s: LanderScene, poses, path, spawn=False, close_up=False):
+    """The world back to front; a close-up has longer thrust bars and no distance label."""
     # Grey outside the world, a sky gradient (by altitude) inside it.
     p.surface.fill(OUTSIDE)
-    width, height = p.surface.get_size()
     corners = np.array([[0.0, s.world_height], [s.world_width, 0.0]])
     (u0, v_top), (u1, v_bottom) = plane.to_screen(corners)
-    left, right = max(0, round(u0)), min(width, round(u1))
-    top, bottom = max(0, round(v_top)), min(height, round(v_bottom))
-    for v in range(top, bottom, 4):
-        t = (v - v_top) / max(1.0, v_bottom - v_top)
-        color = tuple(round(a + (b - a) * t) for a, b in zip(SKY_TOP, SKY_BOTTOM, strict=True))
-        p.pg.draw.rect(p.surface, color, (left, v, right - left, min(4, bottom - v)))
+    p.gradient(
+        (round(u0), round(v_top), round(u1), round(v_bottom)), v_top, v_bottom, SKY_TOP, SKY_BOTTOM
+    )
     r = s.spawn_half_range
     if spawn and r > 0:
         lo = plane.to_screen((s.spawn_center[0] - r, s.spawn_center[1] + r))
@@ -341,27 +248,9 @@ def world(p: Painter, plane: PlaneView, s: LanderScene, poses, path, spawn, clos
             p.line(start, start + up * full_px * fraction, THRUST, 3)
 
 
-def close_up(
-    p: Painter, s: LanderScene, shade_poses: list, path_points: np.ndarray, zoom: float
-) -> None:
-    """A zoomed window on the drone (top-left), framed and titled; p draws on that window."""
-    width, height = p.surface.get_size()
-    # The drone sits a little low so its thrust bars fit above it.
-    center = np.array(s.position) + np.array([0.0, 0.12 * height / CLOSE_UP_SCALE])
-    plane = PlaneView.centred_on(center, CLOSE_UP_SCALE, (width, height))
-    world(p, plane, s, shade_poses, path_points, spawn=False, close_up=True)
-    p.pg.draw.rect(p.surface, (40, 40, 50), (0, 0, width, height), 2)
-    p.text(f"close-up ×{zoom:.0f}", (8, 6), TEXT, 18, bold=True)
-
-
 class LanderView(View):
-    """Draws LanderScene frames: a window ("human") or (H, W, 3) uint8 arrays ("rgb_array").
-
-    Keeps the episode's flight path and shades (a shade every `shade_distance_m` travelled);
-    both restart when a scene's step goes backwards (a new episode) or on `reset()`.
-    """
-
-    SCENE = LanderScene
+    """Draws LanderScene frames: a window ("human") or (H, W, 3) uint8 arrays ("rgb_array"),
+    with the episode's path and a shade every `shade_distance_m` travelled."""
 
     def __init__(
         self,
@@ -379,39 +268,45 @@ class LanderView(View):
     ) -> None:
         self.show_path, self.show_shades = show_path, show_shades
         self.show_spawn_zone, self.show_overlay = show_spawn_zone, show_overlay
-        self._path = FlightPath()
-        self._shades = Shades(shade_distance_m)
-        super().__init__(render_mode, (width, height), "flyloop - Lander2D", fps)
+        self.shade_distance_m = shade_distance_m
+        self._shades: deque[tuple[float, float, float]] = deque(maxlen=500)  # x, y, angle
+        super().__init__(render_mode, (width, height), "flyloop - Lander2D", fps, 5000)
         self._close_up: Painter | None = None
         cw, ch = CLOSE_UP_SIZE
         if show_close_up and width >= 3 * cw and height >= 3 * ch:  # else it has no room
             self._close_up = Painter(self._pg, self._surface.subsurface((20, 20, cw, ch)))
 
-    def world_to_screen(self, scene: LanderScene, points: np.ndarray) -> np.ndarray:
-        """Pixels (u, v) where world points (..., 2) in metres are drawn for this scene."""
-        plane = PlaneView.fit_world(scene.world_width, scene.world_height, self.size)
-        return plane.to_screen(points)
-
     def reset(self) -> None:
         """Forget the flight path and shades (an env calls this from reset())."""
-        self._path.clear()
-        self._shades.poses.clear()
+        super().reset()
+        self._shades.clear()
 
     def render(self, scene: LanderScene) -> np.ndarray | None:
         """Draw one frame: returns it in rgb_array mode, None in human mode."""
-        if self._events(scene) is None:
+        if self._events() is None:
             return None  # the user closed the window: nothing to draw on any more
-        if self._path.update(scene.step, scene.position):
-            self._shades.poses.clear()
-        self._shades.update(scene.position, scene.angle)
+        if self._follow(scene.step, scene.position):
+            self._shades.clear()
+        # A shade at the first pose, then each time the drone is shade_distance_m past the
+        # last one (the reference's shade_distance_m, docs/reference/lander2d.md).
+        x, y = float(scene.position[0]), float(scene.position[1])
+        last = self._shades[-1] if self._shades else None
+        if last is None or np.hypot(x - last[0], y - last[1]) > self.shade_distance_m:
+            self._shades.append((x, y, float(scene.angle)))
         s, p = scene, self._painter
-        plane = PlaneView.fit_world(s.world_width, s.world_height, self.size)
-        shade_poses = self._shades.poses if self.show_shades else ()
-        path_points = self._path.points if self.show_path else np.zeros((0, 2))
-        world(p, plane, s, shade_poses, path_points, self.show_spawn_zone, close_up=False)
+        plane = fit_world(s, self.size)
+        shade_poses = self._shades if self.show_shades else ()
+        path_points = np.array(self.path) if self.show_path else ()
+        world(p, plane, s, shade_poses, path_points, spawn=self.show_spawn_zone)
         zoom = CLOSE_UP_SCALE / plane.scale
         if self._close_up is not None and zoom >= 1.5:  # in a small world it adds nothing
-            close_up(self._close_up, s, shade_poses, path_points, zoom)
+            # The drone a little low in the close-up, so its thrust bars fit above it.
+            (cw, ch), q = CLOSE_UP_SIZE, self._close_up
+            center = s.position + (0.0, 0.12 * ch / CLOSE_UP_SCALE)
+            u0, v0 = cw / 2.0 - center[0] * CLOSE_UP_SCALE, ch / 2.0 + center[1] * CLOSE_UP_SCALE
+            world(q, PlaneView(CLOSE_UP_SCALE, u0, v0), s, shade_poses, path_points, close_up=True)
+            q.pg.draw.rect(q.surface, (40, 40, 50), (0, 0, cw, ch), 2)
+            q.text(f"close-up ×{zoom:.0f}", (8, 6), TEXT, 18, bold=True)
         wind_indicator(p, s)
         if self.show_overlay:
             overlay(p, plane, s)

@@ -1,28 +1,19 @@
-"""The quadrotor view (tasks Hover and Waypoints): its scene, the 3D world drawn through an
-orbit camera, the overlays (info panel, motor bars, axis gizmo, wind dial, legend) and
-QuadrotorView with its window controls.
-
-Frames as the core: world ENU (x east, y north, z up), body FLU (x forward, y left, z up),
-quaternion [w, x, y, z] rotating body to world; motors in PX4's quad-X order (0 front-right,
-1 rear-left, 2 front-left, 3 rear-right). The world is drawn with a painter's algorithm: the
-ground and lines first, then solid things far to near, the drone's hub last (its pixels are
-what tests track). The window's held keys are tracked from KEYDOWN/KEYUP events (not
-pygame.key.get_pressed) so the same events drive the camera in a test as from a person.
-"""
+"""The quadrotor view (tasks Hover and Waypoints): its scene, the 3D world through an orbit
+camera, the overlays and QuadrotorView with its window controls; the core's frames (world
+ENU, body FLU, quaternion [w, x, y, z]) and PX4's motor order. Painter's algorithm: ground
+and lines, then solids far to near, the hub last (tests track its pixels)."""
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from .. import _native
-from ..tasks import observation_slices, parameter_values
+from ..tasks import HOVER
 from .camera import OrbitCamera, Projector
-from .canvas import FlightPath, Painter, View, vector
+from .canvas import Painter, View
 
 # Rotor i sits at (forward, left) * L/sqrt(2) in the body frame: PX4 quad-X order.
 ROTOR_POSITION_SIGNS = np.array([(1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (-1.0, -1.0)])
@@ -37,15 +28,15 @@ WAYPOINT, UP, VELOCITY, WIND = (150, 60, 200), (255, 150, 0), (230, 0, 220), (20
 DROP, SHADOW, TRAIL = (128, 128, 128), (40, 40, 40), (60, 140, 220)
 TEXT, PANEL, BAD, BACKGROUND_TOP = (20, 20, 30), (255, 255, 236), (200, 0, 0), (232, 238, 248)
 BACKGROUND_BOTTOM = (246, 246, 250)
+ROTOR_COLORS = tuple(ROTOR_CCW if spin < 0 else ROTOR_CW for spin in ROTOR_SPIN)
+SPIN_NAMES = tuple("CCW" if spin < 0 else "CW" for spin in ROTOR_SPIN)
 AXES = ((AXIS_X, "x E"), (AXIS_Y, "y N"), (AXIS_Z, "z"))
 TARGET_RADIUS_M, WAYPOINT_RADIUS_M, UP_ARROW_M, MAX_ARROW_M = 0.08, 0.06, 0.5, 2.0
 VELOCITY_SECONDS = 0.5  # the velocity arrow shows where the drone is in this many seconds
 WIND_M_PER_MPS = 0.12  # wind arrow length per m/s of wind
 DEGREES_PER_PIXEL, ZOOM_STEP, MIN_DISTANCE, MAX_DISTANCE = 0.3, 0.9, 0.5, 200.0
 MOVE_FRACTION = 0.012  # per frame, of the camera distance
-# What a scene shows when not told: the hover task with the core's defaults.
-_HOVER = _native.describe("hover")
-_CORE = parameter_values(_HOVER)
+_CORE = HOVER.defaults  # what a scene shows when not told
 
 
 def rotation_matrix(q_wxyz: np.ndarray) -> np.ndarray:
@@ -55,32 +46,6 @@ def rotation_matrix(q_wxyz: np.ndarray) -> np.ndarray:
     row_y = [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)]
     row_z = [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]
     return np.array([row_x, row_y, row_z])
-
-
-def euler_rpy(q_wxyz: np.ndarray) -> tuple[float, float, float]:
-    """Roll, pitch, yaw in radians (intrinsic Z-Y-X) of a unit quaternion [w, x, y, z]."""
-    w, x, y, z = q_wxyz
-    roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
-    pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
-    yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-    return roll, pitch, yaw
-
-
-def quaternion_from_euler(roll: float, pitch: float, yaw: float) -> np.ndarray:
-    """The unit quaternion [w, x, y, z] of intrinsic Z-Y-X angles in radians."""
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    w, x = cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy
-    y, z = cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy
-    return np.array([w, x, y, z])
-
-
-def rotor_positions_body(arm_length: float) -> np.ndarray:
-    """(4, 3) rotor centres in the body frame, metres, in PX4 motor order."""
-    out = np.zeros((4, 3))
-    out[:, :2] = ROTOR_POSITION_SIGNS * (arm_length / math.sqrt(2.0))
-    return out
 
 
 @dataclass(eq=False)
@@ -93,88 +58,35 @@ class QuadScene:
     velocity: np.ndarray  # (3,) m/s, world ENU
     quaternion: np.ndarray  # (4,) [w, x, y, z], body FLU -> world ENU; normalised here
     motors: np.ndarray = field(default_factory=lambda: np.zeros(4))  # (4,) states, [0, 1]
-    body_rates: np.ndarray = field(default_factory=lambda: np.zeros(3))  # (3,) rad/s, body FLU
     wind: np.ndarray = field(default_factory=lambda: np.zeros(3))  # (3,) m/s, world ENU
     target: np.ndarray | None = None  # (3,) m, world ENU: the current target / waypoint
     next_waypoint: np.ndarray | None = None  # (3,) m, the waypoint after the target
     reward: float | None = None  # reward of the last step
     episode_return: float | None = None  # sum of rewards since reset
-    # m: targets live in x, y in [-h, h], z in [0, 2h]
-    bounds_half_size: float = _CORE["space_side_length"] / 2.0
+    bounds_half_size: float = _CORE["space_side_length"] / 2.0  # m: x, y in [-h, h], z in [0, 2h]
     arm_length: float = _CORE["arm_length"]  # m, centre to rotor
     waypoints_reached: int | None = None  # Waypoints task only
     status: str = ""  # e.g. "crashed", "out of bounds"; empty while flying
-    extras: tuple[tuple[str, str], ...] = ()  # more (label, text) lines for the info panel
 
     def __post_init__(self) -> None:
-        for name in ("position", "velocity", "body_rates", "wind", "target", "next_waypoint"):
+        for name in ("position", "velocity", "wind", "target", "next_waypoint"):
             if getattr(self, name) is not None:
-                setattr(self, name, vector(getattr(self, name)))
-        q = vector(self.quaternion)
+                setattr(self, name, np.array(getattr(self, name), float).ravel())
+        q = np.array(self.quaternion, float).ravel()
         self.quaternion = q / float(np.linalg.norm(q))
         # Lagged motor states may overshoot by rounding; the bars show [0, 1].
-        self.motors = np.clip(vector(self.motors), 0.0, 1.0)
+        self.motors = np.clip(np.array(self.motors, float).ravel(), 0.0, 1.0)
         self.time_s, self.step = float(self.time_s), int(self.step)
         if self.waypoints_reached is not None:
             self.waypoints_reached = int(self.waypoints_reached)
-        items = self.extras.items() if isinstance(self.extras, Mapping) else self.extras
-        self.extras = tuple((str(k), str(v)) for k, v in items)
 
 
-def quad_scene(
-    observation: Any,
-    info: Mapping[str, Any],
-    *,
-    reward: float | None = None,
-    episode_return: float | None = None,
-    core: Mapping[str, Any] = _HOVER,
-) -> QuadScene:
-    """A QuadScene from a Hover/Waypoints observation and its info (the task frame's names);
-    `core`: the env's `describe` result (observation layout, parameters). An observation
-    without attitude or motors (the rates interface) is drawn level with motors at 0."""
-    obs = np.asarray(observation, dtype=float).reshape(-1)
-    at, values = observation_slices(core), parameter_values(core)
-
-    def part(name: str, otherwise: Any) -> Any:
-        return obs[at[name]] if name in at else otherwise
-
-    status = (
-        "crashed" if info.get("crashed") else "out of bounds" if info.get("out_of_bounds") else ""
-    )
-    return QuadScene(
-        time_s=info["episode_time"],
-        step=info["step_count"],
-        position=info["position"],
-        velocity=obs[at["velocity"]],
-        quaternion=part("quaternion", (1.0, 0.0, 0.0, 0.0)),
-        body_rates=obs[at["body_rates"]],
-        wind=part("wind", np.zeros(3)),
-        motors=part("motor_states", np.zeros(4)),
-        target=info.get("target_position"),
-        next_waypoint=info.get("next_waypoint_pos"),
-        reward=reward,
-        episode_return=episode_return,
-        bounds_half_size=float(values["space_side_length"]) / 2.0,
-        arm_length=float(values["arm_length"]),
-        waypoints_reached=info.get("waypoints_reached"),
-        status=status,
-    )
-
-
-def rotor_color(index: int) -> tuple[int, int, int]:
-    return ROTOR_CCW if ROTOR_SPIN[index] < 0 else ROTOR_CW
-
-
-def _line(p: Painter, pr: Projector, a, b, color, width: int = 1) -> None:
+def _line(p: Painter, pr: Projector, a, b, color, width: int = 1, dashed=False) -> None:
     seg = pr.segment(a, b)
-    if seg is not None:
-        p.line(seg[0], seg[1], color, width)
-
-
-def _dashed(p: Painter, pr: Projector, a, b, color, width: int = 1) -> None:
-    seg = pr.segment(a, b)
-    if seg is not None:
+    if seg is not None and dashed:
         p.dashed_line(seg[0], seg[1], color, width, dash_px=5)
+    elif seg is not None:
+        p.line(seg[0], seg[1], color, width)
 
 
 def _arrow(p: Painter, pr: Projector, start, vector, color, width: int = 3) -> None:
@@ -192,7 +104,7 @@ def shadow(p: Painter, pr: Projector, position: np.ndarray, radius: float) -> No
     """A soft dark disc on the ground under a point, and a dashed drop line to it."""
     foot = np.array([position[0], position[1], 0.0])
     if position[2] > 0:
-        _dashed(p, pr, position, foot, DROP, 1)
+        _line(p, pr, position, foot, DROP, 1, dashed=True)
     ring = pr.polygon(_circle_points(foot, radius, np.eye(3)[:2]))
     if len(ring):
         p.translucent_polygon(ring, SHADOW, 60)
@@ -216,7 +128,7 @@ def next_waypoint(p: Painter, pr: Projector, scene: QuadScene) -> None:
     if scene.next_waypoint is None:
         return
     if scene.target is not None:
-        _dashed(p, pr, scene.target, scene.next_waypoint, WAYPOINT, 1)
+        _line(p, pr, scene.target, scene.next_waypoint, WAYPOINT, 1, dashed=True)
     hit = pr.point(scene.next_waypoint)
     if hit is not None:
         r = max(4.0, pr.radius(WAYPOINT_RADIUS_M, hit[1]))
@@ -225,14 +137,11 @@ def next_waypoint(p: Painter, pr: Projector, scene: QuadScene) -> None:
 
 
 def drone(p: Painter, pr: Projector, scene: QuadScene, scale: float) -> None:
-    """Arms, rotor discs (coloured by spin, in the body plane), nose, vectors, hub on top.
-
-    Drawn `scale` times the real size so a 0.1 m arm stays visible in a metres-wide box.
-    """
+    """Arms, spin-coloured rotor discs, nose, vectors, hub on top; `scale` times its size."""
     rot = rotation_matrix(scene.quaternion)
     pos = scene.position
     arm = scene.arm_length * scale
-    rotors = pos + rotor_positions_body(arm) @ rot.T
+    rotors = pos + np.c_[ROTOR_POSITION_SIGNS * (arm / math.sqrt(2.0)), np.zeros(4)] @ rot.T
     rotor_radius = 0.38 * arm
     disc_axes = rot.T[:2]  # body x and y in world coordinates
     cam = pr.camera
@@ -241,12 +150,12 @@ def drone(p: Painter, pr: Projector, scene: QuadScene, scale: float) -> None:
         _line(p, pr, pos, rotors[i], ARM, 4)
         poly = pr.polygon(_circle_points(rotors[i], rotor_radius, disc_axes))
         if len(poly):
-            color = rotor_color(int(i))
+            color = ROTOR_COLORS[i]
             p.translucent_polygon(poly, color, 150)
             p.polyline(np.vstack([poly, poly[:1]]), tuple(int(c * 0.6) for c in color), 2)
         level = pr.polygon(_circle_points(rotors[i], rotor_radius * scene.motors[i], disc_axes))
         if len(level) and scene.motors[i] > 0.02:
-            p.translucent_polygon(level, rotor_color(int(i)), 170)
+            p.translucent_polygon(level, ROTOR_COLORS[i], 170)
     _arrow(p, pr, pos, rot[:, 2] * UP_ARROW_M, UP, 3)
     for vec, m_per_unit, color, width in (
         (scene.velocity, VELOCITY_SECONDS, VELOCITY, 3),
@@ -291,7 +200,7 @@ def world(p: Painter, pr: Projector, scene: QuadScene, trail: np.ndarray, scale:
     for i, a in enumerate(corners):
         for b in corners[i + 1 :]:
             if np.count_nonzero(np.abs(a - b) > 1e-9) == 1:  # an edge, not a diagonal
-                _dashed(p, pr, a, b, BOUNDS, 1)
+                _line(p, pr, a, b, BOUNDS, 1, dashed=True)
     for point, radius in ((scene.target, 0.1), (scene.next_waypoint, 0.07)):
         if point is not None:
             shadow(p, pr, point, radius)
@@ -311,7 +220,10 @@ def world(p: Painter, pr: Projector, scene: QuadScene, trail: np.ndarray, scale:
 
 def info_lines(scene: QuadScene) -> list[tuple[str, tuple[int, int, int]]]:
     """The info panel's text: time, step, distance, height, speed, wind, attitude, reward."""
-    roll, pitch, yaw = (math.degrees(a) for a in euler_rpy(scene.quaternion))
+    w, x, y, z = scene.quaternion  # to roll, pitch, yaw (intrinsic Z-Y-X)
+    roll = math.degrees(math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y)))
+    pitch = math.degrees(math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x)))))
+    yaw = math.degrees(math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
     distance = (
         "-" if scene.target is None else f"{np.linalg.norm(scene.target - scene.position):.2f} m"
     )
@@ -330,7 +242,6 @@ def info_lines(scene: QuadScene) -> list[tuple[str, tuple[int, int, int]]]:
         lines.append((f"Waypoints reached {scene.waypoints_reached}", TEXT))
     if scene.status:
         lines.append((scene.status[:1].upper() + scene.status[1:], BAD))
-    lines.extend((f"{label}: {text}", TEXT) for label, text in scene.extras)
     return lines
 
 
@@ -358,10 +269,9 @@ def motor_bars(p: Painter, scene: QuadScene) -> None:
         p.pg.draw.rect(p.surface, color, (x, y0 + bar_h - fill, bar_w, fill))
         p.pg.draw.rect(p.surface, (0, 0, 0), (x, y0, bar_w, bar_h), 1)
         p.text(f"{round(float(level) * 100)}%", (x + bar_w / 2, y0 - 6), TEXT, 17, "midbottom")
-        p.disc((x + bar_w / 2, y0 - 26), 5, rotor_color(i))
-        spin = "CCW" if ROTOR_SPIN[i] < 0 else "CW"
+        p.disc((x + bar_w / 2, y0 - 26), 5, ROTOR_COLORS[i])
         p.text(f"M{i} {ROTOR_NAMES[i]}", (x + bar_w / 2, y0 + bar_h + 4), TEXT, 17, "midtop")
-        p.text(spin, (x + bar_w / 2, y0 + bar_h + 20), TEXT, 15, "midtop")
+        p.text(SPIN_NAMES[i], (x + bar_w / 2, y0 + bar_h + 20), TEXT, 15, "midtop")
 
 
 def axis_gizmo(p: Painter, camera: OrbitCamera) -> None:
@@ -384,8 +294,8 @@ def axis_gizmo(p: Painter, camera: OrbitCamera) -> None:
 
 
 def wind_dial(p: Painter, scene: QuadScene, camera: OrbitCamera) -> None:
-    """Top-right: the horizontal wind seen from above, turned so 'up' is where the camera
-    looks; its length grows with speed (full radius at 5 m/s)."""
+    """Top-right: the horizontal wind from above, up = where the camera looks; longer when
+    faster (full radius at 5 m/s)."""
     width = p.surface.get_width()
     center = np.array([width - 70.0, 72.0])
     radius = 44.0
@@ -439,15 +349,9 @@ HINT = "drag: rotate   wheel: zoom   W/A/S/D: move   Q/E: down/up   R: reset   E
 
 class QuadrotorView(View):
     """Draws QuadScene frames: a window ("human") or (H, W, 3) uint8 arrays ("rgb_array").
-
-    In a window: drag with the left mouse button to orbit, wheel to zoom, W/A/S/D to move
-    along the ground, Q/E down/up, R to reset the camera, Esc or the close box to close.
-    The vehicle is drawn `drone_scale` times its real size (a 0.1 m arm would be a few
-    pixels); its centre is at its true position. The trail keeps the last `trail_steps`
-    positions of the episode and restarts when the step number goes backwards or on reset().
-    """
-
-    SCENE = QuadScene
+    In a window: drag to orbit, wheel to zoom, W/A/S/D to move, Q/E down/up, R to reset the
+    camera, Esc to close. The vehicle is drawn `drone_scale` times its size (a 0.1 m arm
+    stays visible); the trail keeps the episode's last `trail_steps` positions."""
 
     def __init__(
         self,
@@ -461,38 +365,24 @@ class QuadrotorView(View):
         trail_steps: int = 400,
         hud: bool = True,
     ) -> None:
-        if not drone_scale > 0:
-            raise ValueError(f"drone_scale must be > 0, got {drone_scale}")
         self.drone_scale, self.hud, self.camera = float(drone_scale), hud, camera
-        self._trail = FlightPath(max(2, trail_steps))
-        super().__init__(render_mode, (width, height), "flyloop - Quadrotor 3D", fps)
-        pg = self._pg
-        keys = (pg.K_w, pg.K_s, pg.K_d, pg.K_a, pg.K_e, pg.K_q)
+        title = "flyloop - Quadrotor 3D"
+        super().__init__(render_mode, (width, height), title, fps, max(2, trail_steps))
+        # W/S forward/back, D/A right/left, E/Q up/down.
         moves = ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))
-        self._moves = dict(zip(keys, moves, strict=True))
+        self._moves = {getattr(self._pg, f"K_{k}"): m for k, m in zip("wsdaeq", moves, strict=True)}
         self._held: set[int] = set()
         self._dragging = False
 
-    def world_to_screen(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Pixels (..., 2) of world points (..., 3) and whether each is in front of the camera."""
-        if self.camera is None:
-            raise RuntimeError("the camera is set up by the first render (or pass camera=...)")
-        return self.camera.project(points, *self.size)
-
-    def reset(self) -> None:
-        """Forget the trail (an env calls this from reset())."""
-        self._trail.clear()
-
     def _steer(self, camera: OrbitCamera, events: list[Any]) -> None:
-        """Apply this frame's events, then one frame of movement for each key held or pressed
-        in this frame (a tap shorter than a frame still moves once)."""
+        """Apply this frame's events, then move for each key held or pressed in this frame (a
+        tap shorter than a frame still moves once). Held keys come from KEYDOWN/KEYUP events,
+        not pygame.key.get_pressed, so posted events move the camera as a person's do."""
         pg = self._pg
         tapped: set[int] = set()
         for event in events:
-            if event.type == pg.MOUSEBUTTONDOWN and event.button == 1:
-                self._dragging = True
-            elif event.type == pg.MOUSEBUTTONUP and event.button == 1:
-                self._dragging = False
+            if event.type in (pg.MOUSEBUTTONDOWN, pg.MOUSEBUTTONUP) and event.button == 1:
+                self._dragging = event.type == pg.MOUSEBUTTONDOWN
             elif event.type == pg.MOUSEMOTION and self._dragging:
                 dx, dy = event.rel
                 # Dragging right turns the world right; dragging down looks from higher up.
@@ -518,7 +408,7 @@ class QuadrotorView(View):
 
     def render(self, scene: QuadScene) -> np.ndarray | None:
         """Draw one frame: returns it in rgb_array mode, None in human mode."""
-        events = self._events(scene)
+        events = self._events()
         if self.camera is None:
             # Looking at the middle of the target box from the south-west, the box in view.
             h = scene.bounds_half_size
@@ -526,10 +416,11 @@ class QuadrotorView(View):
         if events is None:
             return None  # the user closed the window
         self._steer(self.camera, events)
-        self._trail.update(scene.step, scene.position)
+        self._follow(scene.step, scene.position)
         p = self._painter
-        p.vertical_gradient(BACKGROUND_TOP, BACKGROUND_BOTTOM)
-        trail = self._trail.points
+        width, height = self.size
+        p.gradient((0, 0, width, height), 0, height - 1, BACKGROUND_TOP, BACKGROUND_BOTTOM)
+        trail = np.array(self.path)
         world(p, Projector(self.camera, self.size), scene, trail, self.drone_scale)
         if self.hud:
             info_panel(p, scene)
@@ -538,6 +429,5 @@ class QuadrotorView(View):
             wind_dial(p, scene, self.camera)
             legend(p)
             if self.render_mode == "human":  # bottom centre: how to move the camera
-                width, height = self.size
                 p.text(HINT, (width / 2, height - 8), (90, 90, 100), 17, "midbottom")
         return self._present()

@@ -1,8 +1,5 @@
-"""Save rgb_array frames as a GIF (Pillow) or a video (ffmpeg from imageio-ffmpeg).
-
-gymnasium's own `gymnasium.wrappers.RecordVideo` also works with flyloop's envs in
-render_mode="rgb_array" (it needs moviepy); these helpers need neither.
-"""
+"""Save rgb_array frames as a GIF (Pillow) or a video (imageio-ffmpeg's ffmpeg); unlike
+gymnasium's `RecordVideo` wrapper, which also works with flyloop's envs, without moviepy."""
 
 from __future__ import annotations
 
@@ -39,13 +36,10 @@ def save_video(frames: Iterable[np.ndarray], path: str | Path, fps: float = 30.0
 
 
 def _save_gif(frames: list[np.ndarray], path: Path, fps: float, colors: int = 128) -> None:
-    """A looping GIF with ONE palette drawn from a sample of the frames, so Pillow can store
-    each frame as its difference to the last (a few kB a frame for these scenes, against
-    ~50 kB with a palette of its own per frame)."""
-    try:
-        from PIL import Image
-    except ImportError as exc:
-        raise ImportError("saving a GIF needs Pillow: pip install pillow") from exc
+    """A looping GIF with ONE palette from a sample of the frames: Pillow then stores each
+    frame as its change from the last (a few kB, against ~50 kB with a palette per frame)."""
+    from PIL import Image  # the "render" extra's, as pygame
+
     images = [Image.fromarray(f) for f in frames]
     sample = images[:: max(1, len(images) // 10)]
     width, height = images[0].size
@@ -91,35 +85,10 @@ def _save_ffmpeg(frames: list[np.ndarray], path: Path, fps: float) -> None:
         writer.close()
 
 
-class FrameRecorder:
-    """Collects frames (e.g. each env.render() in rgb_array mode) and saves them at the end."""
-
-    def __init__(self, max_frames: int | None = None) -> None:
-        if max_frames is not None and max_frames < 1:
-            raise ValueError(f"max_frames must be >= 1, got {max_frames}")
-        self.max_frames = max_frames
-        self.frames: list[np.ndarray] = []
-
-    def add(self, frame: np.ndarray | None) -> None:
-        """Keep a copy of frame; None (a human-mode render) is refused with a clear error."""
-        if frame is None:
-            raise ValueError("got no frame: record with render_mode='rgb_array'")
-        if self.max_frames is not None and len(self.frames) >= self.max_frames:
-            return
-        self.frames.append(np.array(frame, dtype=np.uint8, copy=True))
-
-    def __len__(self) -> int:
-        return len(self.frames)
-
-    def save(self, path: str | Path, fps: float = 30.0) -> Path:
-        return save_video(self.frames, path, fps)
-
-    def clear(self) -> None:
-        self.frames.clear()
-
-
 @dataclass(frozen=True)
 class Recording:
+    """What record_episode saved: where, how many frames and steps, and the episode's return."""
+
     path: Path
     frames: int
     steps: int
@@ -135,27 +104,21 @@ def record_episode(
     max_steps: int | None = None,
     fps: float | None = None,
 ) -> Recording:
-    """Run one episode of a gymnasium env made with render_mode="rgb_array" and save it.
-
-    policy(observation) -> action; random actions when None. fps defaults to the env's
-    metadata["render_fps"] (30 if absent). One frame after reset and one per step.
-    """
-    if getattr(env, "render_mode", None) != "rgb_array":
-        raise ValueError(
-            f"record_episode needs an env made with render_mode='rgb_array', "
-            f"got {getattr(env, 'render_mode', None)!r}"
-        )
+    """Run one episode of a gymnasium env made with render_mode="rgb_array" and save a frame
+    after reset and one per step. policy(observation) -> action (random when None); fps: the
+    env's metadata["render_fps"] (30 if absent) unless given."""
+    if (mode := getattr(env, "render_mode", None)) != "rgb_array":
+        raise ValueError(f"record_episode needs an env made with render_mode='rgb_array': {mode!r}")
     rate = fps if fps is not None else float(env.metadata.get("render_fps") or 30)
-    recorder = FrameRecorder()
     observation, _ = env.reset(seed=seed)
-    recorder.add(env.render())
+    frames = [env.render()]
     steps, total = 0, 0.0
     while max_steps is None or steps < max_steps:
         action = policy(observation) if policy is not None else env.action_space.sample()
         observation, reward, terminated, truncated, _ = env.step(action)
-        recorder.add(env.render())
+        frames.append(env.render())
         steps += 1
         total += float(reward)
         if terminated or truncated:
             break
-    return Recording(recorder.save(path, rate), len(recorder), steps, total)
+    return Recording(save_video(frames, path, rate), len(frames), steps, total)
