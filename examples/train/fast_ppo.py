@@ -69,8 +69,6 @@ class Config:
     gae_lambda: float = 0.95
     clip: float = 0.2
     value_coef: float = 0.5
-    # Weight of the policy's entropy bonus in the loss (0: none).
-    entropy_coef: float = 0.0
     max_grad_norm: float = 0.5
     hidden: int = 64
     # The learner sees reward * reward_scale (the reported returns are the env's own).
@@ -533,8 +531,6 @@ def update(
             policy_loss = -torch.min(ratio * a, ratio.clamp(1 - cfg.clip, 1 + cfg.clip) * a).mean()
             value_loss = (model.value(critic_obs[idx]).squeeze(-1) - ret[idx]).pow(2).mean()
             loss = policy_loss + cfg.value_coef * value_loss
-            if cfg.entropy_coef:
-                loss = loss - cfg.entropy_coef * d.entropy().sum(-1).mean()
             optimiser.zero_grad()
             loss.backward()
             nn.utils.clip_grad_norm_(model.parameters(), cfg.max_grad_norm)
