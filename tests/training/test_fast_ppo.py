@@ -86,12 +86,16 @@ def test_fast_ppo_short_lander_run_beats_random_actions(tmp_path):
 def test_fast_ppo_lander_learns_the_same_over_the_sitl_as_in_process(tmp_path, sitl_binary):
     """As for hover, with the moving pad's settings (reward scale, minibatches, the learning
     rate falling to 0, the Gaussian over collective and differential thrust, the time limit
-    terminal with the time remaining as the critic's input; 8 updates): both
-    backends give the same updates and the same held-out evaluation."""
+    terminal with the time remaining as the critic's input, the best validated policy kept;
+    8 updates, validated after updates 4, 6 and 8 here): both backends give the same updates,
+    validations, kept policy and held-out evaluation, and policy.pt is the kept policy."""
+    import evaluate
+
     done = run_script(
         TRAIN / "fast_ppo.py",
         *("--env", "lander_moving", "--backend", "native", "sitl", "--timesteps", "16384"),
         *("--num-envs", "16", "--eval-episodes", "4", "--out", str(tmp_path)),
+        *("--set", "select_every=2", "--set", "select_after=4", "--set", "select_episodes=8"),
         "--no-progress-bar",
     )
     assert done.returncode == 0, done.stderr[-3000:]
@@ -104,7 +108,27 @@ def test_fast_ppo_lander_learns_the_same_over_the_sitl_as_in_process(tmp_path, s
     assert len(strip) == 8
     assert strip == [{k: v for k, v in r.items() if k != "wall_s"} for r in sitl["rows"]]
     assert native["evaluation"] == sitl["evaluation"]
+    assert native["selected_policy"] == sitl["selected_policy"]
     assert sum(r["episodes"] for r in native["rows"]) > 0
+
+    checked = {
+        k + 1: (r["validation_success_rate"], r["validation_mean_return"])
+        for k, r in enumerate(native["rows"])
+        if r["validation_success_rate"] is not None
+    }
+    assert sorted(checked) == [4, 6, 8]
+    kept = native["selected_policy"]
+    best = max(checked, key=lambda k: (*checked[k], k))
+    assert kept["update"] == best and kept["env_steps"] == best * 16 * 128
+    assert (kept["validation_success_rate"], kept["validation_mean_return"]) == checked[best]
+    # policy.pt is that policy with its observation statistics: flown one episode at a time
+    # by evaluate.py, the validation episodes give the kept update's figures again (the
+    # returns up to float32 summation), not another validated update's.
+    again = evaluate.evaluate(tmp_path / "native", 8, kept["validation_seed"])
+    assert again["success_rate"] == kept["validation_success_rate"]
+    assert again["mean_return"] == pytest.approx(kept["validation_mean_return"], abs=0.01)
+    others = [checked[k][1] for k in checked if k != best]
+    assert all(abs(r - again["mean_return"]) > 0.01 for r in others), (checked, again)
 
 
 @pytest.mark.training
