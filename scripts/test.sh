@@ -4,7 +4,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-say() { printf '\n==> %s\n' "$*"; }
+say() { printf '\n==> %s (at %d s)\n' "$*" "$SECONDS"; }
+. scripts/cargo-env.sh
 
 say "cargo fmt --check"
 cargo fmt --all --check
@@ -29,4 +30,7 @@ say "ruff"
 say "Wheel: pip wheel ./python in a fresh venv, every env id with both backends"
 bash scripts/wheel-smoke.sh
 say "Python system tests (pytest)"
-.venv/bin/pytest -q
+# On up to 4 workers (pytest-xdist): most suites wait on processes and sockets, and the
+# training tests keep one core each. conftest.py keeps the tests that share a resource on one.
+workers=$(( $(nproc) < 4 ? $(nproc) : 4 ))
+.venv/bin/pytest -q -n "$workers" --dist loadgroup
