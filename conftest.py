@@ -27,6 +27,8 @@ GROUPS = {
 }
 
 
+# Before xdist's own hook, which reads the groups (it appends "@group" to the test ids).
+@pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     for item in items:
         path = item.path.relative_to(ROOT).as_posix()
