@@ -12,7 +12,9 @@ cargo fmt --all --check
 say "cargo clippy (all targets, warnings are errors)"
 cargo clippy --workspace --all-targets -- -D warnings
 say "cargo check of the fuzz target (sitl/fuzz: its own workspace; fuzzing itself needs nightly)"
-CARGO_TARGET_DIR=target/fuzz-check cargo check --quiet --manifest-path sitl/fuzz/Cargo.toml
+# With the workspace's lock file and target directory it reuses what clippy just checked.
+cp Cargo.lock sitl/fuzz/Cargo.lock
+CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}" cargo check --quiet --manifest-path sitl/fuzz/Cargo.toml
 # cargo-nextest when it is installed (a process per test, faster); otherwise cargo's own
 # runner over the same targets (lib, bins, integration tests; doctests below).
 if cargo nextest --version >/dev/null 2>&1; then
