@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 demo=1
 [[ "${1:-}" == "--no-demo" ]] && demo=0
 
-say() { printf '\n==> %s\n' "$*"; }
+say() { printf '\n==> %s (at %d s)\n' "$*" "$SECONDS"; }
 fail() { printf '\nsetup.sh: %s\n' "$*" >&2; exit 1; }
 
 # The toolchains first, so a missing one is one clear line and not a failure 15 minutes in.
@@ -38,8 +38,12 @@ say "Python venv .venv (test peers: fmpy, libcosimpy, pymavlink, MAVProxy, pytes
 .venv/bin/pip install -q --upgrade pip
 .venv/bin/pip install -q -r tests/requirements.txt
 
-say "Rust build (release)"
-cargo build --release --workspace --all-targets
+. scripts/cargo-env.sh
+say "Rust build (release: the SITL, the FMU library, the extension's crate, the hover demo)"
+# Tests are built by scripts/test.sh, benchmarks by `cargo bench`. pack-fmus.sh, maturin and
+# the test suites reuse this build: scripts/cargo-env.sh and the workspace-hack crate keep
+# their cargo runs on the same dependency builds.
+cargo build --release --workspace --lib --bins --example hover
 
 say "Python package flyloop with its extension flyloop._native (editable, maturin)"
 # maturin builds the extension into the workspace's target/ with the release profile, so it

@@ -7,7 +7,6 @@
 //! 4 s, see `lander2d::scene`), and the shipped policies were checked to land as before.
 
 // Test code: a failed unwrap is a failed test.
-#![allow(clippy::unwrap_used)]
 
 use flyloop_core::lander2d::{DroneState, Lander2d, Lander2dParams};
 use flyloop_core::rng::SimRng;

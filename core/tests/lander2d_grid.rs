@@ -6,7 +6,6 @@
 //! snapshot keeps the grid phase.
 
 // Test code: a failed unwrap is a failed test.
-#![allow(clippy::unwrap_used)]
 
 use flyloop_core::lander2d::{DroneState, Lander2d, Lander2dParams};
 use flyloop_core::rng::SimRng;

@@ -1,7 +1,6 @@
 //! The Landing task: spawn, observation, reward, termination order, truncation, determinism.
 
 // The helpers below are test code too: a failed setup is a failed test.
-#![allow(clippy::unwrap_used)]
 
 use flyloop_core::lander2d::{DroneState, Lander2dParams};
 use flyloop_core::rng::SimRng;

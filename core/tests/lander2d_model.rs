@@ -2,7 +2,6 @@
 //! determinism and exact save/restore.
 
 // The helpers below are test code too: a failed setup is a failed test.
-#![allow(clippy::unwrap_used)]
 
 use flyloop_core::lander2d::{DroneState, Lander2d, Lander2dParams, SnapshotError};
 use flyloop_core::rng::SimRng;

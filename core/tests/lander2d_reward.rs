@@ -4,7 +4,6 @@
 //! landing).
 
 // The helpers below are test code too: a failed setup is a failed test.
-#![allow(clippy::unwrap_used)]
 
 use flyloop_core::lander2d::{DroneState, Lander2d, Lander2dParams};
 use flyloop_core::tasks::landing::{Landing, LandingParams};

@@ -4,7 +4,6 @@
 //! close. The snapshot keeps the grid phase.
 
 // Test code: a failed unwrap is a failed test.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use flyloop_core::quadrotor::{BodyState, Quadrotor, QuadrotorInitial, QuadrotorParams};
 

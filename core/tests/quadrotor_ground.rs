@@ -4,7 +4,6 @@
 //! 10 ms step and at PX4's 4 ms step.
 
 // Helpers are test code too: a failed setup is a failed test.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use flyloop_core::SimRng;
 use flyloop_core::quadrotor::contact::{foot_heights, gear_energy, rest_height};

@@ -2,7 +2,6 @@
 //! latency, noise and the per-episode randomisation, on the Iris of the PX4 preset.
 
 // Helpers are test code too: a failed setup is a failed test.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use flyloop_core::params::Parameters;
 use flyloop_core::quadrotor::QuadrotorParams;

@@ -3,7 +3,6 @@
 //! 001's environment (docs/reference/quadrotor.md).
 
 // Helpers are test code too: a failed setup is a failed test.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use flyloop_core::SimRng;
 use flyloop_core::params::Parameters;

@@ -2,7 +2,6 @@
 //! changes neither the wind samples nor, beyond integration accuracy, the path.
 
 // Helpers are test code too: a failed setup is a failed test.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use flyloop_core::SimRng;
 use flyloop_core::quadrotor::{BodyState, Quadrotor, QuadrotorParams};

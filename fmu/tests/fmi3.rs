@@ -3,9 +3,8 @@
 //! the misuse matrix (wrong call order, unknown references, wrong nValues, NaN, bad state
 //! bytes, NULL pointers): an error status and a log line, never a crash.
 // Test code: a failed unwrap is a failed test.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod support;
+use crate::support;
 
 use flyloop_core::variables::Causality;
 use flyloop_fmu::exports::*;

@@ -2,9 +2,8 @@
 //! and rapier world included); the same through serialize/deserialize, also into another
 //! instance; garbage, truncated and damaged bytes are refused; double free is refused.
 // Test code: a failed unwrap is a failed test.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod support;
+use crate::support;
 
 use flyloop_fmu::fmi2_types::fmi2FMUstate;
 use flyloop_fmu::fmi2_types::fmi2Status::{fmi2Error, fmi2OK};

@@ -1,9 +1,8 @@
 //! The state machine through the exported functions: the allowed sequence, illegal ones
 //! ("Illegal call sequence" + fmi2Error, nothing changed), reset, terminate, logging.
 // Test code: a failed unwrap is a failed test.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod support;
+use crate::support;
 
 use flyloop_fmu::exports::*;
 use flyloop_fmu::fmi2_types::*;

@@ -2,9 +2,8 @@
 //! out-of-range values, a wrong GUID, NULL callbacks and arguments, two instances side by
 //! side. Each returns the documented status, logs why, and crashes nothing.
 // Test code: a failed unwrap is a failed test.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod support;
+use crate::support;
 
 use flyloop_fmu::exports::*;
 use flyloop_fmu::fmi2_types::*;

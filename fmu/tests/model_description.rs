@@ -5,9 +5,8 @@
 //!     UPDATE_MODEL_DESCRIPTION=1 cargo test -p flyloop-fmu --test model_description
 //! (or: cargo run -p flyloop-fmu --bin flyloop-fmu-pack -- model-descriptions modelDescription)
 // Test code: a failed unwrap is a failed test.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod support;
+use crate::support;
 
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::Causality;

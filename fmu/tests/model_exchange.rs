@@ -1,9 +1,8 @@
 //! Model Exchange of Quadrotor.fmu through the exported functions: the state machine, the
 //! derivatives bit for bit against the core, events, FMU states, and the misuse matrix.
 // Test code: a failed unwrap is a failed test.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod support;
+use crate::support;
 
 use flyloop_core::quadrotor::dynamics::{STATE_LEN, derivative_vector};
 use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial, QuadrotorParams};

@@ -2,9 +2,8 @@
 //! t0 + n·h, divergence; and that the FMU's outputs are exactly the core's state after the
 //! same steps (bit for bit), for any communication step size.
 // Test code: a failed unwrap is a failed test.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod support;
+use crate::support;
 
 use flyloop_core::lander2d::{Lander2d, Lander2dInitial, Lander2dParams};
 use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial, QuadrotorParams};

@@ -2,7 +2,6 @@
 //! malformed datagrams between the steps of a controller; every step is answered exactly as
 //! in an undisturbed simulation, nothing panics, and every kind of bad input is counted.
 // Test code: a failed unwrap is a failed test.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use flyloop_core::tasks::registry::TaskKind;
 use flyloop_sitl::sim::{Link, Sim, SimOptions};

@@ -2,7 +2,6 @@
 //! lockstep reply matches the core's Hover task stepped directly in this test, and SIGTERM
 //! stops the SITL cleanly.
 // Test code: a failed unwrap is a failed test.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use flyloop_core::quadrotor::QuadrotorParams;
 use flyloop_core::tasks::flight::FlightParams;

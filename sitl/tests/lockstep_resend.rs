@@ -3,7 +3,6 @@
 //! without stepping; a late duplicate of an older step is skipped; unnamed steps
 //! (`time_usec` 0) step every time; a reset forgets the cached step.
 // Test code: a failed unwrap is a failed test.
-#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use flyloop_core::tasks::registry::TaskKind;
 use flyloop_sitl::commands::seed_params;

@@ -1,0 +1,37 @@
+"""Test groups for pytest-xdist. scripts/test.sh runs the suites on several workers
+(`-n N --dist loadgroup`); the tests of one group run on one worker, one after another:
+
+- px4, ardupilot: each autopilot build is started one instance at a time, so two instances
+  never race for the same free ports or work directories;
+- fmu (with the README and docs snippets, which simulate the packed FMUs): the session's
+  scripts/pack-fmus.sh rewrites dist/fmu/, which no other test may be reading meanwhile;
+- ray: one Ray on the machine at a time (the cluster test's `--address auto` must find its
+  own head node).
+
+Without xdist (a plain `pytest`), the groups change nothing.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent
+GROUPS = {
+    "tests/px4/": "px4",
+    "tests/ardupilot/": "ardupilot",
+    "tests/fmu/": "fmu",
+    "tests/readme/": "fmu",
+    "tests/training/test_training_rllib": "ray",
+}
+
+
+# Before xdist's own hook, which reads the groups (it appends "@group" to the test ids).
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    for item in items:
+        path = item.path.relative_to(ROOT).as_posix()
+        group = next((g for prefix, g in GROUPS.items() if path.startswith(prefix)), None)
+        if group is not None:
+            item.add_marker(pytest.mark.xdist_group(group))

@@ -1,0 +1,7 @@
+//! sitl's integration tests, one module per file, linked into one test binary (each file
+//! its own binary meant one more link, with LTO in release, per file).
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+mod handler_fuzz;
+mod lockstep_over_udp;
+mod lockstep_resend;
