@@ -15,17 +15,17 @@ say "cargo check of the fuzz target (sitl/fuzz: its own workspace; fuzzing itsel
 # With the workspace's lock file and target directory it reuses what clippy just checked.
 cp Cargo.lock sitl/fuzz/Cargo.lock
 CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}" cargo check --quiet --manifest-path sitl/fuzz/Cargo.toml
-# cargo-nextest when it is installed (a process per test, faster); otherwise cargo's own
-# runner over the same targets (lib, bins, integration tests; doctests below).
+# cargo-nextest when it is installed (a process per test, faster; doctests apart); otherwise
+# cargo's own runner, doctests included. Both take cargo's default targets, so a target with
+# `test = false` (a binary without unit tests) is not linked as a test.
 if cargo nextest --version >/dev/null 2>&1; then
-    say "Rust tests (cargo nextest)"
+    say "Rust tests (cargo nextest, then the doctests)"
     cargo nextest run --workspace --release
+    cargo test --workspace --release --doc
 else
-    say "Rust tests (cargo test; cargo-nextest is not installed)"
-    cargo test --workspace --release --lib --bins --tests
+    say "Rust tests and doctests (cargo test; cargo-nextest is not installed)"
+    cargo test --workspace --release
 fi
-say "Rust doctests"
-cargo test --workspace --release --doc
 say "ruff"
 .venv/bin/ruff check .
 .venv/bin/ruff format --check .
