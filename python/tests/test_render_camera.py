@@ -1,6 +1,8 @@
 """Camera and frame-convention math of flyloop.rendering (pure numpy, no pygame)."""
 
 import math
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -9,17 +11,11 @@ from flyloop.rendering import QuadScene
 from flyloop.rendering.camera import OrbitCamera, Projector
 from flyloop.rendering.quadrotor import ROTOR_SPIN, info_lines, rotation_matrix
 
+# The sample scenes' quaternion from Euler angles (the one copy, in the example that draws them).
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+from render_samples import quaternion_from_euler  # noqa: E402
+
 W, H = 800, 600
-
-
-def quaternion_from_euler(roll: float, pitch: float, yaw: float) -> np.ndarray:
-    """The unit quaternion [w, x, y, z] of intrinsic Z-Y-X angles in radians."""
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    w, x = cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy
-    y, z = cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy
-    return np.array([w, x, y, z])
 
 
 def test_look_at_point_lands_in_the_frame_centre():
