@@ -99,11 +99,10 @@ pub trait Simulation: std::fmt::Debug {
     /// Applies state bytes and returns their stage code; nothing changes on error.
     fn restore(&mut self, bytes: &[u8]) -> Result<u8, FmuError>;
     fn set_time(&mut self, time: f64) -> Result<(), FmuError>;
-    fn continuous_states(&self, x: &mut [f64]) -> Result<(), FmuError>;
-    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), FmuError>;
-    fn derivatives(&self, dx: &mut [f64]) -> Result<(), FmuError>;
-    fn event_indicators(&self, z: &mut [f64]) -> Result<(), FmuError>;
-    fn nominals(&self, nominals: &mut [f64]) -> Result<(), FmuError>;
+    /// The model's hybrid view, after checking that the importer's array `name` of length
+    /// `len` has one entry per continuous state (`ni`: per event indicator).
+    fn hybrid(&self, len: usize, name: &str) -> Result<&dyn Hybrid, FmuError>;
+    fn hybrid_mut(&mut self, len: usize, name: &str) -> Result<&mut dyn Hybrid, FmuError>;
     /// Whether the continuous states changed, and the next time event (absolute time).
     fn new_discrete_states(&mut self) -> Result<(bool, Option<f64>), FmuError>;
     fn completed_integrator_step(&self) -> Result<(), FmuError>;
@@ -163,13 +162,14 @@ impl<M: FmuModel> Engine<M> {
         Ok(())
     }
 
-    /// The model's hybrid view, after checking that the importer's array `name` of length
+    /// Fails unless the model has Model Exchange and the importer's array `name` of length
     /// `len` has one entry per continuous state (`ni`: per event indicator).
-    fn hybrid(&self, len: usize, name: &str) -> Result<&dyn Hybrid, FmuError> {
+    fn check_len(len: usize, name: &str) -> Result<(), FmuError> {
         let table = &M::table().table;
-        let (Some(me), Some(hybrid)) = (&table.model_exchange, self.model.hybrid()) else {
-            return Err(co_simulation_only());
-        };
+        let me = table
+            .model_exchange
+            .as_ref()
+            .ok_or_else(co_simulation_only)?;
         let (expected, what) = match name {
             "ni" => (me.event_indicators, "event indicators"),
             _ => (me.states.len(), "continuous states"),
@@ -180,11 +180,7 @@ impl<M: FmuModel> Engine<M> {
                 table.info.identifier,
             )));
         }
-        Ok(hybrid)
-    }
-
-    fn hybrid_mut(&mut self) -> Result<&mut dyn Hybrid, FmuError> {
-        self.model.hybrid_mut().ok_or_else(co_simulation_only)
+        Ok(())
     }
 
     fn decode(bytes: &[u8]) -> Result<(u8, Book<M::Initial>, M), FmuError> {
@@ -347,7 +343,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
     /// A finite time not before the last event (a solver may go back within a step it
     /// rejects, never past an event it has handled).
     fn set_time(&mut self, time: f64) -> Result<(), FmuError> {
-        self.hybrid_mut()?;
+        self.model.hybrid().ok_or_else(co_simulation_only)?;
         let last = self.book.event_time;
         if !time.is_finite() || time < last - TIME_TOLERANCE * last.abs().max(1.0) {
             return Err(FmuError::InvalidArgument(format!(
@@ -360,30 +356,14 @@ impl<M: FmuModel> Simulation for Engine<M> {
         Ok(())
     }
 
-    fn continuous_states(&self, x: &mut [f64]) -> Result<(), FmuError> {
-        self.hybrid(x.len(), "nx")?.states(x);
-        Ok(())
+    fn hybrid(&self, len: usize, name: &str) -> Result<&dyn Hybrid, FmuError> {
+        Self::check_len(len, name)?;
+        self.model.hybrid().ok_or_else(co_simulation_only)
     }
 
-    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), FmuError> {
-        self.hybrid(x.len(), "nx")?;
-        self.hybrid_mut()?.set_states(x)
-    }
-
-    fn derivatives(&self, dx: &mut [f64]) -> Result<(), FmuError> {
-        self.hybrid(dx.len(), "nx")?.derivatives(dx);
-        Ok(())
-    }
-
-    fn event_indicators(&self, z: &mut [f64]) -> Result<(), FmuError> {
-        self.hybrid(z.len(), "ni")?.event_indicators(z);
-        Ok(())
-    }
-
-    fn nominals(&self, nominals: &mut [f64]) -> Result<(), FmuError> {
-        self.hybrid(nominals.len(), "nx")?;
-        nominals.fill(1.0);
-        Ok(())
+    fn hybrid_mut(&mut self, len: usize, name: &str) -> Result<&mut dyn Hybrid, FmuError> {
+        Self::check_len(len, name)?;
+        self.model.hybrid_mut().ok_or_else(co_simulation_only)
     }
 
     fn new_discrete_states(&mut self) -> Result<(bool, Option<f64>), FmuError> {
@@ -393,7 +373,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
             .as_ref()
             .map_or(0, |me| me.states.len());
         let (mut before, mut after) = (vec![0.0; n], vec![0.0; n]);
-        let hybrid = self.hybrid_mut()?;
+        let hybrid = self.hybrid_mut(n, "nx")?;
         hybrid.states(&mut before);
         hybrid.event_update(elapsed);
         hybrid.states(&mut after);

@@ -1,4 +1,5 @@
-//! The FMI 2.0 functions: Co-Simulation for both models, Model Exchange for the quadrotor.
+//! The FMI 2.0 functions of their own: Co-Simulation for both models, Model Exchange for the
+//! quadrotor. Those the same in FMI 3.0 are in [`super::shared`].
 
 mod cosimulation;
 mod lifecycle;

@@ -1,12 +1,11 @@
-//! Creating, initialising, terminating, resetting and freeing an FMI 3.0 instance, and its
-//! FMU states (the same states as FMI 2.0's, under FMI 3.0's names).
+//! Creating an FMI 3.0 instance and entering initialization mode (with the experiment,
+//! which FMI 2.0 sets in a function of its own).
 
 use crate::exports::guard::{c_str, guarded};
-use crate::exports::shared::fmu_state::*;
 use crate::exports::shared::instantiate::{Request, instantiate};
-use crate::exports::shared::lifecycle::*;
+use crate::exports::shared::lifecycle::setup_experiment;
 use crate::fmi3_types::*;
-use crate::instance::{Interface, Stage, masks, masks3};
+use crate::instance::{Interface, Stage, masks3};
 use crate::log::Sink;
 use crate::table::Api;
 use std::ffi::c_char;
@@ -46,10 +45,6 @@ unsafe fn instantiate3(
 }
 
 exports! {
-    fn fmi3FreeInstance(instance: fmi3Instance) {
-        free_instance(instance, "fmi3FreeInstance");
-    }
-
     /// A Model Exchange instance of the model whose token is `instantiationToken`
     /// (Quadrotor; Lander2D is Co-Simulation only). NULL, with the reason logged, on any
     /// failure.
@@ -134,37 +129,4 @@ forward! {
         let stop = (stopTimeDefined != fmi3False).then_some(stopTime);
         setup_experiment(i, f, startTime, stop).map(|()| i.stage = Stage::InitializationMode)
     };
-    fn fmi3SetDebugLogging(
-        instance: fmi3Instance,
-        loggingOn: fmi3Boolean,
-        nCategories: usize,
-        categories: *const fmi3String,
-    ) -> fmi3Status = masks::SET_DEBUG_LOGGING => set_debug_logging;
-    fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status =
-        masks::EXIT_INITIALIZATION_MODE => exit_initialization_mode;
-    fn fmi3Terminate(instance: fmi3Instance) -> fmi3Status = masks::TERMINATE => terminate;
-    fn fmi3Reset(instance: fmi3Instance) -> fmi3Status = masks::RESET => reset;
-    fn fmi3GetFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status =
-        masks::FMU_STATE => get_state;
-    fn fmi3SetFMUState(instance: fmi3Instance, FMUState: fmi3FMUState) -> fmi3Status =
-        masks::FMU_STATE => set_state;
-    fn fmi3FreeFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status =
-        masks::FMU_STATE => free_state;
-    fn fmi3SerializedFMUStateSize(
-        instance: fmi3Instance,
-        FMUState: fmi3FMUState,
-        size: *mut usize,
-    ) -> fmi3Status = masks::FMU_STATE => serialized_size;
-    fn fmi3SerializeFMUState(
-        instance: fmi3Instance,
-        FMUState: fmi3FMUState,
-        serializedState: *mut fmi3Byte,
-        size: usize,
-    ) -> fmi3Status = masks::FMU_STATE => serialize;
-    fn fmi3DeserializeFMUState(
-        instance: fmi3Instance,
-        serializedState: *const fmi3Byte,
-        size: usize,
-        FMUState: *mut fmi3FMUState,
-    ) -> fmi3Status = masks::FMU_STATE => deserialize;
 }

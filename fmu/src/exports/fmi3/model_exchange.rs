@@ -2,10 +2,10 @@
 //! same states, derivatives, event indicators and events as FMI 2.0's Model Exchange.
 
 use crate::error::FmuError;
-use crate::exports::guard::{c_slice, c_slice_mut, with_instance, write_out};
-use crate::exports::shared::model_exchange::*;
+use crate::exports::guard::{c_slice_mut, with_instance, write_out};
+use crate::exports::shared::model_exchange::discrete_update;
 use crate::fmi3_types::*;
-use crate::instance::{Instance, masks, masks3};
+use crate::instance::{Instance, masks3};
 use crate::table::ModelExchangeTable;
 
 /// How many values a Model Exchange quantity of the model has (0 for a Co-Simulation-only
@@ -52,44 +52,14 @@ exports! {
 }
 
 forward! {
-    fn fmi3SetTime(instance: fmi3Instance, time: fmi3Float64) -> fmi3Status =
-        masks::SET_TIME => |i| i.sim.set_time(time);
-    fn fmi3SetContinuousStates(
-        instance: fmi3Instance,
-        continuousStates: *const fmi3Float64,
-        nContinuousStates: usize,
-    ) -> fmi3Status = masks::SET_CONTINUOUS_STATES => |i| {
-        let states = c_slice(continuousStates, nContinuousStates, "continuous states")?;
-        i.sim.set_continuous_states(states)
-    };
+    /// FMI 3.0's fmi2GetDerivatives, also in initialization mode.
     fn fmi3GetContinuousStateDerivatives(
         instance: fmi3Instance,
         derivatives: *mut fmi3Float64,
         nContinuousStates: usize,
     ) -> fmi3Status = masks3::GET_DERIVATIVES => |i| {
-        i.sim.derivatives(c_slice_mut(derivatives, nContinuousStates, "derivatives")?)
-    };
-    fn fmi3GetEventIndicators(
-        instance: fmi3Instance,
-        eventIndicators: *mut fmi3Float64,
-        nEventIndicators: usize,
-    ) -> fmi3Status = masks::GET_EVENT_INDICATORS => |i| {
-        i.sim.event_indicators(c_slice_mut(eventIndicators, nEventIndicators, "eventIndicators")?)
-    };
-    fn fmi3GetContinuousStates(
-        instance: fmi3Instance,
-        continuousStates: *mut fmi3Float64,
-        nContinuousStates: usize,
-    ) -> fmi3Status = masks::GET_CONTINUOUS_STATES => |i| {
-        let states = c_slice_mut(continuousStates, nContinuousStates, "continuousStates")?;
-        i.sim.continuous_states(states)
-    };
-    fn fmi3GetNominalsOfContinuousStates(
-        instance: fmi3Instance,
-        nominals: *mut fmi3Float64,
-        nContinuousStates: usize,
-    ) -> fmi3Status = masks::GET_NOMINALS => |i| {
-        i.sim.nominals(c_slice_mut(nominals, nContinuousStates, "nominals")?)
+        let dx = c_slice_mut(derivatives, nContinuousStates, "derivatives")?;
+        i.sim.hybrid(nContinuousStates, "nx").map(|model| model.derivatives(dx))
     };
     /// The number of event indicators (0 for a Co-Simulation-only model).
     fn fmi3GetNumberOfEventIndicators(
@@ -98,21 +68,10 @@ forward! {
     ) -> fmi3Status = masks3::ANY => |i| {
         write_out(nEventIndicators, count(i, |me| me.event_indicators), "the count")
     };
-    /// The number of continuous states (0 for a Co-Simulation-only model).
     fn fmi3GetNumberOfContinuousStates(
         instance: fmi3Instance,
         nContinuousStates: *mut usize,
     ) -> fmi3Status = masks3::ANY => |i| {
         write_out(nContinuousStates, count(i, |me| me.states.len()), "the count")
     };
-    fn fmi3EnterEventMode(instance: fmi3Instance) -> fmi3Status =
-        masks::ENTER_EVENT_MODE => enter_event_mode;
-    fn fmi3EnterContinuousTimeMode(instance: fmi3Instance) -> fmi3Status =
-        masks::ENTER_CONTINUOUS_TIME_MODE => enter_continuous_time_mode;
-    fn fmi3CompletedIntegratorStep(
-        instance: fmi3Instance,
-        _noSetFMUStatePriorToCurrentPoint: fmi3Boolean,
-        enterEventMode: *mut fmi3Boolean,
-        terminateSimulation: *mut fmi3Boolean,
-    ) -> fmi3Status = masks::COMPLETED_INTEGRATOR_STEP => completed_integrator_step;
 }

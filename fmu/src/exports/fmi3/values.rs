@@ -42,7 +42,7 @@ pub(crate) fn computed(instance: &Instance, v: &Variable3) -> Result<f64, FmuErr
     match v.source {
         Source::EventIndicator(k) => {
             let mut z = vec![0.0; instance.sim.table().fmi3.event_indicators.len()];
-            instance.sim.event_indicators(&mut z)?;
+            instance.sim.hybrid(z.len(), "ni")?.event_indicators(&mut z);
             Ok(z[k])
         }
         _ => Ok(instance.sim.time()),

@@ -1,8 +1,10 @@
-//! Configuring, initialising, terminating, resetting and freeing an instance.
+//! Configuring, initialising, terminating, resetting and freeing an instance: the functions
+//! that are the same in both versions, and the experiment both versions set.
 
 use crate::error::FmuError;
 use crate::exports::guard::{c_slice, c_str, with_instance};
 use crate::fmi2_types::*;
+use crate::fmi3_types::*;
 use crate::instance::{Instance, Interface, Stage, masks};
 use crate::log::Category;
 use flyloop_core::number::Compact;
@@ -10,7 +12,7 @@ use std::ffi::CStr;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// Frees the instance behind `c` (the body of fmi2FreeInstance and fmi3FreeInstance).
-pub(crate) fn free_instance(c: fmi2Component, function: &'static str) {
+fn free_instance(c: fmi2Component, function: &'static str) {
     let status: fmi2Status = with_instance(c, function, masks::FREE_INSTANCE, |instance| {
         instance.event(&format!("{function}: freeing the instance"));
         Ok(())
@@ -23,44 +25,6 @@ pub(crate) fn free_instance(c: fmi2Component, function: &'static str) {
             drop(unsafe { Box::from_raw(c.cast::<Instance>()) });
         }));
     }
-}
-
-/// The body of fmi2SetDebugLogging and fmi3SetDebugLogging.
-///
-/// # Safety
-/// `categories` must be NULL or point to `n` C strings.
-pub(crate) unsafe fn set_debug_logging(
-    instance: &mut Instance,
-    function: &str,
-    on: impl Into<i32>,
-    n: usize,
-    categories: *const fmi2String,
-) -> Result<fmi2Status, FmuError> {
-    let on = on.into() != 0;
-    // SAFETY: per the function's contract.
-    let names = unsafe { c_slice(categories, n, "categories[]") }?;
-    if names.is_empty() {
-        instance.logging = [on; 4];
-        return Ok(fmi2Status::fmi2OK);
-    }
-    let mut worst = fmi2Status::fmi2OK;
-    for &name in names {
-        // SAFETY: each entry is NULL or a C string (the contract).
-        let name = unsafe { c_str(name) }.map(CStr::to_string_lossy);
-        let error = match name.as_deref().map(|n| (n, Category::from_name(n))) {
-            Some((_, Some(category))) => {
-                instance.logging[category as usize] = on;
-                continue;
-            }
-            Some((n, None)) => FmuError::InvalidArgument(format!(
-                "unknown log category `{n}` (known: logEvents, logStatusWarning, \
-                 logStatusError, logStatusFatal)"
-            )),
-            None => FmuError::NullArgument("categories[i]"),
-        };
-        worst = worst.max(instance.report(function, &error));
-    }
-    Ok(worst)
 }
 
 /// The experiment (fmi2SetupExperiment; fmi3EnterInitializationMode's arguments).
@@ -79,35 +43,66 @@ pub(crate) fn setup_experiment(
     Ok(())
 }
 
-/// The body of fmi2ExitInitializationMode and fmi3ExitInitializationMode: Co-Simulation
-/// goes to step mode, Model Exchange to event mode.
-pub(crate) fn exit_initialization_mode(
-    instance: &mut Instance,
-    function: &str,
-) -> Result<(), FmuError> {
-    let stage = match instance.interface {
-        Interface::CoSimulation => Stage::StepComplete,
-        Interface::ModelExchange => Stage::EventMode,
+exports! {
+    /// Frees the instance and every FMU state it handed out. NULL is ignored.
+    fn fmi2FreeInstance(c: fmi2Component) {
+        free_instance(c, "fmi2FreeInstance");
+    }
+
+    /// FMI 3.0's [`fmi2FreeInstance`].
+    fn fmi3FreeInstance(instance: fmi3Instance) {
+        free_instance(instance, "fmi3FreeInstance");
+    }
+}
+
+twins! {
+    /// Switches log categories: those named in `categories`, or all of them when
+    /// `nCategories` is 0. An unknown category name is an error (the others still switch).
+    fn fmi2SetDebugLogging / fmi3SetDebugLogging(
+        c,
+        loggingOn: fmi2Boolean | fmi3Boolean,
+        nCategories: usize,
+        categories: *const fmi2String,
+    ) = masks::SET_DEBUG_LOGGING => |i, f| {
+        let on = loggingOn != 0;
+        let names = c_slice(categories, nCategories, "categories[]")?;
+        if names.is_empty() {
+            i.logging = [on; 4];
+        }
+        let mut worst = fmi2Status::fmi2OK;
+        for &name in names {
+            let name = c_str(name).map(CStr::to_string_lossy);
+            let error = match name.as_deref().map(|n| (n, Category::from_name(n))) {
+                Some((_, Some(category))) => {
+                    i.logging[category as usize] = on;
+                    continue;
+                }
+                Some((n, None)) => FmuError::InvalidArgument(format!(
+                    "unknown log category `{n}` (known: logEvents, logStatusWarning, \
+                     logStatusError, logStatusFatal)"
+                )),
+                None => FmuError::NullArgument("categories[i]"),
+            };
+            worst = worst.max(i.report(f, &error));
+        }
+        Ok(worst)
     };
-    instance.enter(
-        stage,
-        &format!("{function}: t = {}", Compact(instance.sim.time())),
-    )
-}
-
-/// The body of fmi2Terminate and fmi3Terminate.
-pub(crate) fn terminate(instance: &mut Instance, function: &str) -> Result<(), FmuError> {
-    instance.enter(
-        Stage::Terminated,
-        &format!("{function}: t = {}", Compact(instance.sim.time())),
-    )
-}
-
-/// The body of fmi2Reset and fmi3Reset: back to the state right after instantiation.
-pub(crate) fn reset(instance: &mut Instance, function: &str) -> Result<(), FmuError> {
-    instance.sim.reset()?;
-    instance.enter(
-        Stage::Instantiated,
-        &format!("{function}: back to the start values"),
-    )
+    /// Co-Simulation goes to step mode, Model Exchange to event mode.
+    fn fmi2ExitInitializationMode / fmi3ExitInitializationMode(c) =
+        masks::EXIT_INITIALIZATION_MODE => |i, f| {
+            let stage = match i.interface {
+                Interface::CoSimulation => Stage::StepComplete,
+                Interface::ModelExchange => Stage::EventMode,
+            };
+            i.enter(stage, &format!("{f}: t = {}", Compact(i.sim.time())))
+        };
+    fn fmi2Terminate / fmi3Terminate(c) = masks::TERMINATE => |i, f| {
+        i.enter(Stage::Terminated, &format!("{f}: t = {}", Compact(i.sim.time())))
+    };
+    /// Back to the state right after instantiation: start values, no experiment. FMU states
+    /// handed out stay valid.
+    fn fmi2Reset / fmi3Reset(c) = masks::RESET => |i, f| {
+        i.sim.reset()?;
+        i.enter(Stage::Instantiated, &format!("{f}: back to the start values"))
+    };
 }

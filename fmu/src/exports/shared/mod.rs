@@ -1,6 +1,7 @@
-//! What FMI 2.0 and FMI 3.0 share below their C signatures: creating, configuring and
-//! freeing instances, FMU states and Model Exchange. Each body takes the function's name for
-//! its log messages and answers an FMI 2.0 status (FMI 3.0 converts it).
+//! What FMI 2.0 and FMI 3.0 share below their C signatures: the functions that are the same
+//! in both versions, declared once for both ([`twins!`]: freeing and configuring instances,
+//! FMU states, most of Model Exchange), and the bodies of those that differ only in their
+//! signatures (instantiation, the experiment, the event update).
 
 pub(crate) mod fmu_state;
 pub(crate) mod instantiate;

@@ -1,25 +1,12 @@
-//! The Model Exchange bodies of FMI 2.0 and FMI 3.0 (each mask refuses a Co-Simulation
-//! instance).
+//! Model Exchange (each mask refuses a Co-Simulation instance): the functions that are the
+//! same in both versions, and the event update both versions' discrete-state functions run.
 
 use crate::error::FmuError;
-use crate::exports::guard::write_out;
-use crate::instance::{Instance, Stage};
+use crate::exports::guard::{c_slice, c_slice_mut, write_out};
+use crate::fmi2_types::fmi2Boolean;
+use crate::fmi3_types::fmi3Boolean;
+use crate::instance::{Instance, Stage, masks};
 use flyloop_core::number::Compact;
-
-/// The body of fmi2EnterEventMode and fmi3EnterEventMode.
-pub(crate) fn enter_event_mode(instance: &mut Instance, _function: &str) -> Result<(), FmuError> {
-    instance.stage = Stage::EventMode;
-    Ok(())
-}
-
-/// The body of fmi2EnterContinuousTimeMode and fmi3EnterContinuousTimeMode.
-pub(crate) fn enter_continuous_time_mode(
-    instance: &mut Instance,
-    _function: &str,
-) -> Result<(), FmuError> {
-    instance.stage = Stage::ContinuousTimeMode;
-    Ok(())
-}
 
 /// The discrete changes of the event at the current time, logged as `function`'s event:
 /// whether the continuous states changed, and the next time event.
@@ -36,29 +23,63 @@ pub(crate) fn discrete_update(
     Ok((changed, next))
 }
 
-/// The body of fmi2CompletedIntegratorStep and fmi3CompletedIntegratorStep: no step event
-/// and no termination (`B::default()` is the version's false); an error (Error stage) once the
-/// state is not finite.
-///
-/// # Safety
-/// The two flags must be NULL or writable.
-pub(crate) unsafe fn completed_integrator_step<B: Copy + Default>(
-    instance: &mut Instance,
-    _function: &str,
-    _no_set_fmu_state_prior_to_current_point: B,
-    enter_event_mode: *mut B,
-    terminate_simulation: *mut B,
-) -> Result<(), FmuError> {
-    if enter_event_mode.is_null() {
-        return Err(FmuError::NullArgument("enterEventMode"));
-    }
-    if terminate_simulation.is_null() {
-        return Err(FmuError::NullArgument("terminateSimulation"));
-    }
-    instance.sim.completed_integrator_step()?;
-    // SAFETY: both non-NULL (checked above) and writable per the contract.
-    unsafe {
-        write_out(enter_event_mode, B::default(), "enterEventMode")?;
-        write_out(terminate_simulation, B::default(), "terminateSimulation")
-    }
+twins! {
+    /// A finite time not before the last event.
+    fn fmi2SetTime / fmi3SetTime(c, time: f64) = masks::SET_TIME => |i| i.sim.set_time(time);
+    /// Sets the states; nothing changes when a value is not finite.
+    fn fmi2SetContinuousStates / fmi3SetContinuousStates(c, x: *const f64, nx: usize) =
+        masks::SET_CONTINUOUS_STATES => |i| {
+            let x = c_slice(x, nx, "continuous states")?;
+            i.sim.hybrid_mut(nx, "nx")?.set_states(x)
+        };
+    fn fmi2GetContinuousStates / fmi3GetContinuousStates(c, x: *mut f64, nx: usize) =
+        masks::GET_CONTINUOUS_STATES => |i| {
+            let x = c_slice_mut(x, nx, "x")?;
+            i.sim.hybrid(nx, "nx").map(|model| model.states(x))
+        };
+    /// The foot heights (m): a sign change is a touch-down or a lift-off.
+    fn fmi2GetEventIndicators / fmi3GetEventIndicators(
+        c,
+        eventIndicators: *mut f64,
+        ni: usize,
+    ) = masks::GET_EVENT_INDICATORS => |i| {
+        let z = c_slice_mut(eventIndicators, ni, "eventIndicators")?;
+        i.sim.hybrid(ni, "ni").map(|model| model.event_indicators(z))
+    };
+    /// 1 for every state (positions in m, speeds in m/s, quaternion and motors near 1).
+    fn fmi2GetNominalsOfContinuousStates / fmi3GetNominalsOfContinuousStates(
+        c,
+        x_nominal: *mut f64,
+        nx: usize,
+    ) = masks::GET_NOMINALS => |i| {
+        let nominals = c_slice_mut(x_nominal, nx, "x_nominal")?;
+        i.sim.hybrid(nx, "nx").map(|_| nominals.fill(1.0))
+    };
+    /// Model Exchange only (Co-Simulation has no event mode here).
+    fn fmi2EnterEventMode / fmi3EnterEventMode(c) = masks::ENTER_EVENT_MODE => |i| {
+        i.stage = Stage::EventMode;
+        Ok(())
+    };
+    fn fmi2EnterContinuousTimeMode / fmi3EnterContinuousTimeMode(c) =
+        masks::ENTER_CONTINUOUS_TIME_MODE => |i| {
+            i.stage = Stage::ContinuousTimeMode;
+            Ok(())
+        };
+    /// No step event and no termination; an error once the state is not finite.
+    fn fmi2CompletedIntegratorStep / fmi3CompletedIntegratorStep(
+        c,
+        _noSetFMUStatePriorToCurrentPoint: fmi2Boolean | fmi3Boolean,
+        enterEventMode: *mut fmi2Boolean | *mut fmi3Boolean,
+        terminateSimulation: *mut fmi2Boolean | *mut fmi3Boolean,
+    ) = masks::COMPLETED_INTEGRATOR_STEP => |i| {
+        if enterEventMode.is_null() {
+            return Err(FmuError::NullArgument("enterEventMode"));
+        }
+        if terminateSimulation.is_null() {
+            return Err(FmuError::NullArgument("terminateSimulation"));
+        }
+        i.sim.completed_integrator_step()?;
+        write_out(enterEventMode, 0, "enterEventMode")?;
+        write_out(terminateSimulation, 0, "terminateSimulation")
+    };
 }
