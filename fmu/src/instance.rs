@@ -229,9 +229,8 @@ impl Instance {
     }
 
     pub fn log(&self, status: fmi2Status, message: &str) {
-        let category = category_of(status);
-        if self.logging[category as usize] {
-            self.logger.log(status, category, message);
+        if self.logging[category_of(status) as usize] {
+            self.logger.log(status, message);
         }
     }
 

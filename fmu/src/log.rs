@@ -27,15 +27,6 @@ pub const CATEGORIES: [(&CStr, &str); 4] = [
     ),
 ];
 
-impl Category {
-    const ALL: [Category; 4] = [Self::Events, Self::Warning, Self::Error, Self::Fatal];
-
-    pub fn from_name(name: &str) -> Option<Category> {
-        let at = CATEGORIES.iter().position(|(c, _)| c.to_str() == Ok(name));
-        at.map(|at| Self::ALL[at])
-    }
-}
-
 /// The importer's logging callback and the environment it wants back.
 #[derive(Debug, Clone, Copy)]
 pub enum Sink {
@@ -58,11 +49,12 @@ pub struct Logger {
 }
 
 impl Logger {
-    /// Calls the callback once with `message` (NUL bytes in it become U+FFFD; FMI 2.0:
-    /// always through a "%s" format so that a '%' in it is printed, never interpreted).
-    pub fn log(&self, status: fmi2Status, category: Category, message: &str) {
+    /// Calls the callback once with `message` in the category of `status` (NUL bytes in it
+    /// become U+FFFD; FMI 2.0: always through a "%s" format so that a '%' in it is printed,
+    /// never interpreted).
+    pub fn log(&self, status: fmi2Status, message: &str) {
         let text = CString::new(message.replace('\0', "\u{fffd}")).unwrap_or_default();
-        let category = CATEGORIES[category as usize].0.as_ptr();
+        let category = CATEGORIES[category_of(status) as usize].0.as_ptr();
         match self.sink {
             // SAFETY: callback and environment came together from the importer, which keeps
             // them valid while the instance lives; every string is NUL-terminated and

@@ -59,14 +59,6 @@ impl From<()> for fmi2Status {
     }
 }
 
-/// Runs `body` (an export without an instance) and returns `fallback` if it panics.
-pub(crate) fn guarded<R>(fallback: R, body: impl FnOnce() -> R) -> R {
-    catch_unwind(AssertUnwindSafe(body)).unwrap_or_else(|payload| {
-        let _ = panic_message(payload);
-        fallback
-    })
-}
-
 /// The text of a panic payload. The payload is leaked, not dropped: a payload whose drop
 /// panicked again would abort the importing process.
 fn panic_message(payload: Box<dyn Any + Send>) -> String {
@@ -208,11 +200,5 @@ mod tests {
         let last = recorder.last().unwrap();
         assert!(last.message.contains("stage Fatal"), "{last:?}");
         assert!(recorder.bad_formats.lock().unwrap().is_empty());
-    }
-
-    #[test]
-    fn panics_without_an_instance_give_the_fallback() {
-        assert_eq!(guarded(7, || panic!("no instance")), 7);
-        assert_eq!(guarded(7, || 3), 3);
     }
 }

@@ -1,7 +1,7 @@
 //! Creating an FMI 3.0 instance and entering initialization mode (with the experiment,
 //! which FMI 2.0 sets in a function of its own).
 
-use crate::exports::guard::{c_str, guarded};
+use crate::exports::guard::c_str;
 use crate::exports::shared::instantiate::{Request, instantiate};
 use crate::exports::shared::lifecycle::setup_experiment;
 use crate::fmi3_types::*;
@@ -13,7 +13,7 @@ use std::ffi::c_char;
 /// Returns "3.0".
 #[unsafe(no_mangle)]
 pub extern "C" fn fmi3GetVersion() -> *const c_char {
-    guarded(fmi3Version.as_ptr(), || fmi3Version.as_ptr())
+    fmi3Version.as_ptr()
 }
 
 /// What the fmi3Instantiate* functions do for `interface` (or the reason it holds).

@@ -2,7 +2,7 @@
 
 use crate::fmi2_types::fmi2Status;
 use crate::instance::{Instance, Interface};
-use crate::log::{Category, Logger, Sink};
+use crate::log::{Logger, Sink};
 use crate::models;
 use crate::table::Api;
 use std::ffi::{CStr, c_void};
@@ -73,7 +73,7 @@ pub(crate) fn instantiate<'a>(build: impl FnOnce() -> Option<Request<'a>>) -> *m
             sink: request.sink,
             instance_name: name,
         };
-        logger.log(fmi2Status::fmi2Error, Category::Error, &message);
+        logger.log(fmi2Status::fmi2Error, &message);
         None
     }));
     outcome.ok().flatten().unwrap_or(std::ptr::null_mut())

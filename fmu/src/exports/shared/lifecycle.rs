@@ -6,7 +6,7 @@ use crate::exports::guard::{c_slice, c_str, with_instance};
 use crate::fmi2_types::*;
 use crate::fmi3_types::*;
 use crate::instance::{Instance, Interface, Stage, masks};
-use crate::log::Category;
+use crate::log::CATEGORIES;
 use flyloop_core::number::Compact;
 use std::ffi::CStr;
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -72,9 +72,10 @@ twins! {
         let mut worst = fmi2Status::fmi2OK;
         for &name in names {
             let name = c_str(name).map(CStr::to_string_lossy);
-            let error = match name.as_deref().map(|n| (n, Category::from_name(n))) {
+            let known = |n: &str| CATEGORIES.iter().position(|(c, _)| c.to_str() == Ok(n));
+            let error = match name.as_deref().map(|n| (n, known(n))) {
                 Some((_, Some(category))) => {
-                    i.logging[category as usize] = on;
+                    i.logging[category] = on;
                     continue;
                 }
                 Some((n, None)) => FmuError::InvalidArgument(format!(
