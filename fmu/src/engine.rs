@@ -5,11 +5,10 @@
 
 use crate::error::FmuError;
 use crate::model::{Access, FmuModel, Hybrid, StepRequest, Table};
-use crate::state_record;
 use crate::table::{Api, ModelTable};
-use flyloop_core::SnapshotError;
 use flyloop_core::number::Compact;
 use flyloop_core::variables::{self, Causality, Variability};
+use flyloop_core::{SnapshotError, snapshot};
 use serde::{Deserialize, Serialize};
 
 /// A communication point matches the instance's time within this fraction of max(1 s, |t|)
@@ -131,8 +130,9 @@ fn co_simulation_only() -> FmuError {
     FmuError::NotSupported("Model Exchange: this model is Co-Simulation only")
 }
 
-/// An FMU state: its model's GUID (readable for any model, so that a state of another model
-/// is named as such) around the model-specific part.
+/// An FMU state (fmi2GetFMUstate, fmi2SerializeFMUstate) in the core's snapshot envelope
+/// (tag, length, checksum) under [`STATE_TAG`]: its model's GUID (readable for any model, so
+/// that a state of another model is named as such) around the model-specific part.
 #[derive(Serialize, Deserialize)]
 struct Record {
     guid: String,
@@ -143,6 +143,9 @@ struct Record {
 
 /// The model-specific part of an FMU state: the book, then the model's own snapshot.
 type Body<I> = (Book<I>, Vec<u8>);
+
+const STATE_TAG: &[u8; 8] = b"FLYFMI01";
+const STATE_NAME: &str = "flyloop FMU state";
 
 impl<M: FmuModel> Engine<M> {
     pub fn new() -> Result<Self, FmuError> {
@@ -184,7 +187,7 @@ impl<M: FmuModel> Engine<M> {
     }
 
     fn decode(bytes: &[u8]) -> Result<(u8, Book<M::Initial>, M), FmuError> {
-        let record: Record = state_record::decode(bytes)?;
+        let record: Record = snapshot::decode(STATE_TAG, STATE_NAME, bytes)?;
         let table = &M::table().table;
         if record.guid != table.token(Api::Fmi2) {
             return Err(FmuError::InvalidArgument(format!(
@@ -327,7 +330,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
             body: postcard::to_stdvec(&body)
                 .map_err(|e| FmuError::State(SnapshotError::Encode(e.to_string())))?,
         };
-        Ok(state_record::encode(&record)?)
+        Ok(snapshot::encode(STATE_TAG, &record)?)
     }
 
     fn check_saved(&self, bytes: &[u8]) -> Result<u8, FmuError> {
@@ -429,5 +432,23 @@ mod tests {
             "a real change is kept"
         );
         assert_eq!(Clock::at(0.0).grid_step(jittered), jittered, "no grid yet");
+    }
+
+    #[test]
+    fn states_are_in_the_envelope_under_the_fmu_tag_and_no_other() {
+        let value = (7u8, -0.0f64, String::from("Quadrotor"), vec![1u8, 2, 3]);
+        let bytes = snapshot::encode(STATE_TAG, &value).unwrap();
+        assert_eq!(&bytes[..8], STATE_TAG);
+        let back: (u8, f64, String, Vec<u8>) =
+            snapshot::decode(STATE_TAG, STATE_NAME, &bytes).unwrap();
+        assert_eq!(back.1.to_bits(), (-0.0f64).to_bits());
+        // A core snapshot (another tag) is not an FMU state.
+        let foreign = snapshot::encode(b"FLYQUA01", &value).unwrap();
+        assert_eq!(
+            snapshot::decode::<(u8, f64, String, Vec<u8>)>(STATE_TAG, STATE_NAME, &foreign),
+            Err(SnapshotError::WrongFormat {
+                expected: STATE_NAME
+            })
+        );
     }
 }

@@ -16,7 +16,6 @@ pub mod model;
 pub mod model_description;
 pub mod models;
 pub mod pack;
-pub mod state_record;
 pub mod table;
 pub mod units;
 
