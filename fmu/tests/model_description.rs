@@ -2,7 +2,7 @@
 //! ModelStructure's direct dependencies are what the models do.
 //!
 //! To update the checked-in copies after changing a variable table:
-//!     UPDATE_MODEL_DESCRIPTION=1 cargo test -p flyloop-fmu --test model_description
+//!     UPDATE_MODEL_DESCRIPTION=1 cargo test -p flyloop-fmu --test integration model_description
 //! (or: cargo run -p flyloop-fmu --bin flyloop-fmu-pack -- model-descriptions modelDescription)
 // Test code: a failed unwrap is a failed test.
 
@@ -39,7 +39,7 @@ fn checked_in_model_descriptions_match_the_generated_ones() {
         assert!(
             checked_in == generated,
             "{} is out of date with the variable tables; regenerate it with\n    \
-             UPDATE_MODEL_DESCRIPTION=1 cargo test -p flyloop-fmu --test model_description\n\
+             UPDATE_MODEL_DESCRIPTION=1 cargo test -p flyloop-fmu --test integration model_description\n\
              and review the diff",
             path.display()
         );
