@@ -3,8 +3,8 @@
 //! appears in rapier's narrow phase at the start of a physics step and the solver acts on it in
 //! that same step, so the impact is judged on the state the drone had when that step began.
 
+use super::drone::DroneState;
 use super::params::Lander2dParams;
-use super::world::DroneState;
 use serde::{Deserialize, Serialize};
 
 /// Contact flags of the drone and the latched touch-down outcome.

@@ -12,8 +12,8 @@
 use rapier2d_f64::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::drone::{DroneGeometry, DroneState};
 use super::params::Lander2dParams;
-use super::world::{DroneGeometry, DroneState};
 
 /// Substeps of one rapier step (rapier's default `num_solver_iterations`).
 pub(crate) const SUBSTEPS: usize = 4;

@@ -3,10 +3,10 @@
 //! what an FMU instance, a SITL vehicle or the Landing task holds.
 
 use super::contact::ContactState;
+use super::drone::DroneState;
 use super::free_body::MassProps;
 use super::params::{Lander2dInitial, Lander2dParams};
 use super::scene::Scene;
-use super::world::DroneState;
 use crate::error::{InputError, ParamError, check_finite};
 use crate::params::Parameters;
 use crate::rng::SimRng;

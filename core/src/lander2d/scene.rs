@@ -13,9 +13,10 @@
 use rapier2d_f64::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::drone::{DroneGeometry, DroneState};
 use super::free_body::{FreeBody, MassProps};
 use super::params::Lander2dParams;
-use super::world::{self, DroneGeometry, DroneState, Handles};
+use super::world::{self, Handles};
 
 /// Clearance kept beyond what one grid step could close, m.
 const SAFETY: f64 = 0.25;

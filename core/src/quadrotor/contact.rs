@@ -28,8 +28,7 @@
 //! (2 ms: ω·h = 0.22): 5 substeps for a 10 ms control step, 2 for PX4's 4 ms step. A step in
 //! which no foot can reach the ground keeps `max_substep` and never evaluates the contact.
 
-use super::dynamics::ROTOR_POSITION;
-use super::params::QuadrotorParams;
+use super::params::{QuadrotorParams, ROTOR_POSITION};
 use super::state::BodyState;
 
 /// Index of the first bristle value in the contact integrator's flat state (after the 17

@@ -11,11 +11,6 @@ use super::params::QuadrotorParams;
 use super::state::BodyState;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
-/// Spin of each rotor seen from above: −1 for CCW (reaction torque toward −z), +1 for CW.
-pub const ROTOR_SPIN: [f64; 4] = [-1.0, -1.0, 1.0, 1.0];
-/// Rotor position signs (forward, left), multiplied by L/√2.
-pub const ROTOR_POSITION: [(f64, f64); 4] = [(1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (-1.0, -1.0)];
-
 /// Time derivative of a [`BodyState`] (same shape: velocity, acceleration, q̇, ω̇, ṁ, ṡ).
 #[derive(Debug, Clone, Copy)]
 pub struct Derivative {
@@ -410,6 +405,7 @@ pub fn accelerations(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::quadrotor::params::{ROTOR_POSITION, ROTOR_SPIN};
 
     /// The written-out torque sums in `rates` against r × F and the spin reaction summed
     /// over the rotor tables, for unequal motor states.
