@@ -3,10 +3,10 @@
 //! checked-in copies under modelDescription/ can be compared byte for byte.
 
 use crate::log::CATEGORIES;
-use crate::table::{Api, ModelTable, Variable3};
+use crate::table::{Api, ModelExchangeTable, ModelTable, Source, Variable3};
 use crate::units::{self, BASE_UNITS};
 use flyloop_core::params::ValueKind;
-use flyloop_core::variables::{Causality, Variable};
+use flyloop_core::variables::Causality;
 use std::collections::BTreeSet;
 use std::fmt::Write;
 
@@ -88,7 +88,7 @@ fn write_units(out: &mut String, variables: &[Variable3]) -> Result<(), UnknownU
             variable: used
                 .clone()
                 .find(|v| v.unit == unit)
-                .map_or_else(String::new, |v| v.name.clone()),
+                .map_or_else(String::new, |v| v.name.to_string()),
         })?;
         let _ = write!(out, "    <Unit name=\"{}\"", escape(unit));
         match exponents {
@@ -106,34 +106,18 @@ fn write_units(out: &mut String, variables: &[Variable3]) -> Result<(), UnknownU
     Ok(())
 }
 
-/// The value references `output` depends on: its direct-feedthrough inputs and, under Model
-/// Exchange, the continuous states (none for a state itself, which is its own known).
-fn output_dependencies(table: &ModelTable, output: &Variable) -> Vec<u32> {
-    let feedthrough = table.info.direct_feedthrough.iter();
-    let inputs = feedthrough.filter(|(name, _)| *name == output.name);
-    let mut dependencies: Vec<u32> = (inputs.flat_map(|(_, inputs)| inputs.iter()))
-        .filter_map(|name| table.by_name(name))
-        .map(|v| v.value_reference)
-        .collect();
-    if let Some(me) = &table.model_exchange {
-        let is_state = me.states.contains(&output.value_reference);
-        if !is_state && !table.info.state_free_outputs.contains(&output.name) {
-            dependencies.extend(&me.states);
-        }
-    }
-    dependencies
-}
-
 /// One modelDescription being written: the version and the variables in ModelVariables order
 /// (FMI 2.0: the table's, each a scalar; FMI 3.0: the FMI 3.0 view's).
 struct Writer<'a> {
     api: Api,
     table: &'a ModelTable,
     variables: &'a [Variable3],
+    /// The model's, or an empty one for a Co-Simulation-only model.
+    me: ModelExchangeTable,
     out: String,
 }
 
-impl<'a> Writer<'a> {
+impl Writer<'_> {
     /// How ModelStructure names the variable at position `i`: FMI 2.0 by its 1-based index,
     /// FMI 3.0 by its value reference.
     fn id(&self, i: usize) -> u32 {
@@ -143,39 +127,41 @@ impl<'a> Writer<'a> {
         }
     }
 
-    /// [`Writer::id`] of the variable that holds model variable `vr`.
-    fn id_of(&self, vr: u32) -> Option<u32> {
-        match self.api {
-            Api::Fmi2 => self.table.by_vr.get(vr).map(|i| i as u32 + 1),
-            Api::Fmi3 => self.table.fmi3.element(vr).map(|(vr, _)| vr),
-        }
+    /// The positions of the variables that hold the model variables `vrs`, in order.
+    fn holders<'v>(&self, vrs: impl IntoIterator<Item = &'v u32>) -> BTreeSet<usize> {
+        let positions = vrs.into_iter().filter_map(|&vr| self.table.by_vr.get(vr));
+        let holder = |at| {
+            self.variables
+                .iter()
+                .position(|v| v.elements().contains(&at))
+        };
+        positions.filter_map(holder).collect()
     }
 
-    /// The ids of the variables holding the model variables `vrs`, each once, in order.
-    fn ids_of(&self, vrs: impl IntoIterator<Item = u32>) -> Vec<u32> {
-        let mut ids: Vec<u32> = Vec::new();
-        for id in vrs.into_iter().filter_map(|vr| self.id_of(vr)) {
-            if !ids.contains(&id) {
-                ids.push(id);
+    /// The ids output `i` depends on: its elements' direct-feedthrough inputs and, under
+    /// Model Exchange, the continuous states (none for a state itself, its own known).
+    fn dependencies(&self, i: usize) -> String {
+        let (table, info) = (self.table, self.table.info);
+        let mut vrs = Vec::new();
+        for output in &table.variables[self.variables[i].elements()] {
+            let feedthrough = info.direct_feedthrough.iter();
+            let inputs = feedthrough.filter(|(name, _)| *name == output.name);
+            let inputs = inputs.flat_map(|(_, inputs)| inputs.iter());
+            vrs.extend(inputs.filter_map(|name| Some(table.by_name(name)?.value_reference)));
+            let is_state = self.me.states.contains(&output.value_reference);
+            if !is_state && !info.state_free_outputs.contains(&output.name) {
+                vrs.extend(&self.me.states);
             }
         }
-        ids
-    }
-
-    /// The id of the state whose derivative `v` is.
-    fn state_of_derivative(&self, v: &Variable3) -> Option<u32> {
-        let me = self.table.model_exchange.as_ref()?;
-        let vr = self.table.variables[*v.elements().first()?].value_reference;
-        let k = me.derivatives.iter().position(|&d| d == vr)?;
-        self.id_of(me.states[k])
+        let ids: Vec<String> = (self.holders(&vrs).into_iter())
+            .map(|i| self.id(i).to_string())
+            .collect();
+        ids.join(" ")
     }
 
     fn header(&mut self) {
         let (api, table, info) = (self.api, self.table, self.table.info);
-        let n = table
-            .model_exchange
-            .as_ref()
-            .map_or(0, |me| me.event_indicators);
+        let n = self.me.event_indicators;
         let (version, token, events) = match api {
             Api::Fmi2 => ("2.0", "guid", format!(" numberOfEventIndicators=\"{n}\"")),
             Api::Fmi3 => ("3.0", "instantiationToken", String::new()),
@@ -220,29 +206,25 @@ impl<'a> Writer<'a> {
     /// element's, for an FMI 3.0 array) and the state it is the derivative of.
     fn variable(&mut self, i: usize, v: &Variable3) {
         let ty = self.api.type_name(v.kind);
-        let element = match self.api {
-            Api::Fmi2 => "ScalarVariable",
-            Api::Fmi3 => ty,
+        let (element, open) = match self.api {
+            Api::Fmi2 => (
+                format!("<!-- Index {} -->\n    <ScalarVariable", i + 1),
+                format!(">\n      <{ty}"),
+            ),
+            Api::Fmi3 => (format!("<{ty}"), String::new()),
         };
+        let (name, vr, text) = (escape(v.name), v.value_reference, escape(v.description));
+        let causality = match v.source {
+            Source::Time => "independent".to_string(),
+            _ => format!("{:?}", v.causality).to_lowercase(),
+        };
+        let variability = format!("{:?}", v.variability).to_lowercase();
         let out = &mut self.out;
-        if self.api == Api::Fmi2 {
-            let _ = writeln!(out, "    <!-- Index {} -->", i + 1);
-        }
-        let (name, vr, text) = (escape(&v.name), v.value_reference, escape(&v.description));
-        let causality = v
-            .causality
-            .map_or("independent".into(), |c| format!("{c:?}"));
-        let variability = format!("{:?}", v.variability);
         let _ = write!(
             out,
-            "    <{element} name=\"{name}\" valueReference=\"{vr}\" description=\"{text}\" \
-             causality=\"{}\" variability=\"{}\"",
-            causality.to_lowercase(),
-            variability.to_lowercase()
+            "    {element} name=\"{name}\" valueReference=\"{vr}\" description=\"{text}\" \
+             causality=\"{causality}\" variability=\"{variability}\"{open}",
         );
-        if self.api == Api::Fmi2 {
-            let _ = write!(out, ">\n      <{ty}");
-        }
         if v.kind == ValueKind::Real && !v.unit.is_empty() {
             let _ = write!(out, " unit=\"{}\"", escape(v.unit));
         }
@@ -253,12 +235,17 @@ impl<'a> Writer<'a> {
                 }
             }
         }
-        if !v.start.is_empty() {
-            let starts: Vec<String> = v.start.iter().map(|&s| value_text(v.kind, s)).collect();
+        let starts = self.table.variables[v.elements()]
+            .iter()
+            .filter_map(|e| e.start);
+        let starts: Vec<String> = starts.map(|s| value_text(v.kind, s)).collect();
+        if !starts.is_empty() {
             let _ = write!(out, " start=\"{}\"", starts.join(" "));
         }
-        if let Some(state) = self.state_of_derivative(v) {
-            let _ = write!(self.out, " derivative=\"{state}\"");
+        let derivative = self.me.derivatives.iter().position(|&d| d == vr);
+        let state = derivative.and_then(|k| self.holders(&self.me.states[k..=k]).pop_first());
+        if let Some(state) = state {
+            let _ = write!(self.out, " derivative=\"{}\"", self.id(state));
         }
         let _ = match (self.api, v.dimension) {
             (Api::Fmi2, _) => writeln!(self.out, "/>\n    </ScalarVariable>"),
@@ -269,64 +256,48 @@ impl<'a> Writer<'a> {
         };
     }
 
-    /// A part of ModelStructure: FMI 2.0 `<Unknown index=..>`s inside `<group>`, FMI 3.0
-    /// `<element valueReference=..>`s; each with its dependencies where they are given.
-    fn structure(&mut self, group: &str, element: &str, unknowns: Vec<(u32, Option<String>)>) {
-        let (indent, element, id) = match self.api {
-            Api::Fmi2 => ("      ", "Unknown", "index"),
-            Api::Fmi3 => ("    ", element, "valueReference"),
-        };
-        if self.api == Api::Fmi2 {
-            let _ = writeln!(self.out, "    <{group}>");
-        }
-        for (unknown, dependencies) in unknowns {
-            let _ = write!(self.out, "{indent}<{element} {id}=\"{unknown}\"");
-            if let Some(d) = dependencies {
-                let _ = write!(self.out, " dependencies=\"{d}\"");
-            }
-            self.out.push_str("/>\n");
-        }
-        if self.api == Api::Fmi2 {
-            let _ = writeln!(self.out, "    </{group}>");
-        }
-    }
-
+    /// ModelStructure: FMI 2.0 `<Unknown index=..>`s in groups, FMI 3.0 elements by value
+    /// reference; the outputs with their dependencies.
     fn model_structure(&mut self) {
-        let me = self.table.model_exchange.as_ref();
-        let outputs: Vec<(u32, Option<String>)> = (self.variables.iter().enumerate())
-            .filter(|(_, v)| v.causality == Some(Causality::Output))
-            .map(|(i, v)| {
-                let elements = v.elements().iter().map(|&at| &self.table.variables[at]);
-                let vrs = elements.flat_map(|e| output_dependencies(self.table, e));
-                let ids: Vec<String> = self.ids_of(vrs).iter().map(u32::to_string).collect();
-                (self.id(i), Some(ids.join(" ")))
-            })
-            .collect();
-        let derivatives = self.ids_of(me.iter().flat_map(|me| me.derivatives.iter().copied()));
+        let variables = self.variables.iter().enumerate();
+        let outputs = variables
+            .clone()
+            .filter(|(_, v)| v.causality == Causality::Output);
+        let outputs: BTreeSet<usize> = outputs.map(|(i, _)| i).collect();
+        let derivatives = self.holders(&self.me.derivatives);
         // Calculated during initialisation: every output, every derivative, the local states.
-        let mut initial: Vec<u32> = outputs.iter().map(|&(id, _)| id).collect();
-        initial.extend(&derivatives);
-        initial.extend(self.ids_of(me.iter().flat_map(|me| me.states.iter().copied())));
-        let position = |id: &u32| (0..self.variables.len()).position(|i| self.id(i) == *id);
-        initial.sort_by_key(position);
-        initial.dedup();
-        let event_indicators = match self.api {
-            Api::Fmi2 => Vec::new(),
-            Api::Fmi3 => self.table.fmi3.event_indicators.clone(),
-        };
-        let unknowns = |ids: Vec<u32>| ids.into_iter().map(|id| (id, None)).collect();
+        let mut initial = &outputs | &derivatives;
+        initial.extend(self.holders(&self.me.states));
+        let events = variables.filter(|(_, v)| matches!(v.source, Source::EventIndicator(_)));
+        let events = events.map(|(i, _)| i).collect();
         self.out.push_str("  <ModelStructure>\n");
-        self.structure("Outputs", "Output", outputs);
-        if me.is_some() || self.api == Api::Fmi3 {
-            self.structure(
-                "Derivatives",
-                "ContinuousStateDerivative",
-                unknowns(derivatives),
-            );
-        }
-        self.structure("InitialUnknowns", "InitialUnknown", unknowns(initial));
-        if self.api == Api::Fmi3 {
-            self.structure("", "EventIndicator", unknowns(event_indicators));
+        for (group, element, unknowns) in [
+            ("Outputs", "Output", outputs),
+            ("Derivatives", "ContinuousStateDerivative", derivatives),
+            ("InitialUnknowns", "InitialUnknown", initial),
+            ("EventIndicators", "EventIndicator", events),
+        ] {
+            // FMI 2.0 has no empty groups (and FMI 3.0 no event indicators either).
+            if unknowns.is_empty() {
+                continue;
+            }
+            let (indent, element, id) = match self.api {
+                Api::Fmi2 => ("      ", "Unknown", "index"),
+                Api::Fmi3 => ("    ", element, "valueReference"),
+            };
+            if self.api == Api::Fmi2 {
+                let _ = writeln!(self.out, "    <{group}>");
+            }
+            for i in unknowns {
+                let _ = write!(self.out, "{indent}<{element} {id}=\"{}\"", self.id(i));
+                if group == "Outputs" {
+                    let _ = write!(self.out, " dependencies=\"{}\"", self.dependencies(i));
+                }
+                self.out.push_str("/>\n");
+            }
+            if self.api == Api::Fmi2 {
+                let _ = writeln!(self.out, "    </{group}>");
+            }
         }
         self.out.push_str("  </ModelStructure>\n");
     }
@@ -334,19 +305,16 @@ impl<'a> Writer<'a> {
 
 /// The modelDescription.xml of `table`'s model in FMI version `api`.
 pub fn generate(table: &ModelTable, api: Api) -> Result<String, UnknownUnit> {
-    let scalars: Vec<Variable3>;
+    let scalars = Variable3::of(&table.variables, &[]);
     let variables = match api {
-        Api::Fmi2 => {
-            let each = |(i, v)| Variable3::of(std::slice::from_ref(v), i, None);
-            scalars = table.variables.iter().enumerate().map(each).collect();
-            &scalars
-        }
+        Api::Fmi2 => &scalars,
         Api::Fmi3 => &table.fmi3.variables,
     };
     let mut w = Writer {
         api,
         table,
         variables,
+        me: table.model_exchange.clone().unwrap_or_default(),
         out: String::new(),
     };
     w.header();

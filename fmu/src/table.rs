@@ -6,6 +6,7 @@ use crate::guid;
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::{Causality, Variability, Variable};
 use std::ffi::CString;
+use std::ops::{Deref, Range};
 
 /// The FMI version an instance was created through.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -52,43 +53,24 @@ impl Api {
     }
 }
 
-/// The type an fmi2Get*/fmi2Set* or fmi3Get*/fmi3Set* function works with: the kind of the
-/// variables it reaches, or none for a type no variable has (String, Float32, Binary...).
+/// The type an fmi2Get*/fmi2Set* or fmi3Get*/fmi3Set* function works with, by its name in
+/// that version: one of [`Api::type_name`], or one no variable has (String, Float32, Binary...).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct ValueType {
-    pub api: Api,
-    pub kind: Option<ValueKind>,
-    pub name: &'static str,
-}
+pub struct ValueType(pub Api, pub &'static str);
 
 impl ValueType {
-    pub const fn of(api: Api, kind: ValueKind) -> Self {
-        ValueType {
-            api,
-            kind: Some(kind),
-            name: api.type_name(kind),
-        }
-    }
-
-    pub const fn none(api: Api, name: &'static str) -> Self {
-        ValueType {
-            api,
-            kind: None,
-            name,
-        }
-    }
-
-    /// Fails unless a variable `name` (value reference `vr`) of `kind` is of this type.
-    pub fn check(self, name: &'static str, vr: u32, kind: ValueKind) -> Result<(), FmuError> {
-        if self.kind == Some(kind) {
+    /// Fails unless variable `v` is of this type.
+    pub fn check(self, v: &Variable) -> Result<(), FmuError> {
+        let (ValueType(api, requested), actual) = (self, self.0.type_name(v.kind));
+        if actual == requested {
             return Ok(());
         }
         Err(FmuError::WrongType {
-            name,
-            vr,
-            actual: self.api.type_name(kind),
-            requested: self.name,
-            api: self.api.prefix(),
+            name: v.name,
+            vr: v.value_reference,
+            actual,
+            requested,
+            api: api.prefix(),
         })
     }
 }
@@ -125,7 +107,7 @@ pub struct ModelInfo {
 
 /// What a Model-Exchange capable model adds to its table: value references of its continuous
 /// states and their derivatives (in state-vector order).
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct ModelExchangeTable {
     pub states: Vec<u32>,
     pub derivatives: Vec<u32>,
@@ -205,8 +187,7 @@ impl ModelTable {
             .by_vr
             .get(vr)
             .ok_or(FmuError::UnknownValueReference(vr))?;
-        let v = &self.variables[index];
-        ty.check(v.name, vr, v.kind)?;
+        ty.check(&self.variables[index])?;
         Ok(index)
     }
 
@@ -220,32 +201,49 @@ pub const TIME_VR: u32 = 1000;
 /// Value reference of the first FMI 3.0 event-indicator variable; the others follow.
 pub const EVENT_INDICATOR_VR: u32 = 1001;
 
+/// A real local without start or range (Model Exchange's extra states and derivatives, FMI
+/// 3.0's `time` and event indicators).
+pub fn local(name: &'static str, vr: u32, unit: &'static str, text: &'static str) -> Variable {
+    Variable {
+        name,
+        value_reference: vr,
+        kind: ValueKind::Real,
+        causality: Causality::Local,
+        variability: Variability::Continuous,
+        unit,
+        description: text,
+        start: None,
+        min: None,
+        max: None,
+    }
+}
+
 /// Where an FMI 3.0 variable's values come from.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Source {
     /// Positions in [`ModelTable::variables`] (one for a scalar).
-    Model(Vec<usize>),
+    Model(Range<usize>),
     Time,
     EventIndicator(usize),
 }
 
+/// A variable as FMI 3.0 shows it: a model variable, an array (its first element under the
+/// array's name and description), or one the FMI layer computes. `time` ([`Source::Time`]) is
+/// the independent variable, which the core's [`Causality`] has no name for: it says Local.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Variable3 {
-    pub name: String,
-    pub description: String,
-    pub value_reference: u32,
-    pub kind: ValueKind,
-    /// The model's causality; `None` for the independent variable `time`.
-    pub causality: Option<Causality>,
-    pub variability: Variability,
-    pub unit: &'static str,
-    pub min: Option<f64>,
-    pub max: Option<f64>,
-    /// Of each element (empty when there is none).
-    pub start: Vec<f64>,
+    pub variable: Variable,
     /// `None` for a scalar, else the array's length.
     pub dimension: Option<usize>,
     pub source: Source,
+}
+
+impl Deref for Variable3 {
+    type Target = Variable;
+
+    fn deref(&self) -> &Variable {
+        &self.variable
+    }
 }
 
 impl Variable3 {
@@ -254,52 +252,37 @@ impl Variable3 {
     }
 
     /// The positions in [`ModelTable::variables`] behind this variable.
-    pub fn elements(&self) -> &[usize] {
+    pub fn elements(&self) -> Range<usize> {
         match &self.source {
-            Source::Model(elements) => elements,
-            _ => &[],
+            Source::Model(elements) => elements.clone(),
+            _ => 0..0,
         }
     }
 
-    /// A real local without start or range (`time`, the event indicators).
-    fn computed(name: &str, vr: u32, unit: &'static str, text: &str, source: Source) -> Self {
-        Variable3 {
-            name: name.to_string(),
-            description: text.to_string(),
-            value_reference: vr,
-            kind: ValueKind::Real,
-            causality: Some(Causality::Local),
-            variability: Variability::Continuous,
-            unit,
-            min: None,
-            max: None,
-            start: Vec::new(),
-            dimension: None,
-            source,
+    /// The variables of `model`, each run declared in `arrays` as one array.
+    pub(crate) fn of(model: &[Variable], arrays: &[Array]) -> Vec<Self> {
+        let mut variables = Vec::new();
+        let mut at = 0;
+        while at < model.len() {
+            let array = arrays.iter().find(|a| a.first == model[at].name);
+            let len = array.map_or(1, |a| a.len);
+            assert!(at + len <= model.len(), "array {array:?}");
+            let variable = Variable {
+                name: array.map_or(model[at].name, |a| a.name),
+                description: array
+                    .and_then(|a| a.description)
+                    .unwrap_or(model[at].description),
+                ..model[at]
+            };
+            let source = Source::Model(at..at + len);
+            variables.push(Variable3 {
+                variable,
+                dimension: array.map(|a| a.len),
+                source,
+            });
+            at += len;
         }
-    }
-
-    /// The model's variables `run` (at positions from `first`) as one variable: a scalar, or
-    /// the array `array`.
-    pub(crate) fn of(run: &[Variable], first: usize, array: Option<&Array>) -> Self {
-        let v = &run[0];
-        Variable3 {
-            name: array.map_or(v.name, |a| a.name).to_string(),
-            description: array
-                .and_then(|a| a.description)
-                .unwrap_or(v.description)
-                .to_string(),
-            value_reference: v.value_reference,
-            kind: v.kind,
-            causality: Some(v.causality),
-            variability: v.variability,
-            unit: v.unit,
-            min: v.min,
-            max: v.max,
-            start: run.iter().filter_map(|e| e.start).collect(),
-            dimension: array.map(|a| a.len),
-            source: Source::Model((first..first + run.len()).collect()),
-        }
+        variables
     }
 }
 
@@ -311,59 +294,29 @@ pub struct Fmi3View {
     pub variables: Vec<Variable3>,
     /// Value reference → position in `variables`.
     by_vr: VrIndex,
-    /// Value references of the event-indicator variables, in order.
-    pub event_indicators: Vec<u32>,
-    /// Model value reference → (FMI 3.0 value reference, element index), sorted.
-    element_of: Vec<(u32, (u32, usize))>,
 }
 
 impl Fmi3View {
     fn new(info: &ModelInfo, model: &[Variable]) -> Self {
-        let time = Variable3 {
-            causality: None,
-            ..Variable3::computed("time", TIME_VR, "s", "Simulation time", Source::Time)
+        let computed = |variable, source| Variable3 {
+            variable,
+            dimension: None,
+            source,
         };
-        let mut variables = vec![time];
-        let mut at = 0;
-        while at < model.len() {
-            let array = info.arrays.iter().find(|a| a.first == model[at].name);
-            let len = array.map_or(1, |a| a.len);
-            let run = model
-                .get(at..at + len)
-                .unwrap_or_else(|| panic!("array {array:?}"));
-            variables.push(Variable3::of(run, at, array));
-            at += len;
-        }
+        let time = local("time", TIME_VR, "s", "Simulation time");
+        let mut variables = vec![computed(time, Source::Time)];
+        variables.extend(Variable3::of(model, info.arrays));
         let event_indicators = (EVENT_INDICATOR_VR..).zip(info.event_indicators);
         for (i, (vr, &(name, unit, text))) in event_indicators.enumerate() {
-            let source = Source::EventIndicator(i);
-            variables.push(Variable3::computed(name, vr, unit, text, source));
+            variables.push(computed(
+                local(name, vr, unit, text),
+                Source::EventIndicator(i),
+            ));
         }
-        let mut element_of: Vec<(u32, (u32, usize))> = Vec::new();
-        for v in &variables {
-            let elements = v.elements().iter().enumerate();
-            element_of.extend(
-                elements.map(|(i, &at)| (model[at].value_reference, (v.value_reference, i))),
-            );
-        }
-        element_of.sort_unstable_by_key(|&(vr, _)| vr);
         Fmi3View {
             by_vr: VrIndex::new(variables.iter().map(|v| v.value_reference)),
             variables,
-            event_indicators: (EVENT_INDICATOR_VR..)
-                .take(info.event_indicators.len())
-                .collect(),
-            element_of,
         }
-    }
-
-    /// The FMI 3.0 variable (value reference) and element index holding model variable `vr`.
-    pub fn element(&self, vr: u32) -> Option<(u32, usize)> {
-        let at = self
-            .element_of
-            .binary_search_by_key(&vr, |&(v, _)| v)
-            .ok()?;
-        Some(self.element_of[at].1)
     }
 
     /// The variable with FMI 3.0 value reference `vr`.
@@ -388,35 +341,32 @@ mod tests {
         let command = by_name(layout, "motor_command");
         assert_eq!(command.value_reference, 0);
         assert_eq!(command.dimension, Some(4));
-        assert_eq!(command.source, Source::Model(vec![0, 1, 2, 3]));
-        assert_eq!(command.start, [0.0; 4]);
+        assert_eq!(command.source, Source::Model(0..4));
         assert_eq!(
             layout.variable(1),
             None,
             "element 1 has no value reference of its own"
         );
         assert_eq!(by_name(layout, "der(motor_state)").len(), 4);
-        assert_eq!(layout.element(2), Some((0, 2)));
         // 25 states: 13 body scalars + motor_state[4] + 8 bristles = 22 variables.
         let me = quad.model_exchange.as_ref().unwrap();
         for vrs in [&me.states, &me.derivatives] {
-            let firsts = vrs.iter().filter(|&&vr| layout.element(vr).unwrap().1 == 0);
-            assert_eq!(firsts.count(), 22);
+            let holders = layout.variables.iter().filter(|v| {
+                (v.elements()).any(|at| vrs.contains(&quad.variables[at].value_reference))
+            });
+            assert_eq!(holders.count(), 22);
         }
-        assert_eq!(layout.event_indicators, [1001, 1002, 1003, 1004]);
+        let indicators = (layout.variables.iter())
+            .filter(|v| matches!(v.source, Source::EventIndicator(_)))
+            .map(|v| v.value_reference);
+        assert_eq!(indicators.collect::<Vec<_>>(), [1001, 1002, 1003, 1004]);
         for table in [quad, lander] {
             let layout = &table.fmi3;
             assert_eq!(layout.variables[0].source, Source::Time);
-            let elements: usize = layout
-                .variables
-                .iter()
-                .filter(|v| matches!(v.source, Source::Model(_)))
-                .map(Variable3::len)
-                .sum();
-            assert_eq!(elements, table.variables.len(), "{}", table.info.identifier);
-            for v in &table.variables {
-                assert!(layout.element(v.value_reference).is_some(), "{}", v.name);
-            }
+            // Every model variable in exactly one FMI 3.0 variable, in table order.
+            let elements: Vec<usize> = layout.variables.iter().flat_map(|v| v.elements()).collect();
+            let all: Vec<usize> = (0..table.variables.len()).collect();
+            assert_eq!(elements, all, "{}", table.info.identifier);
             let mut vrs: Vec<u32> = layout.variables.iter().map(|v| v.value_reference).collect();
             vrs.sort_unstable();
             vrs.dedup();

@@ -164,8 +164,7 @@ fn fmi3_outputs(model: Model) -> Vec<(u32, usize)> {
         .variables
         .iter()
         .filter(|v| {
-            v.causality == Some(Causality::Output)
-                && v.kind == flyloop_core::params::ValueKind::Real
+            v.causality == Causality::Output && v.kind == flyloop_core::params::ValueKind::Real
         })
         .map(|v| (v.value_reference, v.dimension.unwrap_or(1)))
         .collect()
@@ -177,8 +176,8 @@ fn fmi2_outputs(model: Model) -> Vec<u32> {
     let mut vrs = Vec::new();
     for (vr, _) in fmi3_outputs(model) {
         if let flyloop_fmu::table::Source::Model(elements) = &layout.variable(vr).unwrap().source {
-            let table = &model.table().variables;
-            vrs.extend(elements.iter().map(|&i| table[i].value_reference));
+            let table = &model.table().variables[elements.clone()];
+            vrs.extend(table.iter().map(|v| v.value_reference));
         }
     }
     vrs

@@ -11,13 +11,12 @@
 
 use crate::error::FmuError;
 use crate::model::{Access, FmuModel, Hybrid, StepRequest, Table};
-use crate::table::{Array, ModelExchangeTable, ModelInfo};
+use crate::table::{Array, ModelExchangeTable, ModelInfo, local};
 use flyloop_core::number::Compact;
-use flyloop_core::params::ValueKind;
 use flyloop_core::quadrotor::continuous::{BODY_STATE_OUTPUTS, BRISTLES, EVENT_INDICATORS};
 use flyloop_core::quadrotor::dynamics::STATE_LEN;
 use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial, wind};
-use flyloop_core::variables::{self, Causality, Variability, Variable};
+use flyloop_core::variables::{self, Variable};
 use flyloop_core::{ParamError, SnapshotError};
 use std::sync::OnceLock;
 
@@ -103,59 +102,36 @@ fn leak(text: String) -> &'static str {
     Box::leak(text.into_boxed_str())
 }
 
-fn local(name: &'static str, vr: u32, unit: &'static str, description: &'static str) -> Variable {
-    Variable {
-        name,
-        value_reference: vr,
-        kind: ValueKind::Real,
-        causality: Causality::Local,
-        variability: Variability::Continuous,
-        unit,
-        description,
-        start: None,
-        min: None,
-        max: None,
-    }
-}
-
 /// The core's variables, then the bristle states and the derivatives.
 fn table() -> Table<Quadrotor> {
-    let bristle = |at| Access::Local {
-        read: |q: &Quadrotor, at| q.continuous_state()[at],
-        at: BODY_STATE_OUTPUTS.len() + at,
-    };
-    let derivative = |at| Access::Local {
-        read: |q: &Quadrotor, at| q.state_derivative()[at],
-        at,
-    };
-    let bristles = (BRISTLES.iter().zip(BRISTLE_VR..).enumerate())
-        .map(|(i, (&(name, text), vr))| (local(name, vr, "m", text), bristle(i)));
-    let mut locals: Vec<_> = bristles.collect();
     let core = variables::variables::<Quadrotor>();
-    let state = |name: &str| {
-        let mut all = core.iter().chain(locals.iter().map(|(v, _)| v));
-        all.find(|v| v.name == name)
-            .map(|v| (v.value_reference, v.unit))
-    };
-    let (states, units): (Vec<u32>, Vec<&str>) = state_names().filter_map(state).unzip();
+    let bristles =
+        (BRISTLES.iter().zip(BRISTLE_VR..)).map(|(&(name, text), vr)| local(name, vr, "m", text));
+    let bristles: Vec<Variable> = bristles.collect();
+    let state = |name: &str| core.iter().chain(&bristles).find(|v| v.name == name);
+    let states: Vec<&Variable> = state_names().filter_map(state).collect();
     // d/dt of a state has its unit per second: m → m/s, m/s → m/s2, 1 → 1/s.
-    let derivatives = (state_names().zip(units).zip(DERIVATIVE_VR..).enumerate()).map(
-        |(i, ((name, unit), vr))| {
-            let unit = unit
-                .strip_suffix("/s")
-                .map_or(format!("{unit}/s"), |u| format!("{u}/s2"));
-            let name = leak(format!("der({name})"));
-            let text = "Time derivative of the state";
-            (local(name, vr, leak(unit), text), derivative(i))
-        },
-    );
-    locals.extend(derivatives.collect::<Vec<_>>());
+    let derivatives = (states.iter().zip(DERIVATIVE_VR..)).map(|(state, vr)| {
+        let unit = (state.unit.strip_suffix("/s"))
+            .map_or(format!("{}/s", state.unit), |u| format!("{u}/s2"));
+        let name = leak(format!("der({})", state.name));
+        local(name, vr, leak(unit), "Time derivative of the state")
+    });
     let me = ModelExchangeTable {
-        states,
+        states: states.iter().map(|v| v.value_reference).collect(),
         derivatives: (DERIVATIVE_VR..).take(STATE_LEN).collect(),
         event_indicators: EVENT_INDICATORS,
     };
-    Table::new(&INFO, locals, Some(me))
+    // Each reads its value at its position in the state vector.
+    let bristles = (bristles.iter().zip(BODY_STATE_OUTPUTS.len()..)).map(|(v, at)| {
+        let read = |q: &Quadrotor, at: usize| q.continuous_state()[at];
+        (v.clone(), Access::Local { read, at })
+    });
+    let derivatives = derivatives.enumerate().map(|(at, v)| {
+        let read = |q: &Quadrotor, at: usize| q.state_derivative()[at];
+        (v, Access::Local { read, at })
+    });
+    Table::new(&INFO, bristles.chain(derivatives).collect(), Some(me))
 }
 
 impl FmuModel for Quadrotor {

@@ -6,7 +6,6 @@ use crate::exports::guard::{c_slice, c_slice_mut, with_instance};
 use crate::fmi2_types::*;
 use crate::instance::masks;
 use crate::table::{Api, ValueType};
-use flyloop_core::params::ValueKind;
 
 /// Defines fmi2Get<T> and fmi2Set<T> for C type `$t` and value type `$ty`: the getter
 /// converts through `$to_c`, the setter (allowed in `$mask`) through `$from_c`. The body is
@@ -65,7 +64,7 @@ accessors! {
     fmi2GetReal,
     fmi2SetReal,
     fmi2Real,
-    ValueType::of(Api::Fmi2, ValueKind::Real),
+    ValueType(Api::Fmi2, "Real"),
     masks::SET_REAL,
     |v| v,
     |v| v,
@@ -75,7 +74,7 @@ accessors! {
     fmi2GetInteger,
     fmi2SetInteger,
     fmi2Integer,
-    ValueType::of(Api::Fmi2, ValueKind::Integer),
+    ValueType(Api::Fmi2, "Integer"),
     masks::SET_OTHER,
     |v| v as fmi2Integer,
     f64::from,
@@ -84,7 +83,7 @@ accessors! {
     fmi2GetBoolean,
     fmi2SetBoolean,
     fmi2Boolean,
-    ValueType::of(Api::Fmi2, ValueKind::Boolean),
+    ValueType(Api::Fmi2, "Boolean"),
     masks::SET_OTHER,
     |v| if v != 0.0 { fmi2True } else { fmi2False },
     |v| if v != fmi2False { 1.0 } else { 0.0 },
@@ -95,7 +94,7 @@ accessors! {
     fmi2GetString,
     fmi2SetString,
     fmi2String,
-    ValueType::none(Api::Fmi2, "String"),
+    ValueType(Api::Fmi2, "String"),
     masks::SET_OTHER,
     |_| std::ptr::null(),
     |_| f64::NAN,

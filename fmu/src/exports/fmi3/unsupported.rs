@@ -19,7 +19,7 @@ macro_rules! no_variables {
             $get,
             $set,
             $t,
-            ValueType::none(Api::Fmi3, $name),
+            ValueType(Api::Fmi3, $name),
             masks3::SET_OTHER,
             |_| $zero,
             |_| f64::NAN
@@ -58,7 +58,7 @@ unsafe fn no_binary<B>(
     if values.is_null() && n_values > 0 {
         return Err(FmuError::NullArgument("values[]"));
     }
-    let binary = ValueType::none(Api::Fmi3, "Binary");
+    let binary = ValueType(Api::Fmi3, "Binary");
     each_variable(instance, function, variables, binary, |_, _, _| Ok(()))
 }
 

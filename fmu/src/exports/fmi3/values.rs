@@ -10,7 +10,6 @@ use crate::fmi3_types::*;
 use crate::instance::Instance;
 use crate::instance::masks3;
 use crate::table::{Api, Fmi3View, Source, ValueType, Variable3};
-use flyloop_core::params::ValueKind;
 use std::ops::Range;
 
 /// The variables behind `vrs`, after checking that every one exists and that together they
@@ -41,7 +40,7 @@ pub(crate) fn resolve<'a>(
 pub(crate) fn computed(instance: &Instance, v: &Variable3) -> Result<f64, FmuError> {
     match v.source {
         Source::EventIndicator(k) => {
-            let mut z = vec![0.0; instance.sim.table().fmi3.event_indicators.len()];
+            let mut z = vec![0.0; instance.sim.table().info.event_indicators.len()];
             instance.sim.hybrid(z.len(), "ni")?.event_indicators(&mut z);
             Ok(z[k])
         }
@@ -77,8 +76,7 @@ pub(crate) fn each_variable(
     for v in variables {
         let range = at..at + v.len();
         at = range.end;
-        let result =
-            (ty.check(&v.name, v.value_reference, v.kind)).and_then(|()| body(instance, v, range));
+        let result = ty.check(v).and_then(|()| body(instance, v, range));
         if let Err(e) = result {
             worst = worst.max(instance.report(function, &e));
         }
@@ -111,7 +109,7 @@ macro_rules! accessors {
                         let slots = &mut out[range];
                         match &v.source {
                             $crate::table::Source::Model(elements) => {
-                                for (slot, &index) in slots.iter_mut().zip(elements) {
+                                for (slot, index) in slots.iter_mut().zip(elements.clone()) {
                                     *slot = $to_c(instance.sim.get(index));
                                 }
                             }
@@ -144,7 +142,7 @@ macro_rules! accessors {
                         };
                         // Every element is tried; the first refusal is reported.
                         let mut first = Ok(());
-                        for (&index, &value) in elements.iter().zip(&values[range]) {
+                        for (index, &value) in elements.clone().zip(&values[range]) {
                             let r = instance.sim.set(index, $from_c(value), initialised);
                             if first.is_ok() {
                                 first = r;
@@ -163,7 +161,7 @@ accessors! {
     fmi3GetFloat64,
     fmi3SetFloat64,
     fmi3Float64,
-    ValueType::of(Api::Fmi3, ValueKind::Real),
+    ValueType(Api::Fmi3, "Float64"),
     masks3::SET_FLOAT64,
     |v| v,
     |v| v,
@@ -173,7 +171,7 @@ accessors! {
     fmi3GetInt32,
     fmi3SetInt32,
     fmi3Int32,
-    ValueType::of(Api::Fmi3, ValueKind::Integer),
+    ValueType(Api::Fmi3, "Int32"),
     masks3::SET_OTHER,
     |v| v as i32,
     f64::from,
@@ -182,7 +180,7 @@ accessors! {
     fmi3GetBoolean,
     fmi3SetBoolean,
     fmi3Boolean,
-    ValueType::of(Api::Fmi3, ValueKind::Boolean),
+    ValueType(Api::Fmi3, "Boolean"),
     masks3::SET_OTHER,
     |v| u8::from(v != 0.0),
     |v: u8| if v != 0 { 1.0 } else { 0.0 },
