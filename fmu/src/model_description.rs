@@ -7,16 +7,8 @@ use crate::table::{Api, ModelExchangeTable, ModelTable, Source, Variable3};
 use crate::units::{self, BASE_UNITS};
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::Causality;
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write;
-
-/// A unit string the generator has no base-unit entry for (add it to `units.rs`).
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unit `{unit}` of variable `{variable}` has no entry in fmu/src/units.rs")]
-pub struct UnknownUnit {
-    pub unit: String,
-    pub variable: String,
-}
 
 /// Escapes text for an XML attribute value.
 fn escape(text: &str) -> String {
@@ -77,19 +69,20 @@ fn capabilities(api: Api) -> (&'static str, &'static str) {
 }
 
 /// `<UnitDefinitions>` for the units of the Real variables.
-fn write_units(out: &mut String, variables: &[Variable3]) -> Result<(), UnknownUnit> {
-    let used = variables
-        .iter()
-        .filter(|v| v.kind == ValueKind::Real && !v.unit.is_empty());
+///
+/// # Panics
+/// On a unit `units.rs` has no entry for (a fault of the model's table, found by the crate's
+/// tests).
+fn write_units(out: &mut String, variables: &[Variable3]) {
+    let real = variables.iter().rev();
+    let real = real.filter(|v| v.kind == ValueKind::Real && !v.unit.is_empty());
+    // Each unit with the first variable that has it.
+    let used: BTreeMap<&str, &str> = real.map(|v| (v.unit, v.name)).collect();
     out.push_str("  <UnitDefinitions>\n");
-    for unit in used.clone().map(|v| v.unit).collect::<BTreeSet<_>>() {
-        let exponents = units::exponents(unit).ok_or_else(|| UnknownUnit {
-            unit: unit.to_string(),
-            variable: used
-                .clone()
-                .find(|v| v.unit == unit)
-                .map_or_else(String::new, |v| v.name.to_string()),
-        })?;
+    for (unit, name) in used {
+        let exponents = units::exponents(unit).unwrap_or_else(|| {
+            panic!("unit `{unit}` of variable `{name}` has no entry in fmu/src/units.rs")
+        });
         let _ = write!(out, "    <Unit name=\"{}\"", escape(unit));
         match exponents {
             Some(exponents) => {
@@ -103,7 +96,6 @@ fn write_units(out: &mut String, variables: &[Variable3]) -> Result<(), UnknownU
         }
     }
     out.push_str("  </UnitDefinitions>\n");
-    Ok(())
 }
 
 /// One modelDescription being written: the version and the variables in ModelVariables order
@@ -304,7 +296,7 @@ impl Writer<'_> {
 }
 
 /// The modelDescription.xml of `table`'s model in FMI version `api`.
-pub fn generate(table: &ModelTable, api: Api) -> Result<String, UnknownUnit> {
+pub fn generate(table: &ModelTable, api: Api) -> String {
     let scalars = Variable3::of(&table.variables, &[]);
     let variables = match api {
         Api::Fmi2 => &scalars,
@@ -318,7 +310,7 @@ pub fn generate(table: &ModelTable, api: Api) -> Result<String, UnknownUnit> {
         out: String::new(),
     };
     w.header();
-    write_units(&mut w.out, variables)?;
+    write_units(&mut w.out, variables);
     w.categories_and_experiment();
     w.out.push_str("  <ModelVariables>\n");
     for (i, v) in variables.iter().enumerate() {
@@ -327,7 +319,7 @@ pub fn generate(table: &ModelTable, api: Api) -> Result<String, UnknownUnit> {
     w.out.push_str("  </ModelVariables>\n");
     w.model_structure();
     w.out.push_str("</fmiModelDescription>\n");
-    Ok(w.out)
+    w.out
 }
 
 #[cfg(test)]
@@ -378,7 +370,7 @@ mod tests {
     #[test]
     fn structure_lists_every_output_with_its_direct_inputs() {
         let table = crate::models::tables()[0];
-        let xml = generate(table, Api::Fmi2).unwrap();
+        let xml = generate(table, Api::Fmi2);
         let outputs = table
             .variables
             .iter()

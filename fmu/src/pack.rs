@@ -3,7 +3,7 @@
 //! `binaries/x86_64-linux/<modelIdentifier>.so` in `<identifier>-fmi3.fmu` (FMI 3.0). Also
 //! writes the checked-in modelDescription copies.
 
-use crate::model_description::{self, UnknownUnit};
+use crate::model_description::generate;
 use crate::table::{Api, ModelTable};
 use std::fs::{self, File};
 use std::io::{self, Write};
@@ -21,8 +21,6 @@ pub enum PackError {
         path: PathBuf,
         source: zip::result::ZipError,
     },
-    #[error(transparent)]
-    Unit(#[from] UnknownUnit),
 }
 
 fn io(path: &Path) -> impl FnOnce(io::Error) -> PackError + '_ {
@@ -48,7 +46,7 @@ pub fn write_fmu(
     library: &Path,
     out_dir: &Path,
 ) -> Result<PathBuf, PackError> {
-    let xml = model_description::generate(table, version)?;
+    let xml = generate(table, version);
     let binary = fs::read(library).map_err(io(library))?;
     fs::create_dir_all(out_dir).map_err(io(out_dir))?;
     let path = out_dir.join(format!("{}.fmu", stem(table, version)));
@@ -89,6 +87,6 @@ pub fn write_model_description(
     if let Some(parent) = path.parent() {
         fs::create_dir_all(parent).map_err(io(parent))?;
     }
-    fs::write(&path, model_description::generate(table, version)?).map_err(io(&path))?;
+    fs::write(&path, generate(table, version)).map_err(io(&path))?;
     Ok(path)
 }
