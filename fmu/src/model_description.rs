@@ -17,22 +17,16 @@ fn escape(text: &str) -> String {
     text.replace('\'', "&apos;")
 }
 
-/// An xs:double: the shortest text that reads back to the same f64.
-fn real(value: f64) -> String {
-    if value.is_nan() {
-        "NaN".to_string()
-    } else if value.is_infinite() {
-        if value > 0.0 { "INF" } else { "-INF" }.to_string()
-    } else {
-        format!("{value:?}")
-    }
-}
-
+/// A value as XML text; a real as an xs:double, the shortest text that reads back to the same
+/// f64.
 fn value_text(kind: ValueKind, value: f64) -> String {
     match kind {
-        ValueKind::Real => real(value),
         ValueKind::Integer => format!("{}", value as i64),
         ValueKind::Boolean => (value != 0.0).to_string(),
+        ValueKind::Real if value.is_nan() => "NaN".to_string(),
+        ValueKind::Real if value == f64::INFINITY => "INF".to_string(),
+        ValueKind::Real if value == f64::NEG_INFINITY => "-INF".to_string(),
+        ValueKind::Real => format!("{value:?}"),
     }
 }
 
@@ -186,7 +180,7 @@ impl Writer<'_> {
             );
         }
         let (start, stop, step) = self.table.info.default_experiment;
-        let [start, stop, step] = [start, stop, step].map(real);
+        let [start, stop, step] = [start, stop, step].map(|x| value_text(ValueKind::Real, x));
         let _ = writeln!(
             self.out,
             "  </LogCategories>\n  <DefaultExperiment startTime=\"{start}\" stopTime=\"{stop}\" \
@@ -300,7 +294,7 @@ pub fn generate(table: &ModelTable, api: Api) -> String {
     let scalars = Variable3::of(&table.variables, &[]);
     let variables = match api {
         Api::Fmi2 => &scalars,
-        Api::Fmi3 => &table.fmi3.variables,
+        Api::Fmi3 => &table.fmi3,
     };
     let mut w = Writer {
         api,
@@ -359,9 +353,9 @@ mod tests {
             2147483647.0,
             std::f64::consts::PI,
         ] {
-            assert_eq!(real(x).parse::<f64>().unwrap(), x);
+            assert_eq!(value_text(ValueKind::Real, x).parse::<f64>().unwrap(), x);
         }
-        assert_eq!(real(f64::INFINITY), "INF");
+        assert_eq!(value_text(ValueKind::Real, f64::INFINITY), "INF");
         assert_eq!(value_text(ValueKind::Integer, 7.0), "7");
         assert_eq!(value_text(ValueKind::Boolean, 1.0), "true");
         assert_eq!(escape("a<b & \"c\""), "a&lt;b &amp; &quot;c&quot;");

@@ -1,5 +1,5 @@
 //! A model's variable table as the FMI layer looks it up on every call, with the FMI 3.0 view
-//! of the same variables ([`Fmi3View`]: arrays, `time`, one variable per event indicator).
+//! of the same variables ([`Variable3`]: arrays, `time`, one variable per event indicator).
 
 use crate::error::FmuError;
 use crate::guid;
@@ -146,9 +146,13 @@ pub struct ModelTable {
     /// event indicators); hex digits, dashes and braces, never a NUL.
     pub guid: CString,
     pub token3: CString,
-    pub fmi3: Fmi3View,
     /// Value reference → position in `variables`.
     pub by_vr: VrIndex,
+    /// The FMI 3.0 variables in modelDescription order: `time`, the model's (an array takes
+    /// the value reference of its first element), the event indicators.
+    pub fmi3: Vec<Variable3>,
+    /// FMI 3.0 value reference → position in `fmi3`.
+    by_vr3: VrIndex,
     pub model_exchange: Option<ModelExchangeTable>,
 }
 
@@ -162,12 +166,14 @@ impl ModelTable {
         model_exchange: Option<ModelExchangeTable>,
     ) -> Self {
         let token = |api| CString::new(guid::of_interface(api, info.identifier, &variables));
+        let fmi3 = Variable3::fmi3(info, &variables);
         ModelTable {
             info,
             guid: token(Api::Fmi2).unwrap_or_default(),
             token3: token(Api::Fmi3).unwrap_or_default(),
-            fmi3: Fmi3View::new(info, &variables),
             by_vr: VrIndex::new(variables.iter().map(|v| v.value_reference)),
+            by_vr3: VrIndex::new(fmi3.iter().map(|v| v.value_reference)),
+            fmi3,
             variables,
             model_exchange,
         }
@@ -193,6 +199,11 @@ impl ModelTable {
 
     pub fn by_name(&self, name: &str) -> Option<&Variable> {
         self.variables.iter().find(|v| v.name == name)
+    }
+
+    /// The FMI 3.0 variable with value reference `vr`.
+    pub fn variable3(&self, vr: u32) -> Option<&Variable3> {
+        self.fmi3.get(self.by_vr3.get(vr)?)
     }
 }
 
@@ -284,20 +295,9 @@ impl Variable3 {
         }
         variables
     }
-}
 
-/// The FMI 3.0 variables of a model. An array takes the value reference of its first element.
-#[derive(Debug)]
-pub struct Fmi3View {
-    /// In modelDescription order: `time` first, then the model's variables, then the event
-    /// indicators.
-    pub variables: Vec<Variable3>,
-    /// Value reference → position in `variables`.
-    by_vr: VrIndex,
-}
-
-impl Fmi3View {
-    fn new(info: &ModelInfo, model: &[Variable]) -> Self {
+    /// The FMI 3.0 variables of the model `info` with the table `model`.
+    fn fmi3(info: &ModelInfo, model: &[Variable]) -> Vec<Self> {
         let computed = |variable, source| Variable3 {
             variable,
             dimension: None,
@@ -308,20 +308,10 @@ impl Fmi3View {
         variables.extend(Variable3::of(model, info.arrays));
         let event_indicators = (EVENT_INDICATOR_VR..).zip(info.event_indicators);
         for (i, (vr, &(name, unit, text))) in event_indicators.enumerate() {
-            variables.push(computed(
-                local(name, vr, unit, text),
-                Source::EventIndicator(i),
-            ));
+            let source = Source::EventIndicator(i);
+            variables.push(computed(local(name, vr, unit, text), source));
         }
-        Fmi3View {
-            by_vr: VrIndex::new(variables.iter().map(|v| v.value_reference)),
-            variables,
-        }
-    }
-
-    /// The variable with FMI 3.0 value reference `vr`.
-    pub fn variable(&self, vr: u32) -> Option<&Variable3> {
-        self.variables.get(self.by_vr.get(vr)?)
+        variables
     }
 }
 
@@ -330,51 +320,45 @@ mod tests {
     use super::*;
     use crate::models::tables;
 
-    fn by_name<'a>(view: &'a Fmi3View, name: &str) -> &'a Variable3 {
-        view.variables.iter().find(|v| v.name == name).unwrap()
+    fn by_name<'a>(table: &'a ModelTable, name: &str) -> &'a Variable3 {
+        table.fmi3.iter().find(|v| v.name == name).unwrap()
     }
 
     #[test]
     fn motor_commands_are_one_array_and_every_model_value_has_one_home() {
         let [quad, lander] = tables();
-        let layout = &quad.fmi3;
-        let command = by_name(layout, "motor_command");
+        let command = by_name(quad, "motor_command");
         assert_eq!(command.value_reference, 0);
         assert_eq!(command.dimension, Some(4));
         assert_eq!(command.source, Source::Model(0..4));
         assert_eq!(
-            layout.variable(1),
+            quad.variable3(1),
             None,
             "element 1 has no value reference of its own"
         );
-        assert_eq!(by_name(layout, "der(motor_state)").len(), 4);
+        assert_eq!(by_name(quad, "der(motor_state)").len(), 4);
         // 25 states: 13 body scalars + motor_state[4] + 8 bristles = 22 variables.
         let me = quad.model_exchange.as_ref().unwrap();
         for vrs in [&me.states, &me.derivatives] {
-            let holders = layout.variables.iter().filter(|v| {
+            let holders = quad.fmi3.iter().filter(|v| {
                 (v.elements()).any(|at| vrs.contains(&quad.variables[at].value_reference))
             });
             assert_eq!(holders.count(), 22);
         }
-        let indicators = (layout.variables.iter())
+        let indicators = (quad.fmi3.iter())
             .filter(|v| matches!(v.source, Source::EventIndicator(_)))
             .map(|v| v.value_reference);
         assert_eq!(indicators.collect::<Vec<_>>(), [1001, 1002, 1003, 1004]);
         for table in [quad, lander] {
-            let layout = &table.fmi3;
-            assert_eq!(layout.variables[0].source, Source::Time);
+            assert_eq!(table.fmi3[0].source, Source::Time);
             // Every model variable in exactly one FMI 3.0 variable, in table order.
-            let elements: Vec<usize> = layout.variables.iter().flat_map(|v| v.elements()).collect();
+            let elements: Vec<usize> = table.fmi3.iter().flat_map(|v| v.elements()).collect();
             let all: Vec<usize> = (0..table.variables.len()).collect();
             assert_eq!(elements, all, "{}", table.info.identifier);
-            let mut vrs: Vec<u32> = layout.variables.iter().map(|v| v.value_reference).collect();
+            let mut vrs: Vec<u32> = table.fmi3.iter().map(|v| v.value_reference).collect();
             vrs.sort_unstable();
             vrs.dedup();
-            assert_eq!(
-                vrs.len(),
-                layout.variables.len(),
-                "value references are unique"
-            );
+            assert_eq!(vrs.len(), table.fmi3.len(), "value references are unique");
         }
     }
 }

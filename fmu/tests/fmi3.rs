@@ -161,7 +161,6 @@ fn fmi3_outputs(model: Model) -> Vec<(u32, usize)> {
     model
         .table()
         .fmi3
-        .variables
         .iter()
         .filter(|v| {
             v.causality == Causality::Output && v.kind == flyloop_core::params::ValueKind::Real
@@ -172,12 +171,12 @@ fn fmi3_outputs(model: Model) -> Vec<(u32, usize)> {
 
 /// The same outputs read through FMI 2.0, element by element.
 fn fmi2_outputs(model: Model) -> Vec<u32> {
-    let layout = &model.table().fmi3;
+    let table = model.table();
     let mut vrs = Vec::new();
     for (vr, _) in fmi3_outputs(model) {
-        if let flyloop_fmu::table::Source::Model(elements) = &layout.variable(vr).unwrap().source {
-            let table = &model.table().variables[elements.clone()];
-            vrs.extend(table.iter().map(|v| v.value_reference));
+        if let flyloop_fmu::table::Source::Model(elements) = &table.variable3(vr).unwrap().source {
+            let elements = &table.variables[elements.clone()];
+            vrs.extend(elements.iter().map(|v| v.value_reference));
         }
     }
     vrs
@@ -196,11 +195,11 @@ fn fmi3_co_simulation_equals_fmi2_bit_for_bit_with_wind_and_arrays() {
             .map(|v| v.value_reference)
             .collect();
         // An array is named by its first element's value reference.
-        let fmi3 = &model.table().fmi3;
+        let table = model.table();
         let inputs3: Vec<u32> = inputs2
             .iter()
             .copied()
-            .filter(|&vr| fmi3.variable(vr).is_some())
+            .filter(|&vr| table.variable3(vr).is_some())
             .collect();
         let outputs3 = fmi3_outputs(model);
         let outputs2 = fmi2_outputs(model);
@@ -308,7 +307,7 @@ fn fmi3_model_exchange_gives_the_fmi2_states_derivatives_and_indicators() {
     assert_eq!(z2, z3);
     assert!(dx3.iter().any(|&d| d != 0.0));
     // The variables behind them: der(motor_state) as an array, the indicators, time.
-    let der_motor = (model.table().fmi3.variables.iter())
+    let der_motor = (model.table().fmi3.iter())
         .find(|v| v.name == "der(motor_state)")
         .unwrap();
     let (status, values) = me3.get(&[der_motor.value_reference], 4);

@@ -54,7 +54,7 @@ unsafe fn no_binary<B>(
 ) -> Result<fmi2Status, FmuError> {
     // SAFETY: per the function's contract.
     let vrs = unsafe { c_slice(vr, nvr, "valueReferences[]") }?;
-    let variables = resolve(&instance.sim.table().fmi3, vrs, n_values)?;
+    let variables = resolve(instance.sim.table(), vrs, n_values)?;
     if values.is_null() && n_values > 0 {
         return Err(FmuError::NullArgument("values[]"));
     }

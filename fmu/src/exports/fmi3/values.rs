@@ -9,20 +9,20 @@ use crate::fmi2_types::fmi2Status;
 use crate::fmi3_types::*;
 use crate::instance::Instance;
 use crate::instance::masks3;
-use crate::table::{Api, Fmi3View, Source, ValueType, Variable3};
+use crate::table::{Api, ModelTable, Source, ValueType, Variable3};
 use std::ops::Range;
 
 /// The variables behind `vrs`, after checking that every one exists and that together they
 /// hold `n_values` values (no allocation: this runs on every get and set).
 pub(crate) fn resolve<'a>(
-    view: &'static Fmi3View,
+    table: &'static ModelTable,
     vrs: &'a [fmi3ValueReference],
     n_values: usize,
 ) -> Result<impl Iterator<Item = &'static Variable3> + use<'a>, FmuError> {
     let mut total = 0;
     for &vr in vrs {
-        total += view
-            .variable(vr)
+        total += table
+            .variable3(vr)
             .ok_or(FmuError::UnknownValueReference(vr))?
             .len();
     }
@@ -33,7 +33,7 @@ pub(crate) fn resolve<'a>(
             vrs.len()
         )));
     }
-    Ok(vrs.iter().filter_map(|&vr| view.variable(vr)))
+    Ok(vrs.iter().filter_map(|&vr| table.variable3(vr)))
 }
 
 /// Element `i` of `v`, which is not a model variable.
@@ -103,7 +103,7 @@ macro_rules! accessors {
                 let function = stringify!($get);
                 with_instance(instance, function, masks3::GET_VALUE, |instance| {
                     let vrs = c_slice(valueReferences, nValueReferences, "valueReferences[]")?;
-                    let variables = resolve(&instance.sim.table().fmi3, vrs, nValues)?;
+                    let variables = resolve(instance.sim.table(), vrs, nValues)?;
                     let out = c_slice_mut(values, nValues, "values[]")?;
                     each_variable(instance, function, variables, $ty, |instance, v, range| {
                         let slots = &mut out[range];
@@ -133,7 +133,7 @@ macro_rules! accessors {
                 let function = stringify!($set);
                 with_instance(instance, function, $mask, |instance| {
                     let vrs = c_slice(valueReferences, nValueReferences, "valueReferences[]")?;
-                    let variables = resolve(&instance.sim.table().fmi3, vrs, nValues)?;
+                    let variables = resolve(instance.sim.table(), vrs, nValues)?;
                     let values = c_slice(values, nValues, "values[]")?;
                     let initialised = instance.initialised();
                     each_variable(instance, function, variables, $ty, |instance, v, range| {
