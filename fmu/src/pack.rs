@@ -5,28 +5,25 @@
 
 use crate::model_description::generate;
 use crate::table::{Api, ModelTable};
+use std::error::Error;
 use std::fs::{self, File};
-use std::io::{self, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use zip::write::SimpleFileOptions;
 use zip::{CompressionMethod, ZipWriter};
 
-/// Why packing failed.
+/// Why packing failed: the file and what went wrong with it (I/O or zip).
 #[derive(Debug, thiserror::Error)]
-pub enum PackError {
-    #[error("{}: {source}", path.display())]
-    Io { path: PathBuf, source: io::Error },
-    #[error("{}: {source}", path.display())]
-    Zip {
-        path: PathBuf,
-        source: zip::result::ZipError,
-    },
+#[error("{}: {source}", path.display())]
+pub struct PackError {
+    pub path: PathBuf,
+    pub source: Box<dyn Error + Send + Sync>,
 }
 
-fn io(path: &Path) -> impl FnOnce(io::Error) -> PackError + '_ {
-    move |source| PackError::Io {
+fn at<E: Into<Box<dyn Error + Send + Sync>>>(path: &Path) -> impl FnOnce(E) -> PackError + '_ {
+    move |e| PackError {
         path: path.to_path_buf(),
-        source,
+        source: e.into(),
     }
 }
 
@@ -47,28 +44,24 @@ pub fn write_fmu(
     out_dir: &Path,
 ) -> Result<PathBuf, PackError> {
     let xml = generate(table, version);
-    let binary = fs::read(library).map_err(io(library))?;
-    fs::create_dir_all(out_dir).map_err(io(out_dir))?;
+    let binary = fs::read(library).map_err(at(library))?;
+    fs::create_dir_all(out_dir).map_err(at(out_dir))?;
     let path = out_dir.join(format!("{}.fmu", stem(table, version)));
-    let file = File::create(&path).map_err(io(&path))?;
-    let zip_error = |source| PackError::Zip {
-        path: path.clone(),
-        source,
-    };
+    let file = File::create(&path).map_err(at(&path))?;
     let mut zip = ZipWriter::new(file);
     let options = SimpleFileOptions::default().compression_method(CompressionMethod::Deflated);
     zip.start_file("modelDescription.xml", options.unix_permissions(0o644))
-        .map_err(zip_error)?;
-    zip.write_all(xml.as_bytes()).map_err(io(&path))?;
+        .map_err(at(&path))?;
+    zip.write_all(xml.as_bytes()).map_err(at(&path))?;
     let platform = match version {
         Api::Fmi2 => "linux64",
         Api::Fmi3 => "x86_64-linux",
     };
     let so = format!("binaries/{platform}/{}.so", table.info.identifier);
     zip.start_file(so, options.unix_permissions(0o755))
-        .map_err(zip_error)?;
-    zip.write_all(&binary).map_err(io(&path))?;
-    zip.finish().map_err(zip_error)?;
+        .map_err(at(&path))?;
+    zip.write_all(&binary).map_err(at(&path))?;
+    zip.finish().map_err(at(&path))?;
     Ok(path)
 }
 
@@ -85,8 +78,8 @@ pub fn write_model_description(
 ) -> Result<PathBuf, PackError> {
     let path = model_description_path(dir, table, version);
     if let Some(parent) = path.parent() {
-        fs::create_dir_all(parent).map_err(io(parent))?;
+        fs::create_dir_all(parent).map_err(at(parent))?;
     }
-    fs::write(&path, generate(table, version)).map_err(io(&path))?;
+    fs::write(&path, generate(table, version)).map_err(at(&path))?;
     Ok(path)
 }
