@@ -30,36 +30,31 @@ fn value_text(kind: ValueKind, value: f64) -> String {
     }
 }
 
-/// The capability attributes of (ModelExchange, CoSimulation) in `api`.
-fn capabilities(api: Api) -> (&'static str, &'static str) {
-    match api {
+/// The capability attributes of ModelExchange and CoSimulation in `api`: each element's own
+/// between the ones both share.
+fn capabilities(api: Api) -> [String; 2] {
+    let (first, me, cs, last) = match api {
         Api::Fmi2 => (
-            "needsExecutionTool=\"false\" completedIntegratorStepNotNeeded=\"true\" \
-             canBeInstantiatedOnlyOncePerProcess=\"false\" \
-             canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" \
-             canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"",
-            "needsExecutionTool=\"false\" canHandleVariableCommunicationStepSize=\"true\" \
-             canInterpolateInputs=\"false\" maxOutputDerivativeOrder=\"0\" \
-             canRunAsynchronuously=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" \
+            "",
+            "completedIntegratorStepNotNeeded=\"true\"",
+            "canHandleVariableCommunicationStepSize=\"true\" canInterpolateInputs=\"false\" \
+             maxOutputDerivativeOrder=\"0\" canRunAsynchronuously=\"false\"",
+            "canBeInstantiatedOnlyOncePerProcess=\"false\" \
              canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" \
              canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"",
         ),
         Api::Fmi3 => (
-            "needsExecutionTool=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" \
-             canGetAndSetFMUState=\"true\" canSerializeFMUState=\"true\" \
-             providesDirectionalDerivatives=\"false\" providesAdjointDerivatives=\"false\" \
-             providesPerElementDependencies=\"false\" needsCompletedIntegratorStep=\"false\" \
-             providesEvaluateDiscreteStates=\"false\"",
-            "needsExecutionTool=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" \
-             canGetAndSetFMUState=\"true\" canSerializeFMUState=\"true\" \
-             providesDirectionalDerivatives=\"false\" providesAdjointDerivatives=\"false\" \
-             providesPerElementDependencies=\"false\" \
-             canHandleVariableCommunicationStepSize=\"true\" maxOutputDerivativeOrder=\"0\" \
+            " canBeInstantiatedOnlyOncePerProcess=\"false\" canGetAndSetFMUState=\"true\" \
+             canSerializeFMUState=\"true\" providesDirectionalDerivatives=\"false\" \
+             providesAdjointDerivatives=\"false\" providesPerElementDependencies=\"false\"",
+            "needsCompletedIntegratorStep=\"false\"",
+            "canHandleVariableCommunicationStepSize=\"true\" maxOutputDerivativeOrder=\"0\" \
              providesIntermediateUpdate=\"false\" mightReturnEarlyFromDoStep=\"false\" \
-             canReturnEarlyAfterIntermediateUpdate=\"false\" hasEventMode=\"false\" \
-             providesEvaluateDiscreteStates=\"false\"",
+             canReturnEarlyAfterIntermediateUpdate=\"false\" hasEventMode=\"false\"",
+            "providesEvaluateDiscreteStates=\"false\"",
         ),
-    }
+    };
+    [me, cs].map(|own| format!("needsExecutionTool=\"false\"{first} {own} {last}"))
 }
 
 /// `<UnitDefinitions>` for the units of the Real variables.
@@ -162,7 +157,7 @@ impl Writer<'_> {
             escape(info.description),
             env!("CARGO_PKG_VERSION"),
         );
-        let ((me, cs), id) = (capabilities(api), info.identifier);
+        let ([me, cs], id) = (capabilities(api), info.identifier);
         if table.model_exchange.is_some() {
             let _ = writeln!(self.out, "  <ModelExchange modelIdentifier=\"{id}\" {me}/>");
         }

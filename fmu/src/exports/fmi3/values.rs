@@ -21,10 +21,8 @@ pub(crate) fn resolve<'a>(
 ) -> Result<impl Iterator<Item = &'static Variable3> + use<'a>, FmuError> {
     let mut total = 0;
     for &vr in vrs {
-        total += table
-            .variable3(vr)
-            .ok_or(FmuError::UnknownValueReference(vr))?
-            .len();
+        let v = table.variable3(vr);
+        total += v.ok_or(FmuError::UnknownValueReference(vr))?.len();
     }
     if total != n_values {
         return Err(FmuError::InvalidArgument(format!(
@@ -50,16 +48,14 @@ pub(crate) fn computed(instance: &Instance, v: &Variable3) -> Result<f64, FmuErr
 
 /// Why `v`, which is not a model variable, cannot be set.
 pub(crate) fn not_settable(v: &Variable3) -> FmuError {
-    match v.source {
-        Source::Time => FmuError::NotSettable {
-            name: "time",
-            reason: "it is the independent variable (fmi3SetTime or fmi3DoStep moves it)",
-        },
-        _ => FmuError::NotSettable {
-            name: "event indicator",
-            reason: "it is calculated from the state",
-        },
-    }
+    let (name, reason) = match v.source {
+        Source::Time => (
+            "time",
+            "it is the independent variable (fmi3SetTime or fmi3DoStep moves it)",
+        ),
+        _ => ("event indicator", "it is calculated from the state"),
+    };
+    FmuError::NotSettable { name, reason }
 }
 
 /// Runs `body` on each of `variables` with the range of its values in the caller's array,
