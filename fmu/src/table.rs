@@ -51,17 +51,11 @@ impl Api {
             (_, ValueKind::Boolean) => "Boolean",
         }
     }
-}
 
-/// The type an fmi2Get*/fmi2Set* or fmi3Get*/fmi3Set* function works with, by its name in
-/// that version: one of [`Api::type_name`], or one no variable has (String, Float32, Binary...).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct ValueType(pub Api, pub &'static str);
-
-impl ValueType {
-    /// Fails unless variable `v` is of this type.
-    pub fn check(self, v: &Variable) -> Result<(), FmuError> {
-        let (ValueType(api, requested), actual) = (self, self.0.type_name(v.kind));
+    /// Fails unless variable `v` is of the type this version calls `requested`: the type an
+    /// fmi2Get*/fmi3Set*... function works with, perhaps one no variable has (String, Binary).
+    pub fn check(self, requested: &'static str, v: &Variable) -> Result<(), FmuError> {
+        let actual = self.type_name(v.kind);
         if actual == requested {
             return Ok(());
         }
@@ -70,7 +64,7 @@ impl ValueType {
             vr: v.value_reference,
             actual,
             requested,
-            api: api.prefix(),
+            api: self.prefix(),
         })
     }
 }
@@ -187,13 +181,13 @@ impl ModelTable {
         token.to_str().unwrap_or_default()
     }
 
-    /// The position of value reference `vr`, after checking that it is of type `ty`.
-    pub fn lookup(&self, vr: u32, ty: ValueType) -> Result<usize, FmuError> {
+    /// The position of value reference `vr`, after checking that it is of `api`'s type `ty`.
+    pub fn lookup(&self, vr: u32, api: Api, ty: &'static str) -> Result<usize, FmuError> {
         let index = self
             .by_vr
             .get(vr)
             .ok_or(FmuError::UnknownValueReference(vr))?;
-        ty.check(&self.variables[index])?;
+        api.check(ty, &self.variables[index])?;
         Ok(index)
     }
 

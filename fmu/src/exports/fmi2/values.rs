@@ -5,9 +5,9 @@
 use crate::exports::guard::{c_slice, c_slice_mut, with_instance};
 use crate::fmi2_types::*;
 use crate::instance::masks;
-use crate::table::{Api, ValueType};
+use crate::table::Api;
 
-/// Defines fmi2Get<T> and fmi2Set<T> for C type `$t` and value type `$ty`: the getter
+/// Defines fmi2Get<T> and fmi2Set<T> for C type `$t` and FMI 2.0 type `$ty`: the getter
 /// converts through `$to_c`, the setter (allowed in `$mask`) through `$from_c`. The body is
 /// here, not in a helper, so the model is two calls away: the guard, then the engine.
 macro_rules! accessors {
@@ -26,7 +26,7 @@ macro_rules! accessors {
                     let table = instance.sim.table();
                     let mut worst = fmi2Status::fmi2OK;
                     for (&vr, slot) in vrs.iter().zip(values) {
-                        match table.lookup(vr, $ty) {
+                        match table.lookup(vr, Api::Fmi2, $ty) {
                             Ok(index) => *slot = $to_c(instance.sim.get(index)),
                             Err(e) => worst = worst.max(instance.report(function, &e)),
                         }
@@ -49,7 +49,7 @@ macro_rules! accessors {
                     let mut worst = fmi2Status::fmi2OK;
                     for (&vr, &v) in vrs.iter().zip(values) {
                         let set = |index| instance.sim.set(index, $from_c(v), initialised);
-                        if let Err(e) = table.lookup(vr, $ty).and_then(set) {
+                        if let Err(e) = table.lookup(vr, Api::Fmi2, $ty).and_then(set) {
                             worst = worst.max(instance.report(function, &e));
                         }
                     }
@@ -64,7 +64,7 @@ accessors! {
     fmi2GetReal,
     fmi2SetReal,
     fmi2Real,
-    ValueType(Api::Fmi2, "Real"),
+    "Real",
     masks::SET_REAL,
     |v| v,
     |v| v,
@@ -74,7 +74,7 @@ accessors! {
     fmi2GetInteger,
     fmi2SetInteger,
     fmi2Integer,
-    ValueType(Api::Fmi2, "Integer"),
+    "Integer",
     masks::SET_OTHER,
     |v| v as fmi2Integer,
     f64::from,
@@ -83,7 +83,7 @@ accessors! {
     fmi2GetBoolean,
     fmi2SetBoolean,
     fmi2Boolean,
-    ValueType(Api::Fmi2, "Boolean"),
+    "Boolean",
     masks::SET_OTHER,
     |v| if v != 0.0 { fmi2True } else { fmi2False },
     |v| if v != fmi2False { 1.0 } else { 0.0 },
@@ -94,7 +94,7 @@ accessors! {
     fmi2GetString,
     fmi2SetString,
     fmi2String,
-    ValueType(Api::Fmi2, "String"),
+    "String",
     masks::SET_OTHER,
     |_| std::ptr::null(),
     |_| f64::NAN,

@@ -9,7 +9,6 @@ use crate::exports::guard::{c_slice, refuse, with_instance};
 use crate::fmi2_types::fmi2Status;
 use crate::fmi3_types::*;
 use crate::instance::{Instance, masks3};
-use crate::table::{Api, ValueType};
 
 /// Defines fmi3Get<T> and fmi3Set<T> for types no variable has: every value reference is
 /// refused, naming the variable's real type when it exists; no value is ever converted.
@@ -19,7 +18,7 @@ macro_rules! no_variables {
             $get,
             $set,
             $t,
-            ValueType(Api::Fmi3, $name),
+            $name,
             masks3::SET_OTHER,
             |_| $zero,
             |_| f64::NAN
@@ -44,7 +43,7 @@ no_variables! {
 /// with its real type.
 ///
 /// # Safety
-/// `vr` must be NULL or hold `nvr` elements.
+/// `vr` and `values` must be NULL or hold `nvr` and `n_values` elements.
 unsafe fn no_binary<B>(
     instance: &mut Instance,
     function: &str,
@@ -55,11 +54,9 @@ unsafe fn no_binary<B>(
     // SAFETY: per the function's contract.
     let vrs = unsafe { c_slice(vr, nvr, "valueReferences[]") }?;
     let variables = resolve(instance.sim.table(), vrs, n_values)?;
-    if values.is_null() && n_values > 0 {
-        return Err(FmuError::NullArgument("values[]"));
-    }
-    let binary = ValueType(Api::Fmi3, "Binary");
-    each_variable(instance, function, variables, binary, |_, _, _| Ok(()))
+    // SAFETY: per the function's contract.
+    unsafe { c_slice(values, n_values, "values[]") }?;
+    each_variable(instance, function, variables, "Binary", |_, _, _| Ok(()))
 }
 
 forward! {

@@ -9,7 +9,7 @@ use crate::fmi2_types::fmi2Status;
 use crate::fmi3_types::*;
 use crate::instance::Instance;
 use crate::instance::masks3;
-use crate::table::{Api, ModelTable, Source, ValueType, Variable3};
+use crate::table::{Api, ModelTable, Source, Variable3};
 use std::ops::Range;
 
 /// The variables behind `vrs`, after checking that every one exists and that together they
@@ -59,20 +59,22 @@ pub(crate) fn not_settable(v: &Variable3) -> FmuError {
 }
 
 /// Runs `body` on each of `variables` with the range of its values in the caller's array,
-/// once it is of type `ty`; a refused variable is logged with its reason while the others
+/// once it is of FMI 3.0 type `ty`; a refused variable is logged with its reason while the others
 /// still go on. Answers the worst status.
 pub(crate) fn each_variable(
     instance: &mut Instance,
     function: &str,
     variables: impl Iterator<Item = &'static Variable3>,
-    ty: ValueType,
+    ty: &'static str,
     mut body: impl FnMut(&mut Instance, &Variable3, Range<usize>) -> Result<(), FmuError>,
 ) -> Result<fmi2Status, FmuError> {
     let (mut worst, mut at) = (fmi2Status::fmi2OK, 0);
     for v in variables {
         let range = at..at + v.len();
         at = range.end;
-        let result = ty.check(v).and_then(|()| body(instance, v, range));
+        let result = Api::Fmi3
+            .check(ty, v)
+            .and_then(|()| body(instance, v, range));
         if let Err(e) = result {
             worst = worst.max(instance.report(function, &e));
         }
@@ -80,7 +82,7 @@ pub(crate) fn each_variable(
     Ok(worst)
 }
 
-/// Defines fmi3Get<T> and fmi3Set<T> for C type `$t` and value type `$ty`: the getter
+/// Defines fmi3Get<T> and fmi3Set<T> for C type `$t` and FMI 3.0 type `$ty`: the getter
 /// converts through `$to_c`, the setter (allowed in `$mask`) through `$from_c`. The body is
 /// here, not in a helper, so the model is two calls away: the guard, then the engine.
 macro_rules! accessors {
@@ -157,7 +159,7 @@ accessors! {
     fmi3GetFloat64,
     fmi3SetFloat64,
     fmi3Float64,
-    ValueType(Api::Fmi3, "Float64"),
+    "Float64",
     masks3::SET_FLOAT64,
     |v| v,
     |v| v,
@@ -167,7 +169,7 @@ accessors! {
     fmi3GetInt32,
     fmi3SetInt32,
     fmi3Int32,
-    ValueType(Api::Fmi3, "Int32"),
+    "Int32",
     masks3::SET_OTHER,
     |v| v as i32,
     f64::from,
@@ -176,7 +178,7 @@ accessors! {
     fmi3GetBoolean,
     fmi3SetBoolean,
     fmi3Boolean,
-    ValueType(Api::Fmi3, "Boolean"),
+    "Boolean",
     masks3::SET_OTHER,
     |v| u8::from(v != 0.0),
     |v: u8| if v != 0 { 1.0 } else { 0.0 },
