@@ -240,17 +240,17 @@ impl Writer<'_> {
     /// ModelStructure: FMI 2.0 `<Unknown index=..>`s in groups, FMI 3.0 elements by value
     /// reference; the outputs with their dependencies.
     fn model_structure(&mut self) {
-        let variables = self.variables.iter().enumerate();
-        let outputs = variables
-            .clone()
-            .filter(|(_, v)| v.causality == Causality::Output);
-        let outputs: BTreeSet<usize> = outputs.map(|(i, _)| i).collect();
+        let positions = |keep: fn(&Variable3) -> bool| -> BTreeSet<usize> {
+            (0..self.variables.len())
+                .filter(|&i| keep(&self.variables[i]))
+                .collect()
+        };
+        let outputs = positions(|v| v.causality == Causality::Output);
         let derivatives = self.holders(&self.me.derivatives);
         // Calculated during initialisation: every output, every derivative, the local states.
         let mut initial = &outputs | &derivatives;
         initial.extend(self.holders(&self.me.states));
-        let events = variables.filter(|(_, v)| matches!(v.source, Source::EventIndicator(_)));
-        let events = events.map(|(i, _)| i).collect();
+        let events = positions(|v| matches!(v.source, Source::EventIndicator(_)));
         self.out.push_str("  <ModelStructure>\n");
         for (group, element, unknowns) in [
             ("Outputs", "Output", outputs),

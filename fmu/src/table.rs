@@ -279,11 +279,10 @@ impl Variable3 {
                     .unwrap_or(model[at].description),
                 ..model[at]
             };
-            let source = Source::Model(at..at + len);
             variables.push(Variable3 {
                 variable,
                 dimension: array.map(|a| a.len),
-                source,
+                source: Source::Model(at..at + len),
             });
             at += len;
         }

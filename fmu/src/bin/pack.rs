@@ -20,30 +20,22 @@ const USAGE: &str = "usage: flyloop-fmu-pack fmus <libflyloop_fmu.so> <out-dir>\
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let pairs = Api::ALL.into_iter().flat_map(|v| tables().map(|t| (t, v)));
-    let result: Result<Vec<_>, _> = match args.as_slice() {
-        ["fmus", library, out] => {
-            let (library, out) = (Path::new(library), Path::new(out));
-            pairs.map(|(t, v)| write_fmu(t, v, library, out)).collect()
-        }
-        ["model-descriptions", dir] => pairs
-            .map(|(t, v)| write_model_description(t, v, Path::new(dir)))
-            .collect(),
-        _ => {
-            eprintln!("{USAGE}");
-            return ExitCode::from(2);
-        }
-    };
-    match result {
-        Ok(paths) => {
-            for path in paths {
-                println!("{}", path.display());
+    for (table, version) in Api::ALL.into_iter().flat_map(|v| tables().map(|t| (t, v))) {
+        let written = match args.as_slice() {
+            ["fmus", library, out] => write_fmu(table, version, Path::new(library), Path::new(out)),
+            ["model-descriptions", dir] => write_model_description(table, version, Path::new(dir)),
+            _ => {
+                eprintln!("{USAGE}");
+                return ExitCode::from(2);
             }
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("flyloop-fmu-pack: {e}");
-            ExitCode::FAILURE
+        };
+        match written {
+            Ok(path) => println!("{}", path.display()),
+            Err(e) => {
+                eprintln!("flyloop-fmu-pack: {e}");
+                return ExitCode::FAILURE;
+            }
         }
     }
+    ExitCode::SUCCESS
 }
