@@ -140,6 +140,8 @@ impl Writer<'_> {
         ids.join(" ")
     }
 
+    /// Everything before ModelVariables: the root element, ModelExchange and CoSimulation, the
+    /// units, LogCategories and DefaultExperiment.
     fn header(&mut self) {
         let (api, table, info) = (self.api, self.table, self.table.info);
         let n = self.me.event_indicators;
@@ -162,10 +164,7 @@ impl Writer<'_> {
             let _ = writeln!(self.out, "  <ModelExchange modelIdentifier=\"{id}\" {me}/>");
         }
         let _ = writeln!(self.out, "  <CoSimulation modelIdentifier=\"{id}\" {cs}/>");
-    }
-
-    /// `<LogCategories>` and `<DefaultExperiment>`.
-    fn categories_and_experiment(&mut self) {
+        write_units(&mut self.out, self.variables);
         self.out.push_str("  <LogCategories>\n");
         for (name, text) in CATEGORIES {
             let (name, text) = (name.to_string_lossy(), escape(text));
@@ -299,8 +298,6 @@ pub fn generate(table: &ModelTable, api: Api) -> String {
         out: String::new(),
     };
     w.header();
-    write_units(&mut w.out, variables);
-    w.categories_and_experiment();
     w.out.push_str("  <ModelVariables>\n");
     for (i, v) in variables.iter().enumerate() {
         w.variable(i, v);

@@ -73,8 +73,7 @@ impl Api {
 #[derive(Debug)]
 pub struct Array {
     pub name: &'static str,
-    /// The array's description; `None` takes the first element's.
-    pub description: Option<&'static str>,
+    pub description: &'static str,
     /// The name of element 0; the other elements follow it in the table.
     pub first: &'static str,
     pub len: usize,
@@ -266,17 +265,14 @@ impl Variable3 {
 
     /// The variables of `model`, each run declared in `arrays` as one array.
     pub(crate) fn of(model: &[Variable], arrays: &[Array]) -> Vec<Self> {
-        let mut variables = Vec::new();
-        let mut at = 0;
+        let (mut variables, mut at) = (Vec::new(), 0);
         while at < model.len() {
             let array = arrays.iter().find(|a| a.first == model[at].name);
             let len = array.map_or(1, |a| a.len);
             assert!(at + len <= model.len(), "array {array:?}");
             let variable = Variable {
                 name: array.map_or(model[at].name, |a| a.name),
-                description: array
-                    .and_then(|a| a.description)
-                    .unwrap_or(model[at].description),
+                description: array.map_or(model[at].description, |a| a.description),
                 ..model[at]
             };
             variables.push(Variable3 {

@@ -42,22 +42,20 @@ static INFO: ModelInfo = ModelInfo {
     arrays: &[
         Array {
             name: "motor_command",
-            description: Some(
-                "Commands of the four motors, 0 .. 1 each: front-right (CCW), rear-left (CCW), \
-                 front-left (CW), rear-right (CW)",
-            ),
+            description: "Commands of the four motors, 0 .. 1 each: front-right (CCW), \
+                          rear-left (CCW), front-left (CW), rear-right (CW)",
             first: "motor_command_0",
             len: 4,
         },
         Array {
             name: "motor_state",
-            description: Some("Lagged states of the four motors (order of motor_command)"),
+            description: "Lagged states of the four motors (order of motor_command)",
             first: "motor_state_0",
             len: 4,
         },
         Array {
             name: "der(motor_state)",
-            description: None,
+            description: DERIVATIVE_TEXT,
             first: "der(motor_state_0)",
             len: 4,
         },
@@ -91,6 +89,8 @@ static INFO: ModelInfo = ModelInfo {
 const BRISTLE_VR: u32 = 700;
 const DERIVATIVE_VR: u32 = 800;
 
+const DERIVATIVE_TEXT: &str = "Time derivative of the state";
+
 /// The continuous states' names in state-vector order.
 fn state_names() -> impl Iterator<Item = &'static str> {
     BODY_STATE_OUTPUTS.into_iter().chain(BRISTLES.map(|b| b.0))
@@ -115,7 +115,7 @@ fn table() -> Table<Quadrotor> {
         let unit = (state.unit.strip_suffix("/s"))
             .map_or(format!("{}/s", state.unit), |u| format!("{u}/s2"));
         let name = leak(format!("der({})", state.name));
-        local(name, vr, leak(unit), "Time derivative of the state")
+        local(name, vr, leak(unit), DERIVATIVE_TEXT)
     });
     let me = ModelExchangeTable {
         states: states.iter().map(|v| v.value_reference).collect(),
