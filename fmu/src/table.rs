@@ -231,9 +231,9 @@ pub enum Source {
     EventIndicator(usize),
 }
 
-/// A variable as FMI 3.0 shows it: a model variable, an array (its first element under the
-/// array's name and description), or one the FMI layer computes. `time` ([`Source::Time`]) is
-/// the independent variable, which the core's [`Causality`] has no name for: it says Local.
+/// A variable as FMI 3.0 shows it: a model's; an array (its first element, renamed; each
+/// element's start in [`ModelTable::variables`]); an event indicator; or `time`, the
+/// independent variable, which says Local (the core's [`Causality`] has no such value).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Variable3 {
     pub variable: Variable,

@@ -59,8 +59,8 @@ pub(crate) fn not_settable(v: &Variable3) -> FmuError {
 }
 
 /// Runs `body` on each of `variables` with the range of its values in the caller's array,
-/// once it is of FMI 3.0 type `ty`; a refused variable is logged with its reason while the others
-/// still go on. Answers the worst status.
+/// once it is of FMI 3.0 type `ty`; a refused variable is logged with its reason while the
+/// others still go on. Answers the worst status.
 pub(crate) fn each_variable(
     instance: &mut Instance,
     function: &str,
@@ -72,9 +72,8 @@ pub(crate) fn each_variable(
     for v in variables {
         let range = at..at + v.len();
         at = range.end;
-        let result = Api::Fmi3
-            .check(ty, v)
-            .and_then(|()| body(instance, v, range));
+        let checked = Api::Fmi3.check(ty, v);
+        let result = checked.and_then(|()| body(instance, v, range));
         if let Err(e) = result {
             worst = worst.max(instance.report(function, &e));
         }
