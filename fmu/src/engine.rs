@@ -3,9 +3,10 @@
 //! serves every model. Model Exchange keeps the time of the last event so that the model's
 //! discrete changes happen at events only, never inside the solver's trial steps.
 
+use crate::api::Api;
 use crate::error::FmuError;
 use crate::model::{Access, FmuModel, Hybrid, StepRequest, Table};
-use crate::table::{Api, ModelTable};
+use crate::table::ModelTable;
 use flyloop_core::number::Compact;
 use flyloop_core::variables::{self, Causality, Variability};
 use flyloop_core::{SnapshotError, snapshot};

@@ -3,7 +3,7 @@
 //! writes it into the modelDescription and checks it in fmi2Instantiate, so the two cannot
 //! drift apart; any change of the interface gives a new GUID.
 
-use crate::table::Api;
+use crate::api::Api;
 use flyloop_core::variables::Variable;
 use std::fmt::Write;
 

@@ -2,11 +2,11 @@
 //! Co-Simulation and Model Exchange: the stage it is in and, per function, the stages it may
 //! be called in (the masks of modelica/Reference-FMUs' fmi2Functions.c).
 
+use crate::api::Api;
 use crate::engine::Simulation;
 use crate::error::FmuError;
 use crate::fmi2_types::fmi2Status;
 use crate::log::{Logger, category_of};
-use crate::table::Api;
 use std::collections::HashMap;
 
 /// The stages of an instance: EventMode and ContinuousTimeMode for Model Exchange, the Step*

@@ -4,6 +4,7 @@
 //! [`exports`], [`instance`] (the state machine), [`engine`] (for any [`model::FmuModel`]),
 //! [`models`]; [`model_description`] and [`pack`] write the FMUs.
 
+pub mod api;
 pub mod engine;
 pub mod error;
 pub mod exports;

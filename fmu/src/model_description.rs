@@ -2,8 +2,9 @@
 //! the versions differ only where the standards do. Deterministic output (no date), so the
 //! checked-in copies under modelDescription/ can be compared byte for byte.
 
+use crate::api::Api;
 use crate::log::CATEGORIES;
-use crate::table::{Api, ModelExchangeTable, ModelTable, Source, Variable3};
+use crate::table::{ModelExchangeTable, ModelTable, Source, Variable3};
 use crate::units::{self, BASE_UNITS};
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::Causality;

@@ -3,8 +3,9 @@
 //! `binaries/x86_64-linux/<modelIdentifier>.so` in `<identifier>-fmi3.fmu` (FMI 3.0). Also
 //! writes the checked-in modelDescription copies.
 
+use crate::api::Api;
 use crate::model_description::generate;
-use crate::table::{Api, ModelTable};
+use crate::table::ModelTable;
 use std::error::Error;
 use std::fs::{self, File};
 use std::io::Write;

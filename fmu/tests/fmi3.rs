@@ -7,11 +7,12 @@
 use crate::support;
 
 use flyloop_core::variables::Causality;
+use flyloop_fmu::api::Api;
 use flyloop_fmu::exports::*;
 use flyloop_fmu::fmi2_types::{fmi2LastSuccessfulTime, fmi2Status};
 use flyloop_fmu::fmi3_types::fmi3Status::{fmi3Error, fmi3OK};
 use flyloop_fmu::fmi3_types::*;
-use flyloop_fmu::table::{Api, EVENT_INDICATOR_VR, TIME_VR};
+use flyloop_fmu::table::{EVENT_INDICATOR_VR, TIME_VR};
 use std::ffi::CString;
 use support::{Fmu, Model, Recorder};
 

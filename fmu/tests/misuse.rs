@@ -5,9 +5,9 @@
 
 use crate::support;
 
+use flyloop_fmu::api::Api;
 use flyloop_fmu::exports::*;
 use flyloop_fmu::fmi2_types::*;
-use flyloop_fmu::table::Api;
 use std::ffi::CString;
 use support::{Fmu, Model, Recorder, callbacks_for};
 

@@ -10,10 +10,10 @@ use crate::support;
 
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::Causality;
+use flyloop_fmu::api::Api;
 use flyloop_fmu::fmi2_types::fmi2Status::fmi2OK;
 use flyloop_fmu::model_description::generate;
 use flyloop_fmu::pack::{model_description_path, write_model_description};
-use flyloop_fmu::table::Api;
 use std::path::{Path, PathBuf};
 use support::{Fmu, Model};
 

@@ -8,9 +8,9 @@
 //!
 //! scripts/pack-fmus.sh builds the library and runs the first form into dist/fmu.
 
+use flyloop_fmu::api::Api;
 use flyloop_fmu::models::tables;
 use flyloop_fmu::pack::{write_fmu, write_model_description};
-use flyloop_fmu::table::Api;
 use std::path::Path;
 use std::process::ExitCode;
 

@@ -1,6 +1,6 @@
 //! Every FMI 2.0 and FMI 3.0 function, exported unmangled from the library (`extern "C"`):
-//! [`fmi2`] and [`fmi3`] hold each version's own, [`shared`] those the same in both and the
-//! bodies both versions run, and [`guard`] what every export does around its body. Tests call
+//! [`fmi2`] and [`fmi3`] hold each version's own, `shared` those the same in both and the
+//! bodies both versions run, and `guard` what every export does around its body. Tests call
 //! them directly through the rlib; importers load them from the .so.
 // Function and parameter names are the standard's.
 #![allow(non_snake_case, non_upper_case_globals)]

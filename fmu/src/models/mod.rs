@@ -3,10 +3,11 @@
 mod lander2d;
 mod quadrotor;
 
+use crate::api::Api;
 use crate::engine::{Engine, Simulation};
 use crate::error::FmuError;
 use crate::model::FmuModel;
-use crate::table::{Api, ModelTable};
+use crate::table::ModelTable;
 use flyloop_core::lander2d::Lander2d;
 use flyloop_core::quadrotor::Quadrotor;
 

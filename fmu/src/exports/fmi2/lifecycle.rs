@@ -1,13 +1,13 @@
 //! Creating an FMI 2.0 instance and setting up its experiment (FMI 3.0 does both
 //! differently).
 
+use crate::api::Api;
 use crate::exports::guard::c_str;
 use crate::exports::shared::instantiate::{Request, instantiate};
 use crate::exports::shared::lifecycle::setup_experiment;
 use crate::fmi2_types::*;
 use crate::instance::{Interface, Stage, masks};
 use crate::log::Sink;
-use crate::table::Api;
 use std::ffi::c_char;
 
 /// Returns "default".

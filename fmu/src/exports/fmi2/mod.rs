@@ -1,5 +1,5 @@
 //! The FMI 2.0 functions of their own: Co-Simulation for both models, Model Exchange for the
-//! quadrotor. Those the same in FMI 3.0 are in [`super::shared`].
+//! quadrotor. Those the same in FMI 3.0 are in `exports::shared`.
 
 mod cosimulation;
 mod lifecycle;

@@ -2,10 +2,10 @@
 //! refused one is logged with its reason and the call returns the worst status, while the
 //! others still take effect (set) or are filled in (get).
 
+use crate::api::Api;
 use crate::exports::guard::{c_slice, c_slice_mut, with_instance};
 use crate::fmi2_types::*;
 use crate::instance::masks;
-use crate::table::Api;
 
 /// Defines fmi2Get<T> and fmi2Set<T> for C type `$t` and FMI 2.0 type `$ty`: the getter
 /// converts through `$to_c`, the setter (allowed in `$mask`) through `$from_c`. The body is

@@ -1,13 +1,13 @@
 //! Creating an FMI 3.0 instance and entering initialization mode (with the experiment,
 //! which FMI 2.0 sets in a function of its own).
 
+use crate::api::Api;
 use crate::exports::guard::c_str;
 use crate::exports::shared::instantiate::{Request, instantiate};
 use crate::exports::shared::lifecycle::setup_experiment;
 use crate::fmi3_types::*;
 use crate::instance::{Interface, Stage, masks3};
 use crate::log::Sink;
-use crate::table::Api;
 use std::ffi::c_char;
 
 /// Returns "3.0".

@@ -4,12 +4,13 @@
 //! (positions in `values` would be guesswork); after that every variable is handled as in
 //! FMI 2.0: a refused one is logged with its reason while the others still take effect.
 
+use crate::api::Api;
 use crate::error::FmuError;
 use crate::fmi2_types::fmi2Status;
 use crate::fmi3_types::*;
 use crate::instance::Instance;
 use crate::instance::masks3;
-use crate::table::{Api, ModelTable, Source, Variable3};
+use crate::table::{ModelTable, Source, Variable3};
 use std::ops::Range;
 
 /// The variables behind `vrs`, after checking that every one exists and that together they

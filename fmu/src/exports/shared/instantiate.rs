@@ -1,10 +1,10 @@
 //! What fmi2Instantiate and FMI 3.0's fmi3Instantiate* share.
 
+use crate::api::Api;
 use crate::fmi2_types::fmi2Status;
 use crate::instance::{Instance, Interface};
 use crate::log::{Logger, Sink};
 use crate::models;
-use crate::table::Api;
 use std::ffi::{CStr, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
