@@ -38,7 +38,7 @@ pub enum FmuError {
     },
     /// The model refused a value (out of range, NaN, wrong kind, a broken relation).
     #[error("value refused: {0}")]
-    Refused(ParamError),
+    Refused(#[from] ParamError),
     /// An FMU state that does not decode or does not fit this model.
     #[error("FMU state refused: {0}")]
     State(#[from] SnapshotError),
@@ -89,13 +89,4 @@ pub enum FmuError {
     /// A capability this FMU does not declare (Model Exchange, input interpolation, ...).
     #[error("not supported: {0}")]
     NotSupported(&'static str),
-}
-
-impl From<ParamError> for FmuError {
-    fn from(e: ParamError) -> Self {
-        match e {
-            ParamError::UnknownValueReference(vr) => FmuError::UnknownValueReference(vr),
-            other => FmuError::Refused(other),
-        }
-    }
 }
