@@ -229,7 +229,7 @@ impl Instance {
     }
 
     pub fn log(&self, status: fmi2Status, message: &str) {
-        if self.logging[category_of(status) as usize] {
+        if self.logging[category_of(status)] {
             self.logger.log(status, message);
         }
     }

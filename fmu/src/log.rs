@@ -6,16 +6,7 @@ use crate::fmi2_types::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status
 use crate::fmi3_types::{fmi3InstanceEnvironment, fmi3LogMessageCallback};
 use std::ffi::{CStr, CString};
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Category {
-    Events,
-    Warning,
-    Error,
-    Fatal,
-}
-
-/// Every category's name and description, in modelDescription order (a [`Category`] is its
-/// position).
+/// Every category's name and description, in modelDescription order.
 #[rustfmt::skip]
 pub const CATEGORIES: [(&CStr, &str); 4] = [
     (c"logEvents", "Lifecycle: instantiation, initialisation, reset, termination, FMU states"),
@@ -54,7 +45,7 @@ impl Logger {
     /// never interpreted).
     pub fn log(&self, status: fmi2Status, message: &str) {
         let text = CString::new(message.replace('\0', "\u{fffd}")).unwrap_or_default();
-        let category = CATEGORIES[category_of(status) as usize].0.as_ptr();
+        let category = CATEGORIES[category_of(status)].0.as_ptr();
         match self.sink {
             // SAFETY: callback and environment came together from the importer, which keeps
             // them valid while the instance lives; every string is NUL-terminated and
@@ -84,11 +75,12 @@ impl Logger {
     }
 }
 
-pub fn category_of(status: fmi2Status) -> Category {
+/// The position in [`CATEGORIES`] of the category a message with `status` is logged in.
+pub fn category_of(status: fmi2Status) -> usize {
     match status {
-        fmi2Status::fmi2OK | fmi2Status::fmi2Pending => Category::Events,
-        fmi2Status::fmi2Warning | fmi2Status::fmi2Discard => Category::Warning,
-        fmi2Status::fmi2Error => Category::Error,
-        fmi2Status::fmi2Fatal => Category::Fatal,
+        fmi2Status::fmi2OK | fmi2Status::fmi2Pending => 0,
+        fmi2Status::fmi2Warning | fmi2Status::fmi2Discard => 1,
+        fmi2Status::fmi2Error => 2,
+        fmi2Status::fmi2Fatal => 3,
     }
 }
