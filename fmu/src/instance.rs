@@ -277,15 +277,6 @@ impl Instance {
         Ok(())
     }
 
-    pub fn check_co_simulation(&self) -> Result<(), FmuError> {
-        match self.interface {
-            Interface::CoSimulation => Ok(()),
-            Interface::ModelExchange => Err(FmuError::NotSupported(
-                "Co-Simulation functions on a Model Exchange instance",
-            )),
-        }
-    }
-
     /// The stage saved as `code`, if an instance of this interface can be in it.
     pub fn stage_from_code(&self, code: u8) -> Result<Stage, FmuError> {
         let stage = Stage::from_code(code).ok_or_else(|| {

@@ -3,15 +3,16 @@
 //! need.
 
 use crate::error::FmuError;
-use crate::exports::guard::{refuse, with_instance, write_out};
+use crate::exports::guard::{refuse, write_out};
 use crate::fmi3_types::*;
-use crate::instance::{masks, masks3};
+use crate::instance::{Interface, masks, masks3};
 
-exports! {
+forward! {
     /// Advances from `currentCommunicationPoint` (the instance's time) by
     /// `communicationStepSize`, exactly as fmi2DoStep does. Never asks for event handling,
     /// never terminates, never returns early; `*lastSuccessfulTime` is the time after the
-    /// step. The four output pointers must not be NULL.
+    /// step. The four output pointers must not be NULL. (A Model Exchange instance is never
+    /// in StepComplete, so the mask alone refuses it.)
     fn fmi3DoStep(
         instance: fmi3Instance,
         currentCommunicationPoint: fmi3Float64,
@@ -21,37 +22,35 @@ exports! {
         terminateSimulation: *mut fmi3Boolean,
         earlyReturn: *mut fmi3Boolean,
         lastSuccessfulTime: *mut fmi3Float64,
-    ) -> fmi3Status {
-        with_instance(instance, "fmi3DoStep", masks::DO_STEP, |instance| {
-            instance.check_co_simulation()?;
-            let flags = [
-                (eventHandlingNeeded, "eventHandlingNeeded"),
-                (terminateSimulation, "terminateSimulation"),
-                (earlyReturn, "earlyReturn"),
-            ];
-            if let Some((_, name)) = flags.iter().find(|(p, _)| p.is_null()) {
-                return Err(FmuError::NullArgument(name));
-            }
-            if lastSuccessfulTime.is_null() {
-                return Err(FmuError::NullArgument("lastSuccessfulTime"));
-            }
-            let result = instance.sim.do_step(currentCommunicationPoint, communicationStepSize);
-            for (pointer, name) in flags {
-                write_out(pointer, fmi3False, name)?;
-            }
-            write_out(lastSuccessfulTime, instance.sim.time(), "lastSuccessfulTime")?;
-            result
-        })
-    }
-}
-
-forward! {
+    ) -> fmi3Status = masks::DO_STEP => |i| {
+        let flags = [
+            (eventHandlingNeeded, "eventHandlingNeeded"),
+            (terminateSimulation, "terminateSimulation"),
+            (earlyReturn, "earlyReturn"),
+        ];
+        if let Some((_, name)) = flags.iter().find(|(p, _)| p.is_null()) {
+            return Err(FmuError::NullArgument(name));
+        }
+        if lastSuccessfulTime.is_null() {
+            return Err(FmuError::NullArgument("lastSuccessfulTime"));
+        }
+        let result = i.sim.do_step(currentCommunicationPoint, communicationStepSize);
+        for (pointer, name) in flags {
+            write_out(pointer, fmi3False, name)?;
+        }
+        write_out(lastSuccessfulTime, i.sim.time(), "lastSuccessfulTime")?;
+        result
+    };
     /// Not needed: without event mode (hasEventMode="false") fmi3ExitInitializationMode
     /// already enters step mode.
     fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status = masks3::ENTER_STEP_MODE => |i| {
-        let why = "event mode is not used (hasEventMode=\"false\"): fmi3ExitInitializationMode \
-                   enters step mode";
-        i.check_co_simulation().and(refuse(why))
+        refuse(match i.interface {
+            Interface::ModelExchange => "Co-Simulation functions on a Model Exchange instance",
+            Interface::CoSimulation => {
+                "event mode is not used (hasEventMode=\"false\"): \
+                 fmi3ExitInitializationMode enters step mode"
+            }
+        })
     };
     /// maxOutputDerivativeOrder="0".
     fn fmi3GetOutputDerivatives(
