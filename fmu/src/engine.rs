@@ -5,7 +5,7 @@
 
 use crate::api::Api;
 use crate::error::FmuError;
-use crate::model::{Access, FmuModel, Hybrid, StepRequest, Table};
+use crate::model::{Access, FmuModel, Hybrid, Table};
 use crate::table::ModelTable;
 use flyloop_core::number::Compact;
 use flyloop_core::variables::{self, Causality, Variability};
@@ -75,12 +75,6 @@ impl Clock {
     }
 }
 
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-pub struct Experiment {
-    pub start: f64,
-    pub stop: Option<f64>,
-}
-
 /// The instance's simulation as the FMI functions drive it; a method named after an FMI
 /// function (`do_step`, `set_time`...) is that function's work, `index` is a position in the
 /// table, `stage` the instance's stage code saved in FMU states. The Model Exchange methods
@@ -121,7 +115,9 @@ struct Book<I> {
     /// Inputs set before initialisation, applied again whenever start values rebuild the
     /// model (a rebuild would otherwise put them back to the model's defaults).
     early_inputs: Vec<(u32, f64)>,
-    experiment: Experiment,
+    /// The experiment's start and stop time.
+    start: f64,
+    stop: Option<f64>,
     clock: Clock,
     /// Model Exchange: time of the last event (its discrete changes are done up to here).
     event_time: f64,
@@ -225,7 +221,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
                 )));
             }
         }
-        self.book.experiment = Experiment { start, stop };
+        (self.book.start, self.book.stop) = (start, stop);
         self.book.clock = Clock::at(start);
         self.book.event_time = start;
         Ok(())
@@ -289,24 +285,20 @@ impl<M: FmuModel> Simulation for Engine<M> {
         let step_size = self.book.clock.grid_step(step_size);
         let next = self.book.clock.after(step_size);
         let end = next.time();
-        if let Some(stop) = self.book.experiment.stop {
+        if let Some(stop) = self.book.stop {
             if end > stop + TIME_TOLERANCE * stop.abs().max(1.0) {
                 return Err(FmuError::PastStopTime { end, stop });
             }
         }
-        let request = StepRequest {
-            start_time: self.book.experiment.start,
-            end_time: end,
-            step_size,
-        };
-        let steps = self.model.internal_steps(&request);
+        let since_start = end - self.book.start;
+        let steps = self.model.internal_steps(since_start, step_size);
         if steps.is_nan() || steps > MAX_INTERNAL_STEPS {
             return Err(FmuError::TooManySteps {
                 steps,
                 limit: MAX_INTERNAL_STEPS,
             });
         }
-        self.model.advance(&request);
+        self.model.advance(since_start, step_size);
         self.book.clock = next;
         if !self.model.is_finite() {
             return Err(FmuError::Diverged { time: end });
@@ -347,7 +339,6 @@ impl<M: FmuModel> Simulation for Engine<M> {
     /// A finite time not before the last event (a solver may go back within a step it
     /// rejects, never past an event it has handled).
     fn set_time(&mut self, time: f64) -> Result<(), FmuError> {
-        self.model.hybrid().ok_or_else(co_simulation_only)?;
         let last = self.book.event_time;
         if !time.is_finite() || time < last - TIME_TOLERANCE * last.abs().max(1.0) {
             return Err(FmuError::InvalidArgument(format!(
@@ -373,20 +364,10 @@ impl<M: FmuModel> Simulation for Engine<M> {
     fn new_discrete_states(&mut self) -> Result<(bool, Option<f64>), FmuError> {
         let now = self.time();
         let elapsed = (now - self.book.event_time).max(0.0);
-        let n = (M::table().table.model_exchange)
-            .as_ref()
-            .map_or(0, |me| me.states.len());
-        let (mut before, mut after) = (vec![0.0; n], vec![0.0; n]);
-        let hybrid = self.hybrid_mut(n, "nx")?;
-        hybrid.states(&mut before);
-        hybrid.event_update(elapsed);
-        hybrid.states(&mut after);
+        let hybrid = self.model.hybrid_mut().ok_or_else(co_simulation_only)?;
+        let changed = hybrid.event_update(elapsed);
         let next = hybrid.time_event_after().map(|dt| now + dt);
         self.book.event_time = now;
-        let changed = before
-            .iter()
-            .zip(&after)
-            .any(|(a, b)| a.to_bits() != b.to_bits());
         Ok((changed, next))
     }
 

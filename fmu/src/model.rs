@@ -9,15 +9,6 @@ use flyloop_core::SnapshotError;
 use flyloop_core::variables::{self, Row, Variable, VariableTable};
 use std::fmt;
 
-/// One communication step as the model sees it (s). Times are on the FMU's grid (`t0 + n·h`,
-/// never summed), so a model with its own fixed step can count whole steps.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StepRequest {
-    pub start_time: f64,
-    pub end_time: f64,
-    pub step_size: f64,
-}
-
 /// How the FMU reaches a variable in the model.
 #[derive(Debug)]
 pub enum Access<M: FmuModel> {
@@ -64,10 +55,14 @@ pub trait FmuModel: VariableTable<Initial: fmt::Debug, Params: fmt::Debug> + fmt
     /// defaults when there is none).
     fn build(previous: Option<&Self>, initial: &Self::Initial) -> Result<Self, ParamError>;
 
-    /// How many internal steps `step` would take (to refuse steps that would run for hours).
-    fn internal_steps(&self, step: &StepRequest) -> f64;
+    /// How many internal steps [`advance`](Self::advance) would take (to refuse steps that
+    /// would run for hours).
+    fn internal_steps(&self, end: f64, h: f64) -> f64;
 
-    fn advance(&mut self, step: &StepRequest);
+    /// One communication step of `h` seconds up to `end` seconds after the start time. Both
+    /// are on the FMU's grid (`n·h`, never summed), so a model with its own fixed step can
+    /// count whole steps.
+    fn advance(&mut self, end: f64, h: f64);
 
     /// Whether the state holds only finite numbers (false once the dynamics diverged).
     fn is_finite(&self) -> bool;
@@ -99,6 +94,7 @@ pub trait Hybrid {
     fn event_indicators(&self, z: &mut [f64]);
     /// Seconds from the last event to the next time event, if there is one.
     fn time_event_after(&self) -> Option<f64>;
-    /// The discrete changes of an event `elapsed` seconds after the previous one.
-    fn event_update(&mut self, elapsed: f64);
+    /// The discrete changes of an event `elapsed` seconds after the previous one; whether
+    /// they changed a continuous state (bit for bit).
+    fn event_update(&mut self, elapsed: f64) -> bool;
 }

@@ -4,7 +4,7 @@
 //! shortened rapier step when t falls inside a grid step; so every communication step size
 //! that is a multiple of `physics_step` gives the same bits at the shared times.
 
-use crate::model::{FmuModel, StepRequest, Table};
+use crate::model::{FmuModel, Table};
 use crate::table::ModelInfo;
 use flyloop_core::lander2d::{Lander2d, Lander2dInitial};
 use flyloop_core::{ParamError, SnapshotError};
@@ -38,16 +38,16 @@ impl FmuModel for Lander2d {
         Lander2d::from_initial(params, initial)
     }
 
-    fn internal_steps(&self, step: &StepRequest) -> f64 {
+    fn internal_steps(&self, end: f64, _h: f64) -> f64 {
         // Physics steps to go: whole grid steps, one more cut per control period end, and
         // at most two pieces of a grid step.
         let p = self.params();
-        let ahead = (step.end_time - step.start_time - self.time()).max(0.0);
+        let ahead = (end - self.time()).max(0.0);
         (ahead / p.physics_step).ceil() + (ahead / p.dt).ceil() + 2.0
     }
 
-    fn advance(&mut self, step: &StepRequest) {
-        self.advance_to(step.end_time - step.start_time);
+    fn advance(&mut self, end: f64, _h: f64) {
+        self.advance_to(end);
     }
 
     fn is_finite(&self) -> bool {

@@ -10,7 +10,7 @@
 //! indicators and the turbulence samples as time events.
 
 use crate::error::FmuError;
-use crate::model::{Access, FmuModel, Hybrid, StepRequest, Table};
+use crate::model::{Access, FmuModel, Hybrid, Table};
 use crate::table::{Array, ModelExchangeTable, ModelInfo, local};
 use flyloop_core::number::Compact;
 use flyloop_core::quadrotor::continuous::{BODY_STATE_OUTPUTS, BRISTLES, EVENT_INDICATORS};
@@ -145,13 +145,12 @@ impl FmuModel for Quadrotor {
         Quadrotor::from_initial(params, initial)
     }
 
-    fn internal_steps(&self, step: &StepRequest) -> f64 {
-        (step.step_size / self.params.max_substep).ceil()
-            + wind::segment_count(&self.params, step.step_size)
+    fn internal_steps(&self, _end: f64, h: f64) -> f64 {
+        (h / self.params.max_substep).ceil() + wind::segment_count(&self.params, h)
     }
 
-    fn advance(&mut self, step: &StepRequest) {
-        self.step(step.step_size);
+    fn advance(&mut self, _end: f64, h: f64) {
+        self.step(h);
     }
 
     fn is_finite(&self) -> bool {
@@ -212,7 +211,13 @@ impl Hybrid for Quadrotor {
         self.time_to_turbulence_sample()
     }
 
-    fn event_update(&mut self, elapsed: f64) {
+    fn event_update(&mut self, elapsed: f64) -> bool {
+        let before = self.continuous_state();
         Quadrotor::event_update(self, elapsed);
+        let after = self.continuous_state();
+        before
+            .iter()
+            .zip(&after)
+            .any(|(a, b)| a.to_bits() != b.to_bits())
     }
 }
