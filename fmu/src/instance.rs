@@ -201,28 +201,10 @@ pub struct Instance {
     pub sim: Box<dyn Simulation>,
     /// FMU states handed out and not yet freed, by address. A pointer that is not here is
     /// refused instead of dereferenced (double free, foreign pointer).
-    states: HashMap<usize, Box<SavedState>>,
+    pub(crate) states: HashMap<usize, Box<SavedState>>,
 }
 
 impl Instance {
-    pub fn new(
-        api: Api,
-        interface: Interface,
-        logger: Logger,
-        logging_on: bool,
-        sim: Box<dyn Simulation>,
-    ) -> Self {
-        Instance {
-            api,
-            interface,
-            logger,
-            logging: [logging_on, logging_on, true, true],
-            stage: Stage::Instantiated,
-            sim,
-            states: HashMap::new(),
-        }
-    }
-
     /// Whether the instance is past initialization mode (fixed parameters are fixed now).
     pub fn initialised(&self) -> bool {
         !matches!(self.stage, Stage::Instantiated | Stage::InitializationMode)

@@ -36,30 +36,27 @@ exports! {
         _visible: fmi2Boolean,
         loggingOn: fmi2Boolean,
     ) -> fmi2Component {
-        instantiate(|| {
-            let functions = functions.as_ref().copied()?;
-            let sink = Sink::Fmi2 {
-                callback: functions.logger?,
-                environment: functions.componentEnvironment,
-            };
-            let interface = match fmuType {
-                fmi2CoSimulation => Ok(Interface::CoSimulation),
-                fmi2ModelExchange => Ok(Interface::ModelExchange),
-                other => Err(format!(
-                    "fmuType {other} is neither Model Exchange (0) nor Co-Simulation (1)"
-                )),
-            };
-            let (name, token) = (c_str(instanceName), c_str(fmuGUID));
-            let logging_on = loggingOn != fmi2False;
-            Some(Request {
-                function: "fmi2Instantiate",
-                api: Api::Fmi2,
-                name,
-                interface,
-                token,
-                sink,
-                logging_on,
+        let sink = functions.as_ref().and_then(|f| {
+            Some(Sink::Fmi2 {
+                callback: f.logger?,
+                environment: f.componentEnvironment,
             })
+        });
+        let interface = match fmuType {
+            fmi2CoSimulation => Ok(Interface::CoSimulation),
+            fmi2ModelExchange => Ok(Interface::ModelExchange),
+            other => Err(format!(
+                "fmuType {other} is neither Model Exchange (0) nor Co-Simulation (1)"
+            )),
+        };
+        instantiate(Request {
+            function: "fmi2Instantiate",
+            api: Api::Fmi2,
+            name: c_str(instanceName),
+            interface,
+            token: c_str(fmuGUID),
+            sink,
+            logging_on: loggingOn != fmi2False,
         })
     }
 }

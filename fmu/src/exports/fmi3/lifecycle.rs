@@ -26,21 +26,19 @@ unsafe fn instantiate3(
     (name, token, logging_on): (fmi3String, fmi3String, fmi3Boolean),
     (environment, callback): (fmi3InstanceEnvironment, Option<fmi3LogMessageCallback>),
 ) -> fmi3Instance {
-    instantiate(|| {
-        Some(Request {
-            function,
-            api: Api::Fmi3,
-            // SAFETY: NULL or NUL-terminated strings (the contract).
-            name: unsafe { c_str(name) },
-            interface,
-            // SAFETY: as above.
-            token: unsafe { c_str(token) },
-            sink: Sink::Fmi3 {
-                callback,
-                environment,
-            },
-            logging_on: logging_on != fmi3False,
-        })
+    instantiate(Request {
+        function,
+        api: Api::Fmi3,
+        // SAFETY: NULL or NUL-terminated strings (the contract).
+        name: unsafe { c_str(name) },
+        interface,
+        // SAFETY: as above.
+        token: unsafe { c_str(token) },
+        sink: Some(Sink::Fmi3 {
+            callback,
+            environment,
+        }),
+        logging_on: logging_on != fmi3False,
     })
 }
 

@@ -1,10 +1,12 @@
 //! What fmi2Instantiate and FMI 3.0's fmi3Instantiate* share.
 
 use crate::api::Api;
+use crate::engine::Simulation;
 use crate::fmi2_types::fmi2Status;
-use crate::instance::{Instance, Interface};
+use crate::instance::{Instance, Interface, Stage};
 use crate::log::{Logger, Sink};
 use crate::models;
+use std::collections::HashMap;
 use std::ffi::{CStr, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
@@ -17,13 +19,14 @@ pub(crate) struct Request<'a> {
     pub interface: Result<Interface, String>,
     /// FMI 2.0's GUID or FMI 3.0's instantiation token.
     pub token: Option<&'a CStr>,
-    pub sink: Sink,
+    /// `None` (FMI 2.0 without a logger callback): no one to tell why instantiation fails.
+    pub sink: Option<Sink>,
     pub logging_on: bool,
 }
 
-/// The instance `request` asks for, or why there is none.
-fn new_instance(request: &Request<'_>) -> Result<Instance, String> {
-    let name = (request.name.filter(|n| !n.is_empty())).ok_or("instanceName is NULL or empty")?;
+/// The simulation `request` asks for, or why there is none.
+fn simulation(request: &Request<'_>) -> Result<(Interface, Box<dyn Simulation>), String> {
+    (request.name.filter(|n| !n.is_empty())).ok_or("instanceName is NULL or empty")?;
     let interface = request.interface.clone()?;
     let token_name = request.api.token_name();
     let token = request.token.ok_or(format!("{token_name} is NULL"))?;
@@ -40,41 +43,48 @@ fn new_instance(request: &Request<'_>) -> Result<Instance, String> {
         ));
     };
     let sim = sim.map_err(|e| format!("the model does not start: {e}"))?;
-    let identifier = sim.table().info.identifier;
     if interface == Interface::ModelExchange && sim.table().model_exchange.is_none() {
         return Err(format!(
-            "{identifier} is Co-Simulation only (its physics engine steps internally); \
-             instantiate it for Co-Simulation"
+            "{} is Co-Simulation only (its physics engine steps internally); instantiate it \
+             for Co-Simulation",
+            sim.table().info.identifier
         ));
     }
-    let logger = Logger {
-        sink: request.sink,
-        instance_name: name.to_owned(),
-    };
-    let instance = Instance::new(request.api, interface, logger, request.logging_on, sim);
-    let function = request.function;
-    instance.event(&format!(
-        "{function}: {identifier} {interface:?} instance ({token}) created"
-    ));
-    Ok(instance)
+    Ok((interface, sim))
 }
 
-/// The instance `build` asks for, or NULL after logging why not (`build` gives `None` when
-/// there is no logger to tell why; a panic, caught here, gives NULL too).
-pub(crate) fn instantiate<'a>(build: impl FnOnce() -> Option<Request<'a>>) -> *mut c_void {
+/// The instance `request` asks for, or NULL after logging why not (without a logger: NULL;
+/// a panic, caught here, gives NULL too).
+pub(crate) fn instantiate(request: Request<'_>) -> *mut c_void {
     let outcome = catch_unwind(AssertUnwindSafe(|| {
-        let request = build()?;
-        let message = match new_instance(&request) {
-            Ok(instance) => return Some(Box::into_raw(Box::new(instance)).cast()),
-            Err(message) => format!("{}: {message}", request.function),
-        };
-        let name = request.name.map(CStr::to_owned).unwrap_or_default();
+        let (function, api) = (request.function, request.api);
         let logger = Logger {
-            sink: request.sink,
-            instance_name: name,
+            sink: request.sink?,
+            instance_name: request.name.map(CStr::to_owned).unwrap_or_default(),
         };
-        logger.log(fmi2Status::fmi2Error, &message);
-        None
+        let (interface, sim) = match simulation(&request) {
+            Ok(found) => found,
+            Err(message) => {
+                logger.log(fmi2Status::fmi2Error, &format!("{function}: {message}"));
+                return None;
+            }
+        };
+        let on = request.logging_on;
+        let instance = Instance {
+            api,
+            interface,
+            logger,
+            logging: [on, on, true, true],
+            stage: Stage::Instantiated,
+            sim,
+            states: HashMap::new(),
+        };
+        let table = instance.sim.table();
+        let (identifier, token) = (table.info.identifier, table.token(api));
+        instance.event(&format!(
+            "{function}: {identifier} {interface:?} instance ({token}) created"
+        ));
+        Some(Box::into_raw(Box::new(instance)).cast())
     }));
     outcome.ok().flatten().unwrap_or(std::ptr::null_mut())
 }
