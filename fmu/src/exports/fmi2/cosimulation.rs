@@ -7,25 +7,22 @@ use crate::exports::guard::{refuse, write_out};
 use crate::fmi2_types::*;
 use crate::instance::{Instance, masks};
 
-/// A status kind a function answers, with the way to read its value.
-type Known<T> = Option<(fmi2StatusKind, fn(&Instance) -> T)>;
-
-/// The body of fmi2Get*Status: `known` gives the value of its status kind; any other kind
-/// does not apply to a synchronous FMU that never discards.
+/// The body of fmi2Get*Status: `known` is the status kind the function answers, with its
+/// value; any other kind does not apply to a synchronous FMU that never discards.
 ///
 /// # Safety
 /// `value` must be NULL or writable.
 unsafe fn status<T>(
-    instance: &mut Instance,
+    instance: &Instance,
     function: &str,
     s: fmi2StatusKind,
     value: *mut T,
-    known: Known<T>,
+    known: Option<(fmi2StatusKind, T)>,
 ) -> Result<fmi2Status, FmuError> {
     let why = match (s, known) {
-        (s, Some((kind, read))) if s == kind => {
+        (s, Some((kind, known))) if s == kind => {
             // SAFETY: per the contract.
-            unsafe { write_out(value, read(instance), "value") }?;
+            unsafe { write_out(value, known, "value") }?;
             return Ok(fmi2Status::fmi2OK);
         }
         (fmi2DoStepStatus | fmi2PendingStatus, _) => "fmi2DoStep never returns fmi2Pending",
@@ -46,7 +43,7 @@ forward! {
     /// fmi2LastSuccessfulTime gives the instance's time.
     fn fmi2GetRealStatus(c: fmi2Component, s: fmi2StatusKind, value: *mut fmi2Real) -> fmi2Status =
         masks::GET_STATUS => |i, f| {
-            status(i, f, s, value, Some((fmi2LastSuccessfulTime, |i| i.sim.time())))
+            status(i, f, s, value, Some((fmi2LastSuccessfulTime, i.sim.time())))
         };
     fn fmi2GetIntegerStatus(
         c: fmi2Component,
@@ -59,7 +56,7 @@ forward! {
         s: fmi2StatusKind,
         value: *mut fmi2Boolean,
     ) -> fmi2Status =
-        masks::GET_STATUS => |i, f| status(i, f, s, value, Some((fmi2Terminated, |_| fmi2False)));
+        masks::GET_STATUS => |i, f| status(i, f, s, value, Some((fmi2Terminated, fmi2False)));
     fn fmi2GetStringStatus(
         c: fmi2Component,
         s: fmi2StatusKind,
