@@ -165,13 +165,9 @@ pub mod masks3 {
     use super::{Mask, Stage};
 
     masks! {
-        ENTER_INITIALIZATION_MODE = mask!(Instantiated);
         /// FMI 3.0 allows reading in every stage but the step in progress.
         GET_VALUE = mask!(Instantiated | InitializationMode | EventMode | ContinuousTimeMode
             | StepComplete | StepFailed | StepCanceled | Terminated | Error);
-        /// The same stages as FMI 2.0's fmi2SetReal and the other setters.
-        SET_FLOAT64 = super::masks::SET_REAL;
-        SET_OTHER = super::masks::SET_OTHER;
         ENTER_STEP_MODE = mask!(InitializationMode | EventMode);
         GET_OUTPUT_DERIVATIVES = mask!(StepComplete | StepFailed | Terminated);
         UPDATE_DISCRETE_STATES = mask!(EventMode).model_exchange();

@@ -6,7 +6,7 @@ use crate::exports::guard::c_str;
 use crate::exports::shared::instantiate::{Request, instantiate};
 use crate::exports::shared::lifecycle::setup_experiment;
 use crate::fmi3_types::*;
-use crate::instance::{Interface, Stage, masks3};
+use crate::instance::{Interface, Stage, masks};
 use crate::log::Sink;
 use std::ffi::c_char;
 
@@ -123,7 +123,7 @@ forward! {
         startTime: fmi3Float64,
         stopTimeDefined: fmi3Boolean,
         stopTime: fmi3Float64,
-    ) -> fmi3Status = masks3::ENTER_INITIALIZATION_MODE => |i, f| {
+    ) -> fmi3Status = masks::ENTER_INITIALIZATION_MODE => |i, f| {
         let stop = (stopTimeDefined != fmi3False).then_some(stopTime);
         setup_experiment(i, f, startTime, stop).map(|()| i.stage = Stage::InitializationMode)
     };

@@ -8,7 +8,7 @@ use crate::error::FmuError;
 use crate::exports::guard::{c_slice, refuse, with_instance};
 use crate::fmi2_types::fmi2Status;
 use crate::fmi3_types::*;
-use crate::instance::{Instance, masks3};
+use crate::instance::{Instance, masks, masks3};
 
 /// Defines fmi3Get<T> and fmi3Set<T> for types no variable has: every value reference is
 /// refused, naming the variable's real type when it exists; no value is ever converted.
@@ -19,7 +19,7 @@ macro_rules! no_variables {
             $set,
             $t,
             $name,
-            masks3::SET_OTHER,
+            masks::SET_OTHER,
             |_| $zero,
             |_| f64::NAN
         );
@@ -79,7 +79,7 @@ forward! {
         _valueSizes: *const usize,
         values: *const fmi3Binary,
         nValues: usize,
-    ) -> fmi3Status = masks3::SET_OTHER => |i, f| {
+    ) -> fmi3Status = masks::SET_OTHER => |i, f| {
         no_binary(i, f, (valueReferences, nValueReferences), values, nValues)
     };
 }

@@ -8,8 +8,7 @@ use crate::api::Api;
 use crate::error::FmuError;
 use crate::fmi2_types::fmi2Status;
 use crate::fmi3_types::*;
-use crate::instance::Instance;
-use crate::instance::masks3;
+use crate::instance::{Instance, masks, masks3};
 use crate::table::{ModelTable, Source, Variable3};
 use std::ops::Range;
 
@@ -160,7 +159,7 @@ accessors! {
     fmi3SetFloat64,
     fmi3Float64,
     "Float64",
-    masks3::SET_FLOAT64,
+    masks::SET_REAL,
     |v| v,
     |v| v,
 }
@@ -170,7 +169,7 @@ accessors! {
     fmi3SetInt32,
     fmi3Int32,
     "Int32",
-    masks3::SET_OTHER,
+    masks::SET_OTHER,
     |v| v as i32,
     f64::from,
 }
@@ -179,7 +178,7 @@ accessors! {
     fmi3SetBoolean,
     fmi3Boolean,
     "Boolean",
-    masks3::SET_OTHER,
+    masks::SET_OTHER,
     |v| u8::from(v != 0.0),
     |v: u8| if v != 0 { 1.0 } else { 0.0 },
 }
