@@ -85,10 +85,18 @@ forward! {
 }
 
 const NO_CLOCKS: &str = "this FMU has no clocks";
+const NO_CONFIGURATION: &str = "configuration mode: this FMU has no structural parameters";
+const NO_DEPENDENCIES: &str = "per-element dependencies \
+                               (providesPerElementDependencies=\"false\"); the modelDescription's \
+                               ModelStructure lists the dependencies";
 
-/// Defines exported functions that only refuse, each with its C signature.
+/// An array of value references (in the signatures below, whose arguments are never read).
+type Vrs = *const fmi3ValueReference;
+
+/// Defines exported functions that only refuse, each with the types of its C arguments after
+/// the instance.
 macro_rules! refused {
-    ($($name:ident ( $($arg:ident : $t:ty),* ) => $why:expr;)*) => {
+    ($($name:ident($($t:ty),* $(,)?) => $why:expr;)*) => {
         $(
             /// Not offered: answers fmi3Error with the reason in the log.
             ///
@@ -103,48 +111,33 @@ macro_rules! refused {
 }
 
 refused! {
-    fmi3GetClock(vrs: *const fmi3ValueReference, n: usize, values: *mut fmi3Clock)
+    fmi3GetClock(Vrs, usize, *mut fmi3Clock) => NO_CLOCKS;
+    fmi3SetClock(Vrs, usize, *const fmi3Clock) => NO_CLOCKS;
+    fmi3GetIntervalDecimal(Vrs, usize, *mut f64, *mut fmi3IntervalQualifier) => NO_CLOCKS;
+    fmi3GetIntervalFraction(Vrs, usize, *mut u64, *mut u64, *mut fmi3IntervalQualifier)
         => NO_CLOCKS;
-    fmi3SetClock(vrs: *const fmi3ValueReference, n: usize, values: *const fmi3Clock)
-        => NO_CLOCKS;
-    fmi3GetIntervalDecimal(vrs: *const fmi3ValueReference, n: usize, intervals: *mut f64,
-        qualifiers: *mut fmi3IntervalQualifier) => NO_CLOCKS;
-    fmi3GetIntervalFraction(vrs: *const fmi3ValueReference, n: usize, counters: *mut u64,
-        resolutions: *mut u64, qualifiers: *mut fmi3IntervalQualifier) => NO_CLOCKS;
-    fmi3GetShiftDecimal(vrs: *const fmi3ValueReference, n: usize, shifts: *mut f64)
-        => NO_CLOCKS;
-    fmi3GetShiftFraction(vrs: *const fmi3ValueReference, n: usize, counters: *mut u64,
-        resolutions: *mut u64) => NO_CLOCKS;
-    fmi3SetIntervalDecimal(vrs: *const fmi3ValueReference, n: usize, intervals: *const f64)
-        => NO_CLOCKS;
-    fmi3SetIntervalFraction(vrs: *const fmi3ValueReference, n: usize, counters: *const u64,
-        resolutions: *const u64) => NO_CLOCKS;
-    fmi3SetShiftDecimal(vrs: *const fmi3ValueReference, n: usize, shifts: *const f64)
-        => NO_CLOCKS;
-    fmi3SetShiftFraction(vrs: *const fmi3ValueReference, n: usize, counters: *const u64,
-        resolutions: *const u64) => NO_CLOCKS;
-    fmi3ActivateModelPartition(clock: fmi3ValueReference, time: f64)
-        => "Scheduled Execution is not offered";
-    fmi3EnterConfigurationMode()
-        => "configuration mode: this FMU has no structural parameters";
-    fmi3ExitConfigurationMode()
-        => "configuration mode: this FMU has no structural parameters";
+    fmi3GetShiftDecimal(Vrs, usize, *mut f64) => NO_CLOCKS;
+    fmi3GetShiftFraction(Vrs, usize, *mut u64, *mut u64) => NO_CLOCKS;
+    fmi3SetIntervalDecimal(Vrs, usize, *const f64) => NO_CLOCKS;
+    fmi3SetIntervalFraction(Vrs, usize, *const u64, *const u64) => NO_CLOCKS;
+    fmi3SetShiftDecimal(Vrs, usize, *const f64) => NO_CLOCKS;
+    fmi3SetShiftFraction(Vrs, usize, *const u64, *const u64) => NO_CLOCKS;
+    fmi3ActivateModelPartition(fmi3ValueReference, f64) => "Scheduled Execution is not offered";
+    fmi3EnterConfigurationMode() => NO_CONFIGURATION;
+    fmi3ExitConfigurationMode() => NO_CONFIGURATION;
     fmi3EvaluateDiscreteStates()
         => "evaluateDiscreteStates (providesEvaluateDiscreteStates=\"false\")";
-    fmi3GetNumberOfVariableDependencies(vr: fmi3ValueReference, n: *mut usize)
-        => "per-element dependencies (providesPerElementDependencies=\"false\"); the \
-            modelDescription's ModelStructure lists the dependencies";
-    fmi3GetVariableDependencies(dependent: fmi3ValueReference, element: *mut usize,
-        independents: *mut fmi3ValueReference, elements: *mut usize,
-        kinds: *mut fmi3DependencyKind, n: usize)
-        => "per-element dependencies (providesPerElementDependencies=\"false\"); the \
-            modelDescription's ModelStructure lists the dependencies";
-    fmi3GetDirectionalDerivative(unknowns: *const fmi3ValueReference, nu: usize,
-        knowns: *const fmi3ValueReference, nk: usize, seed: *const f64, ns: usize,
-        sensitivity: *mut f64, nsens: usize)
+    fmi3GetNumberOfVariableDependencies(fmi3ValueReference, *mut usize) => NO_DEPENDENCIES;
+    fmi3GetVariableDependencies(
+        fmi3ValueReference,
+        *mut usize,
+        *mut fmi3ValueReference,
+        *mut usize,
+        *mut fmi3DependencyKind,
+        usize,
+    ) => NO_DEPENDENCIES;
+    fmi3GetDirectionalDerivative(Vrs, usize, Vrs, usize, *const f64, usize, *mut f64, usize)
         => "directional derivatives (providesDirectionalDerivative=\"false\")";
-    fmi3GetAdjointDerivative(unknowns: *const fmi3ValueReference, nu: usize,
-        knowns: *const fmi3ValueReference, nk: usize, seed: *const f64, ns: usize,
-        sensitivity: *mut f64, nsens: usize)
+    fmi3GetAdjointDerivative(Vrs, usize, Vrs, usize, *const f64, usize, *mut f64, usize)
         => "adjoint derivatives (providesAdjointDerivatives=\"false\")";
 }
