@@ -1,21 +1,20 @@
 //! FMI 2.0 Model Exchange, for an instance made with fmuType fmi2ModelExchange.
 
 use crate::error::FmuError;
-use crate::exports::guard::{c_slice_mut, with_instance, write_out};
+use crate::exports::guard::{c_slice_mut, write_out};
 use crate::exports::shared::model_exchange::discrete_update;
 use crate::fmi2_types::*;
 use crate::instance::masks;
 
-exports! {
+forward! {
     /// The discrete changes of the event at the current time (turbulence sample, released
     /// bristles) and the next time event.
-    fn fmi2NewDiscreteStates(c: fmi2Component, eventInfo: *mut fmi2EventInfo) -> fmi2Status {
-        let function = "fmi2NewDiscreteStates";
-        with_instance(c, function, masks::NEW_DISCRETE_STATES, |instance| {
+    fn fmi2NewDiscreteStates(c: fmi2Component, eventInfo: *mut fmi2EventInfo) -> fmi2Status =
+        masks::NEW_DISCRETE_STATES => |i, f| {
             if eventInfo.is_null() {
                 return Err(FmuError::NullArgument("eventInfo"));
             }
-            let (changed, next) = discrete_update(instance, function)?;
+            let (changed, next) = discrete_update(i, f)?;
             let info = fmi2EventInfo {
                 newDiscreteStatesNeeded: fmi2False,
                 terminateSimulation: fmi2False,
@@ -25,11 +24,7 @@ exports! {
                 nextEventTime: next.unwrap_or(0.0),
             };
             write_out(eventInfo, info, "eventInfo")
-        })
-    }
-}
-
-forward! {
+        };
     /// The derivatives of the continuous states: the core's right-hand side, bit for bit.
     fn fmi2GetDerivatives(c: fmi2Component, derivatives: *mut fmi2Real, nx: usize) -> fmi2Status =
         masks::GET_DERIVATIVES => |i| {

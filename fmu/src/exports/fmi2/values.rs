@@ -3,7 +3,7 @@
 //! others still take effect (set) or are filled in (get).
 
 use crate::api::Api;
-use crate::exports::guard::{c_slice, c_slice_mut, with_instance};
+use crate::exports::guard::{c_slice, c_slice_mut};
 use crate::fmi2_types::*;
 use crate::instance::masks;
 
@@ -11,51 +11,44 @@ use crate::instance::masks;
 /// converts through `$to_c`, the setter (allowed in `$mask`) through `$from_c`. The body is
 /// here, not in a helper, so the model is two calls away: the guard, then the engine.
 macro_rules! accessors {
-    ($get:ident, $set:ident, $t:ty, $ty:expr, $mask:expr, $to_c:expr, $from_c:expr $(,)?) => {
-        exports! {
+    ($get:ident, $set:ident, $t:ty, $ty:expr, $mask:path, $to_c:expr, $from_c:expr $(,)?) => {
+        forward! {
             fn $get(
                 c: fmi2Component,
                 vr: *const fmi2ValueReference,
                 nvr: usize,
                 value: *mut $t,
-            ) -> fmi2Status {
-                let function = stringify!($get);
-                with_instance(c, function, masks::GET_VALUE, |instance| {
-                    let vrs = c_slice(vr, nvr, "vr[]")?;
-                    let values = c_slice_mut(value, nvr, "value[]")?;
-                    let table = instance.sim.table();
-                    let mut worst = fmi2Status::fmi2OK;
-                    for (&vr, slot) in vrs.iter().zip(values) {
-                        match table.lookup(vr, Api::Fmi2, $ty) {
-                            Ok(index) => *slot = $to_c(instance.sim.get(index)),
-                            Err(e) => worst = worst.max(instance.report(function, &e)),
-                        }
+            ) -> fmi2Status = masks::GET_VALUE => |instance, function| {
+                let vrs = c_slice(vr, nvr, "vr[]")?;
+                let values = c_slice_mut(value, nvr, "value[]")?;
+                let table = instance.sim.table();
+                let mut worst = fmi2Status::fmi2OK;
+                for (&vr, slot) in vrs.iter().zip(values) {
+                    match table.lookup(vr, Api::Fmi2, $ty) {
+                        Ok(index) => *slot = $to_c(instance.sim.get(index)),
+                        Err(e) => worst = worst.max(instance.report(function, &e)),
                     }
-                    Ok(worst)
-                })
-            }
-
+                }
+                Ok(worst)
+            };
             fn $set(
                 c: fmi2Component,
                 vr: *const fmi2ValueReference,
                 nvr: usize,
                 value: *const $t,
-            ) -> fmi2Status {
-                let function = stringify!($set);
-                with_instance(c, function, $mask, |instance| {
-                    let vrs = c_slice(vr, nvr, "vr[]")?;
-                    let values = c_slice(value, nvr, "value[]")?;
-                    let (initialised, table) = (instance.initialised(), instance.sim.table());
-                    let mut worst = fmi2Status::fmi2OK;
-                    for (&vr, &v) in vrs.iter().zip(values) {
-                        let set = |index| instance.sim.set(index, $from_c(v), initialised);
-                        if let Err(e) = table.lookup(vr, Api::Fmi2, $ty).and_then(set) {
-                            worst = worst.max(instance.report(function, &e));
-                        }
+            ) -> fmi2Status = $mask => |instance, function| {
+                let vrs = c_slice(vr, nvr, "vr[]")?;
+                let values = c_slice(value, nvr, "value[]")?;
+                let (initialised, table) = (instance.initialised(), instance.sim.table());
+                let mut worst = fmi2Status::fmi2OK;
+                for (&vr, &v) in vrs.iter().zip(values) {
+                    let set = |index| instance.sim.set(index, $from_c(v), initialised);
+                    if let Err(e) = table.lookup(vr, Api::Fmi2, $ty).and_then(set) {
+                        worst = worst.max(instance.report(function, &e));
                     }
-                    Ok(worst)
-                })
-            }
+                }
+                Ok(worst)
+            };
         }
     };
 }

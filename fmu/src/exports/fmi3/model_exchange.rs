@@ -2,7 +2,7 @@
 //! same states, derivatives, event indicators and events as FMI 2.0's Model Exchange.
 
 use crate::error::FmuError;
-use crate::exports::guard::{c_slice_mut, with_instance, write_out};
+use crate::exports::guard::{c_slice_mut, write_out};
 use crate::exports::shared::model_exchange::discrete_update;
 use crate::fmi3_types::*;
 use crate::instance::{Instance, masks3};
@@ -14,7 +14,7 @@ fn count(instance: &Instance, of: fn(&ModelExchangeTable) -> usize) -> usize {
     instance.sim.table().model_exchange.as_ref().map_or(0, of)
 }
 
-exports! {
+forward! {
     /// The discrete changes of the event at the current time (turbulence sample, released
     /// bristles) and the next time event. Every output pointer must be writable.
     fn fmi3UpdateDiscreteStates(
@@ -25,33 +25,27 @@ exports! {
         valuesOfContinuousStatesChanged: *mut fmi3Boolean,
         nextEventTimeDefined: *mut fmi3Boolean,
         nextEventTime: *mut fmi3Float64,
-    ) -> fmi3Status {
-        let function = "fmi3UpdateDiscreteStates";
-        with_instance(instance, function, masks3::UPDATE_DISCRETE_STATES, |instance| {
-            let flags = [
-                (discreteStatesNeedUpdate, "discreteStatesNeedUpdate"),
-                (terminateSimulation, "terminateSimulation"),
-                (nominalsOfContinuousStatesChanged, "nominalsOfContinuousStatesChanged"),
-                (valuesOfContinuousStatesChanged, "valuesOfContinuousStatesChanged"),
-                (nextEventTimeDefined, "nextEventTimeDefined"),
-            ];
-            if let Some((_, name)) = flags.iter().find(|(p, _)| p.is_null()) {
-                return Err(FmuError::NullArgument(name));
-            }
-            if nextEventTime.is_null() {
-                return Err(FmuError::NullArgument("nextEventTime"));
-            }
-            let (changed, next) = discrete_update(instance, function)?;
-            let values = [false, false, false, changed, next.is_some()];
-            for ((pointer, name), value) in flags.into_iter().zip(values) {
-                write_out(pointer, u8::from(value), name)?;
-            }
-            write_out(nextEventTime, next.unwrap_or(0.0), "nextEventTime")
-        })
-    }
-}
-
-forward! {
+    ) -> fmi3Status = masks3::UPDATE_DISCRETE_STATES => |i, f| {
+        let flags = [
+            (discreteStatesNeedUpdate, "discreteStatesNeedUpdate"),
+            (terminateSimulation, "terminateSimulation"),
+            (nominalsOfContinuousStatesChanged, "nominalsOfContinuousStatesChanged"),
+            (valuesOfContinuousStatesChanged, "valuesOfContinuousStatesChanged"),
+            (nextEventTimeDefined, "nextEventTimeDefined"),
+        ];
+        if let Some((_, name)) = flags.iter().find(|(p, _)| p.is_null()) {
+            return Err(FmuError::NullArgument(name));
+        }
+        if nextEventTime.is_null() {
+            return Err(FmuError::NullArgument("nextEventTime"));
+        }
+        let (changed, next) = discrete_update(i, f)?;
+        let values = [false, false, false, changed, next.is_some()];
+        for ((pointer, name), value) in flags.into_iter().zip(values) {
+            write_out(pointer, u8::from(value), name)?;
+        }
+        write_out(nextEventTime, next.unwrap_or(0.0), "nextEventTime")
+    };
     /// FMI 3.0's fmi2GetDerivatives, also in initialization mode.
     fn fmi3GetContinuousStateDerivatives(
         instance: fmi3Instance,

@@ -85,8 +85,8 @@ pub(crate) fn each_variable(
 /// converts through `$to_c`, the setter (allowed in `$mask`) through `$from_c`. The body is
 /// here, not in a helper, so the model is two calls away: the guard, then the engine.
 macro_rules! accessors {
-    ($get:ident, $set:ident, $t:ty, $ty:expr, $mask:expr, $to_c:expr, $from_c:expr $(,)?) => {
-        exports! {
+    ($get:ident, $set:ident, $t:ty, $ty:expr, $mask:path, $to_c:expr, $from_c:expr $(,)?) => {
+        forward! {
             /// Reads the variables (arrays element by element) into `values`.
             fn $get(
                 instance: fmi3Instance,
@@ -94,29 +94,25 @@ macro_rules! accessors {
                 nValueReferences: usize,
                 values: *mut $t,
                 nValues: usize,
-            ) -> fmi3Status {
+            ) -> fmi3Status = masks3::GET_VALUE => |instance, function| {
                 use $crate::exports::fmi3::values::{computed, each_variable, resolve};
-                use $crate::exports::guard::{c_slice, c_slice_mut, with_instance};
-                let function = stringify!($get);
-                with_instance(instance, function, masks3::GET_VALUE, |instance| {
-                    let vrs = c_slice(valueReferences, nValueReferences, "valueReferences[]")?;
-                    let variables = resolve(instance.sim.table(), vrs, nValues)?;
-                    let out = c_slice_mut(values, nValues, "values[]")?;
-                    each_variable(instance, function, variables, $ty, |instance, v, range| {
-                        let slots = &mut out[range];
-                        match &v.source {
-                            $crate::table::Source::Model(elements) => {
-                                for (slot, index) in slots.iter_mut().zip(elements.clone()) {
-                                    *slot = $to_c(instance.sim.get(index));
-                                }
+                use $crate::exports::guard::{c_slice, c_slice_mut};
+                let vrs = c_slice(valueReferences, nValueReferences, "valueReferences[]")?;
+                let variables = resolve(instance.sim.table(), vrs, nValues)?;
+                let out = c_slice_mut(values, nValues, "values[]")?;
+                each_variable(instance, function, variables, $ty, |instance, v, range| {
+                    let slots = &mut out[range];
+                    match &v.source {
+                        $crate::table::Source::Model(elements) => {
+                            for (slot, index) in slots.iter_mut().zip(elements.clone()) {
+                                *slot = $to_c(instance.sim.get(index));
                             }
-                            _ => slots[0] = $to_c(computed(instance, v)?),
                         }
-                        Ok(())
-                    })
+                        _ => slots[0] = $to_c(computed(instance, v)?),
+                    }
+                    Ok(())
                 })
-            }
-
+            };
             /// Writes `values` to the variables (arrays element by element).
             fn $set(
                 instance: fmi3Instance,
@@ -124,31 +120,28 @@ macro_rules! accessors {
                 nValueReferences: usize,
                 values: *const $t,
                 nValues: usize,
-            ) -> fmi3Status {
+            ) -> fmi3Status = $mask => |instance, function| {
                 use $crate::exports::fmi3::values::{each_variable, not_settable, resolve};
-                use $crate::exports::guard::{c_slice, with_instance};
-                let function = stringify!($set);
-                with_instance(instance, function, $mask, |instance| {
-                    let vrs = c_slice(valueReferences, nValueReferences, "valueReferences[]")?;
-                    let variables = resolve(instance.sim.table(), vrs, nValues)?;
-                    let values = c_slice(values, nValues, "values[]")?;
-                    let initialised = instance.initialised();
-                    each_variable(instance, function, variables, $ty, |instance, v, range| {
-                        let $crate::table::Source::Model(elements) = &v.source else {
-                            return Err(not_settable(v));
-                        };
-                        // Every element is tried; the first refusal is reported.
-                        let mut first = Ok(());
-                        for (index, &value) in elements.clone().zip(&values[range]) {
-                            let r = instance.sim.set(index, $from_c(value), initialised);
-                            if first.is_ok() {
-                                first = r;
-                            }
+                use $crate::exports::guard::c_slice;
+                let vrs = c_slice(valueReferences, nValueReferences, "valueReferences[]")?;
+                let variables = resolve(instance.sim.table(), vrs, nValues)?;
+                let values = c_slice(values, nValues, "values[]")?;
+                let initialised = instance.initialised();
+                each_variable(instance, function, variables, $ty, |instance, v, range| {
+                    let $crate::table::Source::Model(elements) = &v.source else {
+                        return Err(not_settable(v));
+                    };
+                    // Every element is tried; the first refusal is reported.
+                    let mut first = Ok(());
+                    for (index, &value) in elements.clone().zip(&values[range]) {
+                        let r = instance.sim.set(index, $from_c(value), initialised);
+                        if first.is_ok() {
+                            first = r;
                         }
-                        first
-                    })
+                    }
+                    first
                 })
-            }
+            };
         }
     };
 }
