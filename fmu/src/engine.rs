@@ -77,8 +77,8 @@ impl Clock {
 
 /// The instance's simulation as the FMI functions drive it; a method named after an FMI
 /// function (`do_step`, `set_time`...) is that function's work, `index` is a position in the
-/// table, `stage` the instance's stage code saved in FMU states. The Model Exchange methods
-/// (from `set_time` on) are an error for a Co-Simulation-only model.
+/// table, `stage` the instance's stage code saved in FMU states. The hybrid views and the
+/// event update are an error for a Co-Simulation-only model.
 pub trait Simulation: std::fmt::Debug {
     fn table(&self) -> &'static ModelTable;
     fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> Result<(), FmuError>;

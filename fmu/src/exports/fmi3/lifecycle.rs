@@ -57,8 +57,7 @@ exports! {
     ) -> fmi3Instance {
         let args = (instanceName, instantiationToken, loggingOn);
         let logger = (instanceEnvironment, logMessage);
-        let interface = Ok(Interface::ModelExchange);
-        instantiate3("fmi3InstantiateModelExchange", interface, args, logger)
+        instantiate3("fmi3InstantiateModelExchange", Ok(Interface::ModelExchange), args, logger)
     }
 
     /// A Co-Simulation instance. Refused (NULL, with the reason logged) with
@@ -108,8 +107,7 @@ exports! {
         let logger = (instanceEnvironment, logMessage);
         let why = "Scheduled Execution is not offered (the modelDescription has no \
                    ScheduledExecution element)";
-        let refusal = Err(why.to_string());
-        instantiate3("fmi3InstantiateScheduledExecution", refusal, args, logger)
+        instantiate3("fmi3InstantiateScheduledExecution", Err(why.to_string()), args, logger)
     }
 }
 
