@@ -59,9 +59,9 @@ pub trait FmuModel: VariableTable<Initial: fmt::Debug, Params: fmt::Debug> + fmt
     /// would run for hours).
     fn internal_steps(&self, end: f64, h: f64) -> f64;
 
-    /// One communication step of `h` seconds up to `end` seconds after the start time. Both
-    /// are on the FMU's grid (`n·h`, never summed), so a model with its own fixed step can
-    /// count whole steps.
+    /// One communication step of `h` seconds, ending `end` seconds after the start time t0:
+    /// the FMU's grid time `t0 + n·h` (never a running sum) less t0, so a model with its own
+    /// fixed step can count whole steps.
     fn advance(&mut self, end: f64, h: f64);
 
     /// Whether the state holds only finite numbers (false once the dynamics diverged).
