@@ -3,7 +3,8 @@
 //! and adjoint derivatives, evaluateDiscreteStates and Scheduled Execution. Each is exported
 //! (importers bind every function) and answers fmi3Error with the reason in the log.
 
-use super::values::{accessors, each_variable, resolve};
+use super::values::{accessors, resolve};
+use crate::api::Api;
 use crate::error::FmuError;
 use crate::exports::guard::{c_slice, refuse, with_instance};
 use crate::fmi2_types::fmi2Status;
@@ -56,7 +57,13 @@ unsafe fn no_binary<B>(
     let variables = resolve(instance.sim.table(), vrs, n_values)?;
     // SAFETY: per the function's contract.
     unsafe { c_slice(values, n_values, "values[]") }?;
-    each_variable(instance, function, variables, "Binary", |_, _, _| Ok(()))
+    let mut worst = fmi2Status::fmi2OK;
+    for (v, _) in variables {
+        if let Err(e) = Api::Fmi3.check("Binary", v) {
+            worst = worst.max(instance.report(function, &e));
+        }
+    }
+    Ok(worst)
 }
 
 forward! {

@@ -4,21 +4,20 @@
 //! (positions in `values` would be guesswork); after that every variable is handled as in
 //! FMI 2.0: a refused one is logged with its reason while the others still take effect.
 
-use crate::api::Api;
 use crate::error::FmuError;
-use crate::fmi2_types::fmi2Status;
 use crate::fmi3_types::*;
 use crate::instance::{Instance, masks, masks3};
 use crate::table::{ModelTable, Source, Variable3};
 use std::ops::Range;
 
-/// The variables behind `vrs`, after checking that every one exists and that together they
-/// hold `n_values` values (no allocation: this runs on every get and set).
+/// The variables behind `vrs`, each with the range of its values in the caller's array, after
+/// checking that every one exists and that together they hold `n_values` values (no
+/// allocation: this runs on every get and set).
 pub(crate) fn resolve<'a>(
     table: &'static ModelTable,
     vrs: &'a [fmi3ValueReference],
     n_values: usize,
-) -> Result<impl Iterator<Item = &'static Variable3> + use<'a>, FmuError> {
+) -> Result<impl Iterator<Item = (&'static Variable3, Range<usize>)> + use<'a>, FmuError> {
     let mut total = 0;
     for &vr in vrs {
         let v = table.variable3(vr);
@@ -31,7 +30,14 @@ pub(crate) fn resolve<'a>(
             vrs.len()
         )));
     }
-    Ok(vrs.iter().filter_map(|&vr| table.variable3(vr)))
+    let mut at = 0;
+    Ok(vrs
+        .iter()
+        .filter_map(|&vr| table.variable3(vr))
+        .map(move |v| {
+            at += v.len();
+            (v, at - v.len()..at)
+        }))
 }
 
 /// Element `i` of `v`, which is not a model variable.
@@ -58,32 +64,10 @@ pub(crate) fn not_settable(v: &Variable3) -> FmuError {
     FmuError::NotSettable { name, reason }
 }
 
-/// Runs `body` on each of `variables` with the range of its values in the caller's array,
-/// once it is of FMI 3.0 type `ty`; a refused variable is logged with its reason while the
-/// others still go on. Answers the worst status.
-pub(crate) fn each_variable(
-    instance: &mut Instance,
-    function: &str,
-    variables: impl Iterator<Item = &'static Variable3>,
-    ty: &'static str,
-    mut body: impl FnMut(&mut Instance, &Variable3, Range<usize>) -> Result<(), FmuError>,
-) -> Result<fmi2Status, FmuError> {
-    let (mut worst, mut at) = (fmi2Status::fmi2OK, 0);
-    for v in variables {
-        let range = at..at + v.len();
-        at = range.end;
-        let checked = Api::Fmi3.check(ty, v);
-        let result = checked.and_then(|()| body(instance, v, range));
-        if let Err(e) = result {
-            worst = worst.max(instance.report(function, &e));
-        }
-    }
-    Ok(worst)
-}
-
 /// Defines fmi3Get<T> and fmi3Set<T> for C type `$t` and FMI 3.0 type `$ty`: the getter
 /// converts through `$to_c`, the setter (allowed in `$mask`) through `$from_c`. The body is
-/// here, not in a helper, so the model is two calls away: the guard, then the engine.
+/// here, not in a helper, so the model is two calls away: the guard, then the engine (after
+/// [`resolve`] has checked every value reference before any value is touched).
 macro_rules! accessors {
     ($get:ident, $set:ident, $t:ty, $ty:expr, $mask:path, $to_c:expr, $from_c:expr $(,)?) => {
         forward! {
@@ -95,23 +79,29 @@ macro_rules! accessors {
                 values: *mut $t,
                 nValues: usize,
             ) -> fmi3Status = masks3::GET_VALUE => |instance, function| {
-                use $crate::exports::fmi3::values::{computed, each_variable, resolve};
+                use $crate::exports::fmi3::values::{computed, resolve};
+                use $crate::{api::Api, fmi2_types::fmi2Status, table::Source};
                 use $crate::exports::guard::{c_slice, c_slice_mut};
                 let vrs = c_slice(valueReferences, nValueReferences, "valueReferences[]")?;
                 let variables = resolve(instance.sim.table(), vrs, nValues)?;
                 let out = c_slice_mut(values, nValues, "values[]")?;
-                each_variable(instance, function, variables, $ty, |instance, v, range| {
+                let mut worst = fmi2Status::fmi2OK;
+                for (v, range) in variables {
                     let slots = &mut out[range];
-                    match &v.source {
-                        $crate::table::Source::Model(elements) => {
+                    let read = Api::Fmi3.check($ty, v).and_then(|()| match &v.source {
+                        Source::Model(elements) => {
                             for (slot, index) in slots.iter_mut().zip(elements.clone()) {
                                 *slot = $to_c(instance.sim.get(index));
                             }
+                            Ok(())
                         }
-                        _ => slots[0] = $to_c(computed(instance, v)?),
+                        _ => computed(instance, v).map(|value| slots[0] = $to_c(value)),
+                    });
+                    if let Err(e) = read {
+                        worst = worst.max(instance.report(function, &e));
                     }
-                    Ok(())
-                })
+                }
+                Ok(worst)
             };
             /// Writes `values` to the variables (arrays element by element).
             fn $set(
@@ -121,26 +111,30 @@ macro_rules! accessors {
                 values: *const $t,
                 nValues: usize,
             ) -> fmi3Status = $mask => |instance, function| {
-                use $crate::exports::fmi3::values::{each_variable, not_settable, resolve};
+                use $crate::exports::fmi3::values::{not_settable, resolve};
+                use $crate::{api::Api, fmi2_types::fmi2Status, table::Source};
                 use $crate::exports::guard::c_slice;
                 let vrs = c_slice(valueReferences, nValueReferences, "valueReferences[]")?;
                 let variables = resolve(instance.sim.table(), vrs, nValues)?;
                 let values = c_slice(values, nValues, "values[]")?;
                 let initialised = instance.initialised();
-                each_variable(instance, function, variables, $ty, |instance, v, range| {
-                    let $crate::table::Source::Model(elements) = &v.source else {
-                        return Err(not_settable(v));
-                    };
-                    // Every element is tried; the first refusal is reported.
-                    let mut first = Ok(());
-                    for (index, &value) in elements.clone().zip(&values[range]) {
-                        let r = instance.sim.set(index, $from_c(value), initialised);
-                        if first.is_ok() {
-                            first = r;
-                        }
+                let mut worst = fmi2Status::fmi2OK;
+                for (v, range) in variables {
+                    let written = Api::Fmi3.check($ty, v).and_then(|()| match &v.source {
+                        // Every element is tried; the first refusal is reported.
+                        Source::Model(elements) => (elements.clone())
+                            .zip(&values[range])
+                            .map(|(index, &value)| {
+                                instance.sim.set(index, $from_c(value), initialised)
+                            })
+                            .fold(Ok(()), Result::and),
+                        _ => Err(not_settable(v)),
+                    });
+                    if let Err(e) = written {
+                        worst = worst.max(instance.report(function, &e));
                     }
-                    first
-                })
+                }
+                Ok(worst)
             };
         }
     };
