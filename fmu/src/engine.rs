@@ -183,7 +183,8 @@ impl<M: FmuModel> Engine<M> {
         Ok(())
     }
 
-    fn decode(bytes: &[u8]) -> Result<(u8, Book<M::Initial>, M), FmuError> {
+    /// The stage code, book and model snapshot of state bytes of this model.
+    fn decode(bytes: &[u8]) -> Result<(u8, Body<M::Initial>), FmuError> {
         let record: Record = snapshot::decode(STATE_TAG, STATE_NAME, bytes)?;
         let table = &M::table().table;
         if record.guid != table.token(Api::Fmi2) {
@@ -194,9 +195,9 @@ impl<M: FmuModel> Engine<M> {
                 table.token(Api::Fmi2)
             )));
         }
-        let (book, model): Body<M::Initial> = postcard::from_bytes(&record.body)
+        let body = postcard::from_bytes(&record.body)
             .map_err(|e| FmuError::State(SnapshotError::Decode(e.to_string())))?;
-        Ok((record.stage, book, M::restore(&model)?))
+        Ok((record.stage, body))
     }
 }
 
@@ -327,11 +328,14 @@ impl<M: FmuModel> Simulation for Engine<M> {
     }
 
     fn check_saved(&self, bytes: &[u8]) -> Result<u8, FmuError> {
-        Self::decode(bytes).map(|(stage, _, _)| stage)
+        let (stage, (_, model)) = Self::decode(bytes)?;
+        M::restore(&model)?;
+        Ok(stage)
     }
 
     fn restore(&mut self, bytes: &[u8]) -> Result<u8, FmuError> {
-        let (stage, book, model) = Self::decode(bytes)?;
+        let (stage, (book, model)) = Self::decode(bytes)?;
+        let model = M::restore(&model)?;
         *self = Engine { model, book };
         Ok(stage)
     }

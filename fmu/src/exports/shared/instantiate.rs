@@ -1,7 +1,6 @@
 //! What fmi2Instantiate and FMI 3.0's fmi3Instantiate* share.
 
 use crate::api::Api;
-use crate::engine::Simulation;
 use crate::fmi2_types::fmi2Status;
 use crate::instance::{Instance, Interface, Stage};
 use crate::log::{Logger, Sink};
@@ -24,33 +23,27 @@ pub(crate) struct Request<'a> {
     pub logging_on: bool,
 }
 
-/// The simulation `request` asks for, or why there is none.
-fn simulation(request: &Request<'_>) -> Result<(Interface, Box<dyn Simulation>), String> {
+/// The interface and token `request` names, or why its arguments name none.
+fn checked(request: &Request<'_>) -> Result<(Interface, String), String> {
     (request.name.filter(|n| !n.is_empty())).ok_or("instanceName is NULL or empty")?;
     let interface = request.interface.clone()?;
     let token_name = request.api.token_name();
     let token = request.token.ok_or(format!("{token_name} is NULL"))?;
-    let token = token.to_string_lossy();
-    let Some(sim) = models::simulation_for(request.api, &token) else {
-        let known: Vec<String> = models::tables()
-            .iter()
-            .map(|t| format!("{} {}", t.info.identifier, t.token(request.api)))
-            .collect();
-        return Err(format!(
-            "{token_name} {token} is not one of this library's models ({}); the \
-             modelDescription.xml and the binary do not belong together",
-            known.join(", ")
-        ));
-    };
-    let sim = sim.map_err(|e| format!("the model does not start: {e}"))?;
-    if interface == Interface::ModelExchange && sim.table().model_exchange.is_none() {
-        return Err(format!(
-            "{} is Co-Simulation only (its physics engine steps internally); instantiate it \
-             for Co-Simulation",
-            sim.table().info.identifier
-        ));
-    }
-    Ok((interface, sim))
+    Ok((interface, token.to_string_lossy().into_owned()))
+}
+
+/// Why no model of this library has `token`.
+fn unknown(api: Api, token: &str) -> String {
+    let known: Vec<String> = models::tables()
+        .iter()
+        .map(|t| format!("{} {}", t.info.identifier, t.token(api)))
+        .collect();
+    format!(
+        "{} {token} is not one of this library's models ({}); the modelDescription.xml and \
+         the binary do not belong together",
+        api.token_name(),
+        known.join(", ")
+    )
 }
 
 /// The instance `request` asks for, or NULL after logging why not (without a logger: NULL;
@@ -62,7 +55,20 @@ pub(crate) fn instantiate(request: Request<'_>) -> *mut c_void {
             sink: request.sink?,
             instance_name: request.name.map(CStr::to_owned).unwrap_or_default(),
         };
-        let (interface, sim) = match simulation(&request) {
+        let found = checked(&request).and_then(|(interface, token)| {
+            let sim = models::simulation_for(api, &token).ok_or_else(|| unknown(api, &token))?;
+            let sim = sim.map_err(|e| format!("the model does not start: {e}"))?;
+            let table = sim.table();
+            if interface == Interface::ModelExchange && table.model_exchange.is_none() {
+                return Err(format!(
+                    "{} is Co-Simulation only (its physics engine steps internally); \
+                     instantiate it for Co-Simulation",
+                    table.info.identifier
+                ));
+            }
+            Ok((interface, sim))
+        });
+        let (interface, sim) = match found {
             Ok(found) => found,
             Err(message) => {
                 logger.log(fmi2Status::fmi2Error, &format!("{function}: {message}"));
