@@ -121,6 +121,15 @@ pub(crate) unsafe fn c_str<'a>(s: *const c_char) -> Option<&'a CStr> {
     (!s.is_null()).then(|| unsafe { CStr::from_ptr(s) })
 }
 
+/// Fails on the first NULL among the output pointers `outs` (checked before anything is done,
+/// so that a call with a NULL one changes nothing).
+pub(crate) fn no_null<T>(outs: &[(*mut T, &'static str)]) -> Result<(), FmuError> {
+    match outs.iter().find(|(pointer, _)| pointer.is_null()) {
+        Some(&(_, name)) => Err(FmuError::NullArgument(name)),
+        None => Ok(()),
+    }
+}
+
 /// `*ptr = value` for an output pointer argument.
 ///
 /// # Safety

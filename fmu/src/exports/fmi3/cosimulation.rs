@@ -2,8 +2,7 @@
 //! (so both give the same outputs bit for bit), and the step-mode functions this FMU does not
 //! need.
 
-use crate::error::FmuError;
-use crate::exports::guard::{refuse, write_out};
+use crate::exports::guard::{no_null, refuse, write_out};
 use crate::fmi3_types::*;
 use crate::instance::{Interface, masks, masks3};
 
@@ -28,12 +27,8 @@ forward! {
             (terminateSimulation, "terminateSimulation"),
             (earlyReturn, "earlyReturn"),
         ];
-        if let Some((_, name)) = flags.iter().find(|(p, _)| p.is_null()) {
-            return Err(FmuError::NullArgument(name));
-        }
-        if lastSuccessfulTime.is_null() {
-            return Err(FmuError::NullArgument("lastSuccessfulTime"));
-        }
+        no_null(&flags)?;
+        no_null(&[(lastSuccessfulTime, "lastSuccessfulTime")])?;
         let result = i.sim.do_step(currentCommunicationPoint, communicationStepSize);
         for (pointer, name) in flags {
             write_out(pointer, fmi3False, name)?;

@@ -1,8 +1,7 @@
 //! Model Exchange through FMI 3.0, for an instance from fmi3InstantiateModelExchange: the
 //! same states, derivatives, event indicators and events as FMI 2.0's Model Exchange.
 
-use crate::error::FmuError;
-use crate::exports::guard::{c_slice_mut, write_out};
+use crate::exports::guard::{c_slice_mut, no_null, write_out};
 use crate::exports::shared::model_exchange::discrete_update;
 use crate::fmi3_types::*;
 use crate::instance::{Instance, masks3};
@@ -33,12 +32,8 @@ forward! {
             (valuesOfContinuousStatesChanged, "valuesOfContinuousStatesChanged"),
             (nextEventTimeDefined, "nextEventTimeDefined"),
         ];
-        if let Some((_, name)) = flags.iter().find(|(p, _)| p.is_null()) {
-            return Err(FmuError::NullArgument(name));
-        }
-        if nextEventTime.is_null() {
-            return Err(FmuError::NullArgument("nextEventTime"));
-        }
+        no_null(&flags)?;
+        no_null(&[(nextEventTime, "nextEventTime")])?;
         let (changed, next) = discrete_update(i, f)?;
         let values = [false, false, false, changed, next.is_some()];
         for ((pointer, name), value) in flags.into_iter().zip(values) {

@@ -2,7 +2,7 @@
 //! same in both versions, and the event update both versions' discrete-state functions run.
 
 use crate::error::FmuError;
-use crate::exports::guard::{c_slice, c_slice_mut, write_out};
+use crate::exports::guard::{c_slice, c_slice_mut, no_null, write_out};
 use crate::fmi2_types::fmi2Boolean;
 use crate::fmi3_types::fmi3Boolean;
 use crate::instance::{Instance, Stage, masks};
@@ -72,12 +72,11 @@ twins! {
         enterEventMode: *mut fmi2Boolean | *mut fmi3Boolean,
         terminateSimulation: *mut fmi2Boolean | *mut fmi3Boolean,
     ) = masks::COMPLETED_INTEGRATOR_STEP => |i| {
-        if enterEventMode.is_null() {
-            return Err(FmuError::NullArgument("enterEventMode"));
-        }
-        if terminateSimulation.is_null() {
-            return Err(FmuError::NullArgument("terminateSimulation"));
-        }
+        let flags = [
+            (enterEventMode, "enterEventMode"),
+            (terminateSimulation, "terminateSimulation"),
+        ];
+        no_null(&flags)?;
         i.sim.completed_integrator_step()?;
         write_out(enterEventMode, 0, "enterEventMode")?;
         write_out(terminateSimulation, 0, "terminateSimulation")
