@@ -14,6 +14,8 @@ import argparse
 import ctypes
 import shutil
 import time
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 from fmpy import extract, read_model_description
@@ -35,8 +37,23 @@ def per_call(loop, steps: int, repeats: int = 5) -> float:
     return best / steps * 1e6
 
 
-def measure(fmu: str, steps: int) -> dict[str, float]:
-    """Microseconds per call for one FMU (FMI 2.0 or 3.0, from its modelDescription)."""
+@dataclass
+class Instance:
+    """An FMU instance initialised at hover, with the calls that set its motor commands and
+    read its outputs (FMI 2.0's or 3.0's)."""
+
+    slave: FMU2Slave | FMU3Slave
+    fmi3: bool
+    set_real: Callable
+    get_real: Callable
+    inputs: list[int]
+    outputs: list[int]
+    directory: str
+
+
+def open_at_hover(fmu: str) -> Instance:
+    """Extracts and instantiates `fmu` (FMI 2.0 or 3.0, from its modelDescription) and
+    initialises it with the motors at hover."""
     md = read_model_description(fmu)
     fmi3 = md.fmiVersion.startswith("3")
     vrs = {v.name: v.valueReference for v in md.modelVariables}
@@ -60,9 +77,39 @@ def measure(fmu: str, steps: int) -> dict[str, float]:
         set_real, get_real = slave.setReal, slave.getReal
         inputs = [vrs[f"motor_command_{i}"] for i in range(4)]
     slave.exitInitializationMode()
+    outputs = [vrs[name] for name in OUTPUTS]
+    return Instance(slave, fmi3, set_real, get_real, inputs, outputs, directory)
+
+
+def raw_do_step(fmu: Instance, h: float) -> Callable[..., None]:
+    """`raw_step(t, instance=the FMU's)`: doStep of h from t without fmpy's Python wrapper
+    (pre-made output arguments): what the FMU and ctypes cost, apart from the wrapper (FMI
+    3.0's builds four ctypes objects and a tuple)."""
+    slave = fmu.slave
+    if fmu.fmi3:
+        flags = [ctypes.c_bool() for _ in range(3)]
+        last = ctypes.c_double()
+        outs = [ctypes.byref(f) for f in flags] + [ctypes.byref(last)]
+        raw = slave.dll.fmi3DoStep
+
+        def raw_step(t: float, instance=slave.component) -> None:
+            raw(instance, t, h, True, *outs)
+    else:
+        raw = slave.dll.fmi2DoStep
+
+        def raw_step(t: float, instance=slave.component) -> None:
+            raw(instance, t, h, 1)
+
+    return raw_step
+
+
+def timed_loops(fmu: Instance) -> dict[str, Callable[[int], None]]:
+    """The loops `measure` times, each `loop(count)`: one clock of 10 ms steps runs on through
+    all of them, so every doStep continues from the last."""
+    slave, set_real, get_real = fmu.slave, fmu.set_real, fmu.get_real
+    inputs, outputs = fmu.inputs, fmu.outputs
     h = 0.01
     n = 0
-    outputs = [vrs[name] for name in OUTPUTS]
 
     def steps_only(count: int) -> None:
         nonlocal n
@@ -79,21 +126,7 @@ def measure(fmu: str, steps: int) -> dict[str, float]:
             get_real(outputs)
             n += 1
 
-    # The same call without fmpy's Python wrapper (pre-made output arguments): what the FMU and
-    # ctypes cost, apart from the wrapper (FMI 3.0's builds four ctypes objects and a tuple).
-    if fmi3:
-        flags = [ctypes.c_bool() for _ in range(3)]
-        last = ctypes.c_double()
-        outs = [ctypes.byref(f) for f in flags] + [ctypes.byref(last)]
-        raw = slave.dll.fmi3DoStep
-
-        def raw_step(t: float, instance=slave.component) -> None:
-            raw(instance, t, h, True, *outs)
-    else:
-        raw = slave.dll.fmi2DoStep
-
-        def raw_step(t: float, instance=slave.component) -> None:
-            raw(instance, t, h, 1)
+    raw_step = raw_do_step(fmu, h)
 
     def null_steps(count: int) -> None:
         # A NULL instance is refused at once: what is left is ctypes passing the arguments.
@@ -112,16 +145,29 @@ def measure(fmu: str, steps: int) -> dict[str, float]:
         for _ in range(count):
             version()
 
+    return dict(
+        steps_only=steps_only,
+        set_step_get=set_step_get,
+        steps_raw=steps_raw,
+        null_steps=null_steps,
+        empty_call=empty_call,
+    )
+
+
+def measure(fmu: str, steps: int) -> dict[str, float]:
+    """Microseconds per call for one FMU (FMI 2.0 or 3.0, from its modelDescription)."""
+    instance = open_at_hover(fmu)
+    loops = timed_loops(instance)
     results = {
-        "doStep (10 ms)": per_call(steps_only, steps),
-        "set 4 + doStep + get 13": per_call(set_step_get, steps // 4),
-        "doStep through ctypes, without fmpy's wrapper": per_call(steps_raw, steps),
-        "the same on a NULL instance (argument passing)": per_call(null_steps, steps),
-        "ctypes empty call (fmi2GetVersion)": per_call(empty_call, steps),
+        "doStep (10 ms)": per_call(loops["steps_only"], steps),
+        "set 4 + doStep + get 13": per_call(loops["set_step_get"], steps // 4),
+        "doStep through ctypes, without fmpy's wrapper": per_call(loops["steps_raw"], steps),
+        "the same on a NULL instance (argument passing)": per_call(loops["null_steps"], steps),
+        "ctypes empty call (fmi2GetVersion)": per_call(loops["empty_call"], steps),
     }
-    slave.terminate()
-    slave.freeInstance()
-    shutil.rmtree(directory, ignore_errors=True)
+    instance.slave.terminate()
+    instance.slave.freeInstance()
+    shutil.rmtree(instance.directory, ignore_errors=True)
     return results
 
 

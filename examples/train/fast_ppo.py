@@ -36,7 +36,7 @@ import csv
 import json
 import sys
 import time
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import flyloop  # noqa: F401  (registers the envs)
@@ -311,191 +311,274 @@ def evaluate(
     )
 
 
+def make_model(cfg: Config, obs_size: int, act_size: int) -> ActorCritic:
+    """The actor-critic of cfg; with cfg.time_limit_terminal the critic also sees the time
+    remaining."""
+    return ActorCritic(
+        obs_size,
+        act_size,
+        cfg.hidden,
+        cfg.init_log_std,
+        cfg.action_basis,
+        value_extra=int(cfg.time_limit_terminal),
+    )
+
+
+def time_limit(cfg: Config, task: str) -> int | None:
+    """The task's episode length in steps when the time limit ends the return (the time
+    remaining is then the critic's input), otherwise None."""
+    if not cfg.time_limit_terminal:
+        return None
+    max_steps = preset(TASKS[task].preset).env_kwargs.get("max_steps")
+    if not max_steps:
+        raise ValueError("time_limit_terminal needs the task's max_steps")
+    return max_steps
+
+
+@dataclass
+class EndedEpisodes:
+    """The training episodes that ended during one rollout."""
+
+    success: list = field(default_factory=list)
+    returns: list = field(default_factory=list)
+    lengths: list = field(default_factory=list)
+
+
+class Rollout:
+    """One update's transitions (rollout_steps steps of num_envs sub-envs), and what carries
+    over from one rollout to the next: each sub-env's episode so far, and whether its next
+    step resets (NEXT_STEP autoreset: that step is left out of the loss)."""
+
+    def __init__(self, cfg: Config, obs_size: int, act_size: int, max_steps: int | None) -> None:
+        t_len, n = cfg.rollout_steps, cfg.num_envs
+        self.reward_scale = cfg.reward_scale
+        self.max_steps = max_steps
+        self.obs = np.zeros((t_len + 1, n, obs_size), np.float32)
+        self.act = np.zeros((t_len, n, act_size), np.float32)
+        self.logp = np.zeros((t_len, n), np.float32)
+        self.rew = np.zeros((t_len, n), np.float32)
+        self.term = np.zeros((t_len, n), bool)
+        self.done = np.zeros((t_len, n), bool)
+        self.valid = np.zeros((t_len, n), bool)
+        # The time remaining at each observation (the critic's extra input when timed).
+        self.time = np.ones((t_len + 1, n), np.float32) if max_steps is not None else None
+        self.resetting = np.zeros(n, bool)  # the previous step ended: this step resets
+        self.episode_return = np.zeros(n)
+        self.episode_length = np.zeros(n, np.int64)
+
+    def collect(self, envs, model: ActorCritic, norm: RunningNorm, obs: np.ndarray):
+        """Flies the sampled policy for the rollout from obs; returns the last observation and
+        the episodes that ended. The observations are normalised with the statistics of
+        earlier rollouts (the same inputs that the update's ratios compare against); norm
+        takes in this rollout's new ones at the end."""
+        space = envs.single_action_space
+        t_len = len(self.rew)
+        ended = EndedEpisodes()
+        raw = []
+        for t in range(t_len):
+            self.obs[t] = norm(obs)
+            raw.append(obs)
+            if self.time is not None:
+                self.time[t] = 1.0 - self.episode_length / self.max_steps
+            with torch.no_grad():
+                d = model.dist(torch.as_tensor(self.obs[t]))
+                action = d.sample()
+                self.logp[t] = d.log_prob(action).sum(-1).numpy()
+            self.act[t] = action.numpy()
+            obs, reward, terminated, truncated, infos = envs.step(
+                to_env(model.to_actions(self.act[t]), space)
+            )
+            self.record(t, reward, terminated, truncated, infos, ended)
+        self.obs[t_len] = norm(obs)
+        if self.time is not None:
+            self.time[t_len] = 1.0 - self.episode_length / self.max_steps
+        norm.update(np.concatenate(raw[1:] + [obs]))
+        return obs, ended
+
+    def record(self, t: int, reward, terminated, truncated, infos, ended: EndedEpisodes) -> None:
+        """Step t's outcome: the buffers, the episodes in progress, and those that ended."""
+        valid = ~self.resetting
+        done = valid & (terminated | truncated)
+        self.rew[t], self.term[t], self.done[t], self.valid[t] = reward, terminated, done, valid
+        if self.time is not None:
+            self.term[t] |= truncated
+        self.episode_return += np.where(valid, self.rew[t], 0.0)
+        self.episode_length += valid
+        if self.reward_scale != 1.0:
+            self.rew[t] *= self.reward_scale
+        if done.any():
+            ended.success.extend(successes(terminated, truncated, infos)[done])
+            ended.returns.extend(self.episode_return[done])
+            ended.lengths.extend(self.episode_length[done])
+            self.episode_return[done] = 0.0
+            self.episode_length[done] = 0
+        self.resetting = done
+
+
+class Selection:
+    """Config.select_every: after the due updates the deterministic policy flies the
+    validation episodes, and the best policy (with its observation statistics) is kept."""
+
+    def __init__(self, cfg: Config, task: str, backend: str, updates: int) -> None:
+        self.cfg, self.task, self.backend, self.updates = cfg, task, backend, updates
+        self.active = cfg.select_every > 0
+        self.envs = make_envs(task, backend, cfg.select_episodes) if self.active else None
+        self.best = None  # (rank, update, state, obs mean, obs var) of the best validated policy
+
+    def due(self, update: int) -> bool:
+        """Every select_every updates from select_after on, and after the last update."""
+        if not self.active:
+            return False
+        every = update % self.cfg.select_every == 0 or update == self.updates
+        return every and update >= self.cfg.select_after
+
+    def validate(self, update: int, model: ActorCritic, norm: RunningNorm) -> dict | None:
+        """The validation after `update` (counted from 1) if due, else None."""
+        if not self.due(update):
+            return None
+        validation = evaluate(
+            model,
+            norm,
+            self.task,
+            self.backend,
+            self.cfg.select_episodes,
+            VALIDATION_SEED,
+            envs=self.envs,
+        )
+        # Ties go to the later update.
+        rank = (validation["success_rate"], validation["mean_return"])
+        if self.best is None or rank >= self.best[0]:
+            state = {key: v.clone() for key, v in model.state_dict().items()}
+            self.best = (rank, update, state, norm.mean.copy(), norm.var.copy())
+        return validation
+
+    def kept(self, obs_size: int, act_size: int) -> dict:
+        """The best validated policy: its model, observation statistics and record."""
+        rank, update, state, mean, var = self.best
+        model = make_model(self.cfg, obs_size, act_size)
+        model.load_state_dict(state)
+        norm = RunningNorm(obs_size)
+        norm.mean, norm.var = mean, var
+        selected = dict(
+            update=update,
+            env_steps=update * self.cfg.num_envs * self.cfg.rollout_steps,
+            validation_seed=VALIDATION_SEED,
+            validation_episodes=self.cfg.select_episodes,
+            validation_success_rate=rank[0],
+            validation_mean_return=rank[1],
+        )
+        return dict(model=model, norm=norm, selected=selected)
+
+    def close(self) -> None:
+        if self.envs is not None:
+            self.envs.close()
+
+
+def anneal_learning_rate(optimiser: torch.optim.Optimizer, cfg: Config, k: int, updates: int):
+    """Before update k (from 0): linearly from learning_rate to learning_rate * lr_end."""
+    if cfg.lr_end != 1.0:
+        fraction = k / max(updates - 1, 1)
+        for group in optimiser.param_groups:
+            group["lr"] = cfg.learning_rate * (1.0 + (cfg.lr_end - 1.0) * fraction)
+
+
+def progress_row(
+    steps: int, wall_s: float, ended: EndedEpisodes, validation: dict | None, selecting: bool
+) -> dict:
+    """One line of progress.csv: the training episodes that ended in the update's rollout,
+    and (when the run selects its policy) the validation, empty between validations."""
+    row = dict(
+        env_steps=steps,
+        wall_s=round(wall_s, 3),
+        episodes=len(ended.success),
+        success_rate=float(np.mean(ended.success)) if ended.success else float("nan"),
+        mean_return=float(np.mean(ended.returns)) if ended.returns else float("nan"),
+        mean_length=float(np.mean(ended.lengths)) if ended.lengths else float("nan"),
+    )
+    if selecting:
+        row["validation_success_rate"] = validation and validation["success_rate"]
+        row["validation_mean_return"] = validation and validation["mean_return"]
+    return row
+
+
+def progress_bar(total: int, off: bool):
+    """A tqdm bar over the env steps, or None with --no-progress-bar."""
+    if off:
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=total, unit="step", unit_scale=True)
+
+
+def show_progress(bar, steps: int, row: dict) -> None:
+    if bar is not None:
+        bar.update(steps)
+        bar.set_postfix(
+            success=f"{row['success_rate']:.2f}",
+            ret=f"{row['mean_return']:.0f}",
+            len=f"{row['mean_length']:.0f}",
+        )
+
+
 def train(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
+    """PPO on `backend` for args.timesteps env steps (whole updates): the model and
+    observation statistics (the kept ones with Config.select_every; then `last` holds the
+    last ones), the progress rows, wall seconds and env steps."""
     torch.manual_seed(args.seed)
     torch.set_num_threads(1)
     envs = make_envs(args.env, backend, cfg.num_envs)
-    space = envs.single_action_space
-    n, t_len = cfg.num_envs, cfg.rollout_steps
-    obs_size, act_size = envs.single_observation_space.shape[0], space.shape[0]
-    timed = cfg.time_limit_terminal
-    model = ActorCritic(
-        obs_size, act_size, cfg.hidden, cfg.init_log_std, cfg.action_basis, value_extra=int(timed)
-    )
-    max_steps = preset(TASKS[args.env].preset).env_kwargs.get("max_steps") if timed else None
-    if timed and not max_steps:
-        raise ValueError("time_limit_terminal needs the task's max_steps")
+    obs_size = envs.single_observation_space.shape[0]
+    act_size = envs.single_action_space.shape[0]
+    model = make_model(cfg, obs_size, act_size)
+    max_steps = time_limit(cfg, args.env)
     optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate, eps=1e-5)
     norm = RunningNorm(obs_size)
     rng = np.random.default_rng(args.seed)
-
-    obs_buf = np.zeros((t_len + 1, n, obs_size), np.float32)
-    act_buf = np.zeros((t_len, n, act_size), np.float32)
-    logp_buf = np.zeros((t_len, n), np.float32)
-    rew_buf = np.zeros((t_len, n), np.float32)
-    term_buf = np.zeros((t_len, n), bool)
-    done_buf = np.zeros((t_len, n), bool)
-    valid_buf = np.zeros((t_len, n), bool)
-    # The time remaining at each observation (the critic's extra input when timed).
-    time_buf = np.ones((t_len + 1, n), np.float32) if timed else None
+    rollout = Rollout(cfg, obs_size, act_size, max_steps)
 
     obs, _ = envs.reset(seed=args.seed)
     norm.update(obs)
-    resetting = np.zeros(n, bool)  # the previous step ended: this step resets (NEXT_STEP)
-    episode_return = np.zeros(n)
-    episode_length = np.zeros(n, np.int64)
     rows: list[dict] = []
     steps, start = 0, time.perf_counter()
-    updates = -(-args.timesteps // (n * t_len))
-    bar = None
-    if not args.no_progress_bar:
-        from tqdm import tqdm
-
-        bar = tqdm(total=updates * n * t_len, unit="step", unit_scale=True)
-    selecting = cfg.select_every > 0
-    validation_envs = make_envs(args.env, backend, cfg.select_episodes) if selecting else None
-    best = None  # (rank, update, state, obs mean, obs var) of the best validated policy
+    per_update = cfg.num_envs * cfg.rollout_steps
+    updates = -(-args.timesteps // per_update)
+    bar = progress_bar(updates * per_update, args.no_progress_bar)
+    selection = Selection(cfg, args.env, backend, updates)
     try:
         for k in range(updates):
-            if cfg.lr_end != 1.0:
-                fraction = k / max(updates - 1, 1)
-                for group in optimiser.param_groups:
-                    group["lr"] = cfg.learning_rate * (1.0 + (cfg.lr_end - 1.0) * fraction)
-            ended_success, ended_return, ended_length = [], [], []
-            raw = []
-            for t in range(t_len):
-                # Normalised with the statistics of earlier rollouts: the same inputs that
-                # the update's ratios compare against.
-                obs_buf[t] = norm(obs)
-                raw.append(obs)
-                if timed:
-                    time_buf[t] = 1.0 - episode_length / max_steps
-                with torch.no_grad():
-                    d = model.dist(torch.as_tensor(obs_buf[t]))
-                    action = d.sample()
-                    logp_buf[t] = d.log_prob(action).sum(-1).numpy()
-                act_buf[t] = action.numpy()
-                obs, reward, terminated, truncated, infos = envs.step(
-                    to_env(model.to_actions(act_buf[t]), space)
-                )
-                valid = ~resetting
-                done = valid & (terminated | truncated)
-                rew_buf[t], term_buf[t], done_buf[t], valid_buf[t] = reward, terminated, done, valid
-                if timed:
-                    term_buf[t] |= truncated
-                episode_return += np.where(valid, rew_buf[t], 0.0)
-                episode_length += valid
-                if cfg.reward_scale != 1.0:
-                    rew_buf[t] *= cfg.reward_scale
-                if done.any():
-                    ended_success.extend(successes(terminated, truncated, infos)[done])
-                    ended_return.extend(episode_return[done])
-                    ended_length.extend(episode_length[done])
-                    episode_return[done] = 0.0
-                    episode_length[done] = 0
-                resetting = done
-            obs_buf[t_len] = norm(obs)
-            if timed:
-                time_buf[t_len] = 1.0 - episode_length / max_steps
-            steps += n * t_len
-            norm.update(np.concatenate(raw[1:] + [obs]))
-            update(
-                model,
-                optimiser,
-                cfg,
-                obs_buf,
-                act_buf,
-                logp_buf,
-                rew_buf,
-                term_buf,
-                done_buf,
-                valid_buf,
-                rng,
-                time_buf,
-            )
-            validation = None
-            due = (k + 1) % cfg.select_every == 0 or k + 1 == updates if selecting else False
-            if due and k + 1 >= cfg.select_after:
-                validation = evaluate(
-                    model,
-                    norm,
-                    args.env,
-                    backend,
-                    cfg.select_episodes,
-                    VALIDATION_SEED,
-                    envs=validation_envs,
-                )
-                rank = (validation["success_rate"], validation["mean_return"])
-                if best is None or rank >= best[0]:
-                    state = {key: v.clone() for key, v in model.state_dict().items()}
-                    best = (rank, k + 1, state, norm.mean.copy(), norm.var.copy())
-            row = dict(
-                env_steps=steps,
-                wall_s=round(time.perf_counter() - start, 3),
-                episodes=len(ended_success),
-                success_rate=float(np.mean(ended_success)) if ended_success else float("nan"),
-                mean_return=float(np.mean(ended_return)) if ended_return else float("nan"),
-                mean_length=float(np.mean(ended_length)) if ended_length else float("nan"),
-            )
-            if selecting:
-                # Empty (None) between validations.
-                row["validation_success_rate"] = validation and validation["success_rate"]
-                row["validation_mean_return"] = validation and validation["mean_return"]
-            rows.append(row)
-            if bar is not None:
-                bar.update(n * t_len)
-                bar.set_postfix(
-                    success=f"{row['success_rate']:.2f}",
-                    ret=f"{row['mean_return']:.0f}",
-                    len=f"{row['mean_length']:.0f}",
-                )
+            anneal_learning_rate(optimiser, cfg, k, updates)
+            obs, ended = rollout.collect(envs, model, norm, obs)
+            steps += per_update
+            update(model, optimiser, cfg, rollout, rng)
+            validation = selection.validate(k + 1, model, norm)
+            wall = time.perf_counter() - start
+            rows.append(progress_row(steps, wall, ended, validation, selection.active))
+            show_progress(bar, per_update, rows[-1])
     finally:
         if bar is not None:
             bar.close()
         envs.close()
-        if validation_envs is not None:
-            validation_envs.close()
+        selection.close()
     wall = time.perf_counter() - start
     run = dict(model=model, norm=norm, rows=rows, wall_s=wall, steps=steps, selected=None)
-    if best is not None:
-        rank, update_index, state, mean, var = best
-        last = (model, norm)
-        model = ActorCritic(
-            obs_size, act_size, cfg.hidden, cfg.init_log_std, cfg.action_basis, int(timed)
-        )
-        model.load_state_dict(state)
-        norm = RunningNorm(obs_size)
-        norm.mean, norm.var = mean, var
-        run.update(model=model, norm=norm, last=last)
-        run["selected"] = dict(
-            update=update_index,
-            env_steps=update_index * n * t_len,
-            validation_seed=VALIDATION_SEED,
-            validation_episodes=cfg.select_episodes,
-            validation_success_rate=rank[0],
-            validation_mean_return=rank[1],
-        )
+    if selection.best is not None:
+        run.update(selection.kept(obs_size, act_size), last=(model, norm))
     return run
 
 
-def update(
-    model,
-    optimiser,
-    cfg,
-    obs_buf,
-    act_buf,
-    logp_buf,
-    rew_buf,
-    term_buf,
-    done_buf,
-    valid_buf,
-    rng,
-    time_buf=None,
-) -> None:
+def update(model, optimiser, cfg: Config, rollout: Rollout, rng) -> None:
     """GAE over the rollout (episode ends break the chain; a truncation bootstraps from its
     final observation, which NEXT_STEP autoreset hands over on the ending step, unless
-    term_buf marks it terminal), then PPO's clipped objective over minibatches of the valid
-    transitions. time_buf (the time remaining per observation) is the critic's extra input."""
+    rollout.term marks it terminal), then PPO's clipped objective over minibatches of the
+    valid transitions. rollout.time (the time remaining per observation) is the critic's
+    extra input."""
+    obs_buf, act_buf, logp_buf, rew_buf = rollout.obs, rollout.act, rollout.logp, rollout.rew
+    term_buf, done_buf, valid_buf, time_buf = (
+        rollout.term,
+        rollout.done,
+        rollout.valid,
+        rollout.time,
+    )
     t_len, n = rew_buf.shape
     critic_buf = obs_buf if time_buf is None else np.concatenate([obs_buf, time_buf[..., None]], -1)
     with torch.no_grad():
@@ -577,30 +660,11 @@ def plot(runs: dict[str, list[dict]], path: Path, title: str) -> None:
     fig.savefig(path, dpi=100)
 
 
-def run_one(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
-    """Trains and evaluates on one backend; writes its folder; returns its summary."""
-    cpu_start = time.process_time()
-    run = train(args, backend, cfg)
-    cpu = time.process_time() - cpu_start
-    result = evaluate(run["model"], run["norm"], args.env, backend, args.eval_episodes)
-    selected = run["selected"]
-    if selected is not None:
-        # What keeping the best policy gained: the last policy on the same held-out episodes.
-        selected["last_policy_evaluation"] = evaluate(
-            *run["last"], args.env, backend, args.eval_episodes
-        )
+def summarise(args: argparse.Namespace, backend: str, cfg: Config, run: dict, cpu: float) -> dict:
+    """summary.json without the held-out evaluation: the run's settings and figures."""
     rows, wall, steps = run["rows"], run["wall_s"], run["steps"]
-    first = next((r for r in rows if r["success_rate"] >= 0.9), None)
-    out = args.out / backend
-    out.mkdir(parents=True, exist_ok=True)
-    with open(out / "progress.csv", "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows(rows)
-    state = {"model": run["model"].state_dict(), "obs_mean": run["norm"].mean}
-    torch.save({**state, "obs_var": run["norm"].var}, out / "policy.pt")
     p = preset(TASKS[args.env].preset)
-    summary = dict(
+    return dict(
         env=p.name,
         env_id=p.env_id,
         env_kwargs=dict(p.env_kwargs),
@@ -616,18 +680,36 @@ def run_one(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
         # This process's CPU seconds while training (learner and env threads).
         cpu_time_s=cpu,
         env_steps_per_s=steps / wall,
-        first_update_at_90_percent=first,
+        first_update_at_90_percent=next((r for r in rows if r["success_rate"] >= 0.9), None),
         last_training_success_rate=rows[-1]["success_rate"],
         # The policy kept (Config.select_every), or None: the last one.
-        selected_policy=selected,
-        evaluation=result,
-        rows=rows,
+        selected_policy=run["selected"],
     )
+
+
+def save(out: Path, run: dict, summary: dict) -> None:
+    """The backend's folder: progress.csv, policy.pt and summary.json."""
+    rows = run["rows"]
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / "progress.csv", "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    state = {"model": run["model"].state_dict(), "obs_mean": run["norm"].mean}
+    torch.save({**state, "obs_var": run["norm"].var}, out / "policy.pt")
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-    name = p.env_id.split("/")[-1]
+
+
+def report(task: str, summary: dict) -> None:
+    """The run in a few lines on stdout."""
+    steps, wall, cpu = summary["env_steps"], summary["wall_time_s"], summary["cpu_time_s"]
+    first, selected = summary["first_update_at_90_percent"], summary["selected_policy"]
+    result = summary["evaluation"]
+    name = summary["env_id"].split("/")[-1]
     print(
-        f"PPO on {name} ({args.env}, {backend}, {cfg.num_envs} envs): {steps:,} env steps in "
-        f"{wall:.1f} s, {cpu:.1f} s CPU ({steps / wall:,.0f} env steps/s incl. learning)"
+        f"PPO on {name} ({task}, {summary['backend']}, {summary['config']['num_envs']} envs): "
+        f"{steps:,} env steps in {wall:.1f} s, {cpu:.1f} s CPU ({steps / wall:,.0f} env steps/s "
+        "incl. learning)"
     )
     if first is not None:
         print(
@@ -647,6 +729,23 @@ def run_one(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
         f"  held-out evaluation ({result['episodes']} episodes, seeds {result['seed']}..): "
         f"success {100 * result['success_rate']:.1f} %, mean return {result['mean_return']:.1f}"
     )
+
+
+def run_one(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
+    """Trains and evaluates on one backend; writes its folder; returns its summary."""
+    cpu_start = time.process_time()
+    run = train(args, backend, cfg)
+    cpu = time.process_time() - cpu_start
+    result = evaluate(run["model"], run["norm"], args.env, backend, args.eval_episodes)
+    if run["selected"] is not None:
+        # What keeping the best policy gained: the last policy on the same held-out episodes.
+        run["selected"]["last_policy_evaluation"] = evaluate(
+            *run["last"], args.env, backend, args.eval_episodes
+        )
+    summary = summarise(args, backend, cfg, run, cpu)
+    summary.update(evaluation=result, rows=run["rows"])
+    save(args.out / backend, run, summary)
+    report(args.env, summary)
     return summary
 
 

@@ -235,6 +235,22 @@ class FrameSink:
         return self._data.reshape(self.n_rows, self.n_arrays * FRAME_ARRAY_LEN)
 
 
+def _frame_bounds(data: bytes, at: int, end: int) -> tuple[int, int, int]:
+    """The MAVLink 2 frame starting at byte `at`: its payload length, where its payload
+    stops and where the frame (checksum and signature included) ends."""
+    if data[at] != STX_V2:
+        raise ProtocolError(f"byte {at} of a datagram is {data[at]:#x}, not MAVLink 2")
+    if at + HEADER_LEN + CHECKSUM_LEN > end:
+        raise ProtocolError("a datagram ends inside a MAVLink header")
+    plen = data[at + 1]
+    signed = data[at + 2] & 0x01
+    stop = at + HEADER_LEN + plen
+    total = stop + CHECKSUM_LEN + (SIGNATURE_LEN if signed else 0)
+    if total > end:
+        raise ProtocolError("a datagram ends inside a MAVLink frame")
+    return plen, stop, total
+
+
 class Decoder:
     """Splits datagrams into MAVLink 2 frames and decodes them."""
 
@@ -248,58 +264,16 @@ class Decoder:
         at, end = 0, len(data)
         view = memoryview(data)
         while at < end:
-            if data[at] != STX_V2:
-                raise ProtocolError(f"byte {at} of a datagram is {data[at]:#x}, not MAVLink 2")
-            if at + HEADER_LEN + CHECKSUM_LEN > end:
-                raise ProtocolError("a datagram ends inside a MAVLink header")
-            plen = data[at + 1]
-            signed = data[at + 2] & 0x01
-            stop = at + HEADER_LEN + plen
-            total = stop + CHECKSUM_LEN + (SIGNATURE_LEN if signed else 0)
-            if total > end:
-                raise ProtocolError("a datagram ends inside a MAVLink frame")
+            plen, stop, total = _frame_bounds(data, at, end)
             msg_id = data[at + 7] | (data[at + 8] << 8) | (data[at + 9] << 16)
-            if msg_id == FRAME_ID and sink is not None:
+            if msg_id == FRAME_ID:
                 crc = data[stop] | (data[stop + 1] << 8)
                 if crc16(view[at + 1 : stop], FRAME_CRC_EXTRA) != crc:
                     raise ProtocolError("a task frame fails its CRC")
-                row = sink.rows.get(data[at + 5])
-                # array_id (payload bytes 8-9) is never 0, so MAVLink 2 never truncates it.
-                k = (data[at + 18] | (data[at + 19] << 8)) - 1 if plen >= 10 else -1
-                if not 0 <= k < sink.n_arrays:
-                    row = None
-                if row is not None:
-                    t = int.from_bytes(data[at + HEADER_LEN : at + HEADER_LEN + 8], "little")
-                    # The episode step, value 3 (payload bytes 32-35; absent when truncated).
-                    zero = plen < 36 or not any(data[at + HEADER_LEN + 32 : at + HEADER_LEN + 36])
-                    if not sink.accepts(row, t, k == 0, zero):
-                        sink.stale += 1
-                        row = None
-                if row is not None:
-                    slot = row * sink.n_arrays + k
-                    off = slot * _FRAME_PAYLOAD
-                    sink.raw[off : off + plen] = view[at + HEADER_LEN : stop]
-                    if plen < _FRAME_PAYLOAD:
-                        sink.raw[off + plen : off + _FRAME_PAYLOAD] = self._zeros[plen:]
-                    if not sink.have[slot]:
-                        sink.have[slot] = 1
-                        sink.count += 1
-            elif msg_id == FRAME_ID:
-                crc = data[stop] | (data[stop + 1] << 8)
-                if crc16(data[at + 1 : stop], FRAME_CRC_EXTRA) != crc:
-                    raise ProtocolError("a task frame fails its CRC")
-                payload = data[at + HEADER_LEN : stop]
-                if plen < _FRAME_PAYLOAD:
-                    payload = payload + self._zeros[plen:]
-                system_id = data[at + 5]
-                array_id = payload[8] | (payload[9] << 8)
-                values = np.frombuffer(payload, "<f4", FRAME_ARRAY_LEN, _FRAME_DATA_OFFSET)
-                out.arrays[(system_id, array_id)] = values
-                if array_id == 1:
-                    out.times[system_id] = int.from_bytes(payload[:8], "little")
-                    out.names[system_id] = (
-                        payload[10:20].split(b"\0", 1)[0].decode(errors="replace")
-                    )
+                if sink is not None:
+                    self._to_sink(sink, data, at, plen)
+                else:
+                    self._to_arrays(out, data, at, plen)
             else:
                 try:
                     out.messages.append(self._mav.decode(bytearray(data[at:total])))
@@ -307,3 +281,42 @@ class Decoder:
                     raise ProtocolError(f"message {msg_id} does not decode: {exc}") from exc
             at = total
         return out
+
+    def _to_sink(self, sink: FrameSink, data: bytes, at: int, plen: int) -> None:
+        """The step path: the task frame at `at` into its vehicle's row of `sink`, unless it
+        is another vehicle's, beyond the sink's arrays, or stale (see FrameSink.accepts)."""
+        row = sink.rows.get(data[at + 5])
+        # array_id (payload bytes 8-9) is never 0, so MAVLink 2 never truncates it.
+        k = (data[at + 18] | (data[at + 19] << 8)) - 1 if plen >= 10 else -1
+        if row is None or not 0 <= k < sink.n_arrays:
+            return
+        start = at + HEADER_LEN
+        t = int.from_bytes(data[start : start + 8], "little")
+        # The episode step, value 3 (payload bytes 32-35; absent when truncated).
+        zero = plen < 36 or not any(data[start + 32 : start + 36])
+        if not sink.accepts(row, t, k == 0, zero):
+            sink.stale += 1
+            return
+        slot = row * sink.n_arrays + k
+        off = slot * _FRAME_PAYLOAD
+        sink.raw[off : off + plen] = memoryview(data)[start : start + plen]
+        if plen < _FRAME_PAYLOAD:
+            # MAVLink 2 cut the payload's trailing zeros.
+            sink.raw[off + plen : off + _FRAME_PAYLOAD] = self._zeros[plen:]
+        if not sink.have[slot]:
+            sink.have[slot] = 1
+            sink.count += 1
+
+    def _to_arrays(self, out: Datagram, data: bytes, at: int, plen: int) -> None:
+        """The task frame at `at` into `out.arrays` (and, for a frame's first array, the
+        vehicle's time and task name into `out.times` and `out.names`)."""
+        payload = data[at + HEADER_LEN : at + HEADER_LEN + plen]
+        if plen < _FRAME_PAYLOAD:
+            payload = payload + self._zeros[plen:]
+        system_id = data[at + 5]
+        array_id = payload[8] | (payload[9] << 8)
+        values = np.frombuffer(payload, "<f4", FRAME_ARRAY_LEN, _FRAME_DATA_OFFSET)
+        out.arrays[(system_id, array_id)] = values
+        if array_id == 1:
+            out.times[system_id] = int.from_bytes(payload[:8], "little")
+            out.names[system_id] = payload[10:20].split(b"\0", 1)[0].decode(errors="replace")

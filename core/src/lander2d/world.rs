@@ -28,44 +28,77 @@ pub(crate) fn build(
     platform_x: f64,
     platform_vx: f64,
 ) -> (PhysicsWorld, Handles) {
+    let mut world = empty_world(p);
+    // The insertion order fixes the handles, and with them the order in which rapier
+    // visits the pairs: every trajectory depends on it.
+    let ground_collider = insert_ground(&mut world, p);
+    let (platform, platform_collider) = insert_platform(&mut world, p, platform_x, platform_vx);
+    let (drone, drone_parts) = insert_drone(&mut world, p, drone);
+    let handles = Handles {
+        drone,
+        drone_parts,
+        platform,
+        platform_collider,
+        ground_collider,
+    };
+    (world, handles)
+}
+
+/// The world's gravity and integration settings, with nothing in it yet.
+fn empty_world(p: &Lander2dParams) -> PhysicsWorld {
     let mut world = PhysicsWorld::new();
     world.gravity = Vector::new(0.0, -p.gravity);
     world.integration_parameters.dt = p.physics_step;
     // Recycled contacts may be up to 5 cm stale; touch-down classification needs fresh ones,
     // and with six candidate pairs the full update costs next to nothing.
     world.integration_parameters.contact_recycling = false;
+    world
+}
 
-    // Product combination, as in Chipmunk: the pad's 1.0 and the ground's 0.8 apply unchanged
-    // against the drone's default 1.0.
-    let material = |b: ColliderBuilder, friction: f64| {
-        b.friction(friction)
-            .friction_combine_rule(CoefficientCombineRule::Multiply)
-            .restitution(0.0)
-    };
+/// Product combination, as in Chipmunk: the pad's 1.0 and the ground's 0.8 apply unchanged
+/// against the drone's default 1.0.
+fn material(b: ColliderBuilder, friction: f64) -> ColliderBuilder {
+    b.friction(friction)
+        .friction_combine_rule(CoefficientCombineRule::Multiply)
+        .restitution(0.0)
+}
 
-    // A thick box rather than the reference's line: nothing tunnels through it.
+/// The ground: a thick box rather than the reference's line, so nothing tunnels through it.
+fn insert_ground(world: &mut PhysicsWorld, p: &Lander2dParams) -> ColliderHandle {
     let ground = material(
         ColliderBuilder::cuboid(p.world_width, 0.5)
             .translation(Vector::new(p.world_width / 2.0, p.ground_height - 0.5)),
         p.ground_friction,
     );
-    let ground_collider = world.insert_collider(ground, None);
+    world.insert_collider(ground, None)
+}
 
-    let platform_body = if p.moving_platform {
-        RigidBodyBuilder::kinematic_velocity_based().linvel(Vector::new(platform_vx, 0.0))
+/// The landing platform, fixed or (moving platform) kinematic at `vx`, centred at `x`.
+fn insert_platform(
+    world: &mut PhysicsWorld,
+    p: &Lander2dParams,
+    x: f64,
+    vx: f64,
+) -> (RigidBodyHandle, ColliderHandle) {
+    let body = if p.moving_platform {
+        RigidBodyBuilder::kinematic_velocity_based().linvel(Vector::new(vx, 0.0))
     } else {
         RigidBodyBuilder::fixed()
     };
-    let platform_body = platform_body.translation(Vector::new(
-        platform_x,
-        p.ground_height + p.platform_height / 2.0,
-    ));
-    let platform_shape = material(
+    let body = body.translation(Vector::new(x, p.ground_height + p.platform_height / 2.0));
+    let shape = material(
         ColliderBuilder::cuboid(p.platform_width / 2.0, p.platform_height / 2.0),
         p.platform_friction,
     );
-    let (platform, platform_collider) = world.insert(platform_body, platform_shape);
+    world.insert(body, shape)
+}
 
+/// The drone: one dynamic body in `drone` state, then its frame, left and right motor.
+fn insert_drone(
+    world: &mut PhysicsWorld,
+    p: &Lander2dParams,
+    drone: &FreeBody,
+) -> (RigidBodyHandle, [ColliderHandle; 3]) {
     let g = DroneGeometry::of(p);
     let [x, y] = drone.translation;
     let pose = Pose::from_parts(Vector::new(x, y), drone.rotation());
@@ -77,35 +110,16 @@ pub(crate) fn build(
         .can_sleep(false)
         .ccd_enabled(true);
     let drone_body = world.insert_body(body);
-    let part = |hx: f64, hy: f64, x: f64, mass: f64| {
-        material(
-            ColliderBuilder::cuboid(hx, hy)
-                .translation(Vector::new(x, 0.0))
-                .mass(mass),
-            p.drone_friction,
-        )
+    let mut part = |hx: f64, hy: f64, x: f64, mass: f64| {
+        let shape = ColliderBuilder::cuboid(hx, hy)
+            .translation(Vector::new(x, 0.0))
+            .mass(mass);
+        world.insert_collider(material(shape, p.drone_friction), Some(drone_body))
     };
-    let frame = world.insert_collider(
-        part(g.frame_half.0, g.frame_half.1, 0.0, g.frame_mass),
-        Some(drone_body),
-    );
-    let left = world.insert_collider(
-        part(g.motor_half, g.motor_half, -g.motor_x, g.motor_mass),
-        Some(drone_body),
-    );
-    let right = world.insert_collider(
-        part(g.motor_half, g.motor_half, g.motor_x, g.motor_mass),
-        Some(drone_body),
-    );
-
-    let handles = Handles {
-        drone: drone_body,
-        drone_parts: [frame, left, right],
-        platform,
-        platform_collider,
-        ground_collider,
-    };
-    (world, handles)
+    let frame = part(g.frame_half.0, g.frame_half.1, 0.0, g.frame_mass);
+    let left = part(g.motor_half, g.motor_half, -g.motor_x, g.motor_mass);
+    let right = part(g.motor_half, g.motor_half, g.motor_x, g.motor_mass);
+    (drone_body, [frame, left, right])
 }
 
 impl Handles {
