@@ -172,16 +172,40 @@ fn rates(
     command: &[f64; 4],
     wind: &Vector3<f64>,
 ) -> Flat {
+    let (m0, m1, m2, m3) = (x[13], x[14], x[15], x[16]);
+    // T_i = k m_i².
+    let squares = [m0 * m0, m1 * m1, m2 * m2, m3 * m3];
+    let [ax, ay, az] = acceleration(c, x, &squares, wind);
+    let [alpha_x, alpha_y, alpha_z] = angular_acceleration(p, c, x, &squares);
+    let [dqw, dqx, dqy, dqz] = attitude_rate(x);
+    [
+        x[3],
+        x[4],
+        x[5],
+        ax,
+        ay,
+        az,
+        dqw,
+        dqx,
+        dqy,
+        dqz,
+        alpha_x,
+        alpha_y,
+        alpha_z,
+        (command[0] - m0) * c.inv_tau,
+        (command[1] - m1) * c.inv_tau,
+        (command[2] - m2) * c.inv_tau,
+        (command[3] - m3) * c.inv_tau,
+    ]
+}
+
+/// Acceleration (world) of a flat state with squared motor states `squares`: thrust along
+/// body z, gravity, quadratic drag on the air-relative velocity.
+#[inline(always)]
+fn acceleration(c: &Coefficients, x: &Flat, squares: &[f64; 4], wind: &Vector3<f64>) -> [f64; 3] {
     let (vx, vy, vz) = (x[3], x[4], x[5]);
     let (qw, qx, qy, qz) = (x[6], x[7], x[8], x[9]);
-    let (wx, wy, wz) = (x[10], x[11], x[12]);
-    let (m0, m1, m2, m3) = (x[13], x[14], x[15], x[16]);
-    // T_i = k m_i²; the sums below are r × F and the spin reaction written out for the
-    // quad-X signs of ROTOR_POSITION and ROTOR_SPIN (a test checks them against the tables).
-    let (s0, s1, s2, s3) = (m0 * m0, m1 * m1, m2 * m2, m3 * m3);
-
-    // Forces (world) per unit mass: thrust along body z, gravity, quadratic drag on the
-    // air-relative velocity.
+    let [s0, s1, s2, s3] = *squares;
     let thrust = c.thrust_per_mass * ((s0 + s1) + (s2 + s3));
     let (bx, by, bz) = (
         2.0 * (qx * qz + qw * qy),
@@ -190,49 +214,56 @@ fn rates(
     );
     let (rx, ry, rz) = (vx - wind.x, vy - wind.y, vz - wind.z);
     let drag = -c.drag_per_mass * (rx * rx + ry * ry + rz * rz).sqrt();
-    let ax = bx * thrust + rx * drag;
-    let ay = by * thrust + ry * drag;
-    let az = bz * thrust + rz * drag - c.gravity;
+    [
+        bx * thrust + rx * drag,
+        by * thrust + ry * drag,
+        bz * thrust + rz * drag - c.gravity,
+    ]
+}
 
-    // Torques (body): rotors, damping, optional pendulum; Euler's equation with the
-    // gyroscopic term ω × Iω.
+/// Angular acceleration (body) of a flat state with squared motor states `squares`: rotors,
+/// damping, optional pendulum; Euler's equation with the gyroscopic term ω × Iω.
+#[inline(always)]
+fn angular_acceleration(
+    p: &QuadrotorParams,
+    c: &Coefficients,
+    x: &Flat,
+    squares: &[f64; 4],
+) -> [f64; 3] {
+    let (wx, wy, wz) = (x[10], x[11], x[12]);
+    // The rotor sums are r × F and the spin reaction written out for the quad-X signs of
+    // ROTOR_POSITION and ROTOR_SPIN (a test checks them against the tables).
+    let [s0, s1, s2, s3] = *squares;
     let damping = p.angular_damping_linear
         + p.angular_damping_quadratic * (wx * wx + wy * wy + wz * wz).sqrt();
     let mut tx = c.roll_pitch * ((s1 + s2) - (s0 + s3)) - damping * wx;
     let mut ty = c.roll_pitch * ((s1 + s3) - (s0 + s2)) - damping * wy;
     let tz = c.yaw * ((s2 + s3) - (s0 + s1)) - damping * wz;
     if p.pendulum_coefficient != 0.0 {
-        let attitude = UnitQuaternion::new_unchecked(Quaternion::new(qw, qx, qy, qz));
+        let attitude = UnitQuaternion::new_unchecked(Quaternion::new(x[6], x[7], x[8], x[9]));
         let (roll, pitch, _) = attitude.euler_angles();
         let restoring = p.pendulum_coefficient * p.mass * p.gravity;
         tx -= restoring * roll.sin();
         ty -= restoring * pitch.sin();
     }
     let (ix, iy, iz) = (c.inertia.x * wx, c.inertia.y * wy, c.inertia.z * wz);
-    let alpha_x = (tx - (wy * iz - wz * iy)) * c.inv_inertia.x;
-    let alpha_y = (ty - (wz * ix - wx * iz)) * c.inv_inertia.y;
-    let alpha_z = (tz - (wx * iy - wy * ix)) * c.inv_inertia.z;
-
-    // q̇ = ½ q ⊗ (0, ω).
-    let (hx, hy, hz) = (0.5 * wx, 0.5 * wy, 0.5 * wz);
     [
-        vx,
-        vy,
-        vz,
-        ax,
-        ay,
-        az,
+        (tx - (wy * iz - wz * iy)) * c.inv_inertia.x,
+        (ty - (wz * ix - wx * iz)) * c.inv_inertia.y,
+        (tz - (wx * iy - wy * ix)) * c.inv_inertia.z,
+    ]
+}
+
+/// q̇ = ½ q ⊗ (0, ω) of a flat state.
+#[inline(always)]
+fn attitude_rate(x: &Flat) -> [f64; 4] {
+    let (qw, qx, qy, qz) = (x[6], x[7], x[8], x[9]);
+    let (hx, hy, hz) = (0.5 * x[10], 0.5 * x[11], 0.5 * x[12]);
+    [
         -(qx * hx + qy * hy + qz * hz),
         qw * hx + qy * hz - qz * hy,
         qw * hy + qz * hx - qx * hz,
         qw * hz + qx * hy - qy * hx,
-        alpha_x,
-        alpha_y,
-        alpha_z,
-        (command[0] - m0) * c.inv_tau,
-        (command[1] - m1) * c.inv_tau,
-        (command[2] - m2) * c.inv_tau,
-        (command[3] - m3) * c.inv_tau,
     ]
 }
 
