@@ -138,6 +138,46 @@ fn split<'a>(mut rows: Rows<'a>, sizes: Sizes<'_>, parts: usize) -> Vec<Rows<'a>
     out
 }
 
+/// Runs every env of `rows`: over `pool` in up to `threads` contiguous chunks of (nearly) equal
+/// size, no more chunks than [`MIN_ENVS_PER_THREAD`] envs each allow, when there are envs for
+/// two; in the calling thread otherwise.
+fn run_all(
+    rows: Rows<'_>,
+    sizes: Sizes<'_>,
+    pool: Option<&rayon::ThreadPool>,
+    threads: usize,
+) -> Result<(), String> {
+    let n = rows.envs.len();
+    match pool {
+        Some(pool) if n >= MIN_ENVS_PER_THREAD * 2 => {
+            let parts = threads.min(n / MIN_ENVS_PER_THREAD).max(1);
+            let chunks = split(rows, sizes, parts);
+            pool.install(|| {
+                chunks
+                    .into_par_iter()
+                    .try_for_each(|rows| run_rows(rows, sizes))
+            })
+        }
+        _ => run_rows(rows, sizes),
+    }
+}
+
+/// ValueError naming the first non-finite action of an env that is not reset.
+fn refuse_non_finite(actions: &[f32], reset: &[bool], n_act: usize) -> PyResult<()> {
+    for (i, row) in actions.chunks_exact(n_act.max(1)).enumerate() {
+        if reset[i] {
+            continue;
+        }
+        if let Some(j) = row.iter().position(|a| !a.is_finite()) {
+            return Err(PyValueError::new_err(format!(
+                "actions[{i}, {j}] = {}: actions must be finite; step refused",
+                row[j]
+            )));
+        }
+    }
+    Ok(())
+}
+
 fn shape_error(what: &str, expected: &[usize], got: &[usize]) -> PyErr {
     PyValueError::new_err(format!("{what} must have shape {expected:?}, got {got:?}"))
 }
@@ -360,17 +400,7 @@ impl Batch {
         let terminated = mut_of1("terminated", &mut terminated, n)?;
         let truncated = mut_of1("truncated", &mut truncated, n)?;
         // Refuse before anything moves: a bad row must not leave the others stepped.
-        for (i, row) in actions.chunks_exact(n_act.max(1)).enumerate() {
-            if reset[i] {
-                continue;
-            }
-            if let Some(j) = row.iter().position(|a| !a.is_finite()) {
-                return Err(PyValueError::new_err(format!(
-                    "actions[{i}, {j}] = {}: actions must be finite; step refused",
-                    row[j]
-                )));
-            }
-        }
+        refuse_non_finite(actions, reset, n_act)?;
         let sizes = Sizes {
             n_act,
             n_obs: self.n_obs,
@@ -391,19 +421,8 @@ impl Batch {
         };
         let pool = self.pool.as_ref();
         let threads = self.num_threads;
-        let result = py.detach(move || match pool {
-            Some(pool) if n >= MIN_ENVS_PER_THREAD * 2 => {
-                let parts = threads.min(n / MIN_ENVS_PER_THREAD).max(1);
-                let chunks = split(rows, sizes, parts);
-                pool.install(|| {
-                    chunks
-                        .into_par_iter()
-                        .try_for_each(|rows| run_rows(rows, sizes))
-                })
-            }
-            _ => run_rows(rows, sizes),
-        });
-        result.map_err(|e| PyRuntimeError::new_err(format!("step failed: {e}")))
+        py.detach(move || run_all(rows, sizes, pool, threads))
+            .map_err(|e| PyRuntimeError::new_err(format!("step failed: {e}")))
     }
 
     /// Single env: starts a new episode of env 0 with `seed`; returns (observation, info).
