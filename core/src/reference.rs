@@ -12,9 +12,26 @@ use crate::tasks::flight::FlightParams;
 use crate::tasks::landing::LandingParams;
 use crate::tasks::waypoints::WaypointParams;
 
+/// The reference's title and what it is.
+const INTRO: &str = "# Parameter reference\n\n\
+     Generated from the parameter tables in `core/` by\n\
+     `cargo run -p flyloop-core --example parameter_reference > docs/parameters.md`;\n\
+     a test fails when this file and the code disagree. Every value is checked against\n\
+     its range when set (from TOML/JSON, over MAVLink, through the FMU), and the error\n\
+     names the parameter and the bound it broke.\n";
+
 /// The whole reference as markdown.
 pub fn parameter_reference() -> String {
-    let sections = [
+    let mut out = String::from(INTRO);
+    for (title, text, table) in sections() {
+        out.push_str(&format!("\n## {title}\n\n{text}\n\n{table}"));
+    }
+    out
+}
+
+/// Every parameter table in the reference's order: (title, what it holds, markdown table).
+fn sections() -> [(&'static str, &'static str, String); 9] {
+    [
         (
             "Quadrotor model (`QuadrotorParams`)",
             "Physical parameters of the 3D quadrotor (world ENU, body FLU, PX4 quad-X).",
@@ -60,17 +77,5 @@ pub fn parameter_reference() -> String {
             "Episode settings of Lander2D (seed 000's arguments).",
             LandingParams::markdown_table(),
         ),
-    ];
-    let mut out = String::from(
-        "# Parameter reference\n\n\
-         Generated from the parameter tables in `core/` by\n\
-         `cargo run -p flyloop-core --example parameter_reference > docs/parameters.md`;\n\
-         a test fails when this file and the code disagree. Every value is checked against\n\
-         its range when set (from TOML/JSON, over MAVLink, through the FMU), and the error\n\
-         names the parameter and the bound it broke.\n",
-    );
-    for (title, text, table) in sections {
-        out.push_str(&format!("\n## {title}\n\n{text}\n\n{table}"));
-    }
-    out
+    ]
 }
