@@ -187,7 +187,20 @@ def overlay(p: Painter, plane: PlaneView, s: LanderScene) -> None:
 
 def world(p: Painter, plane: PlaneView, s: LanderScene, poses, path, spawn=False, close_up=False):
     """The world back to front; a close-up has longer thrust bars and no distance label."""
-    # Grey outside the world, a sky gradient (by altitude) inside it.
+    backdrop(p, plane, s, spawn)
+    for x, y, angle in poses:
+        for part in _drone_parts(s, x, y, angle):
+            p.translucent_polygon(plane.to_screen(part), SHADE, 95)
+    if len(path) >= 2:
+        p.polyline(plane.to_screen(path), PATH, 1)
+    platform(p, plane, s)
+    sensor_line(p, plane, s, label=not close_up)
+    drone(p, plane, s, 70 if close_up else THRUST_BAR_PX)
+
+
+def backdrop(p: Painter, plane: PlaneView, s: LanderScene, spawn: bool) -> None:
+    """Grey outside the world, a sky gradient (by altitude) inside it, the spawn zone (if
+    asked), the ground and the world's dashed bounds."""
     p.surface.fill(OUTSIDE)
     corners = np.array([[0.0, s.world_height], [s.world_width, 0.0]])
     (u0, v_top), (u1, v_bottom) = plane.to_screen(corners)
@@ -209,12 +222,10 @@ def world(p: Painter, plane: PlaneView, s: LanderScene, poses, path, spawn=False
     edges = plane.to_screen(np.array([[0, 0], [w, 0], [w, h], [0, h], [0, 0]], dtype=float))
     for a, b in zip(edges[:-1], edges[1:], strict=True):
         p.dashed_line(a, b, BOUNDS, 2, dash_px=8)
-    for x, y, angle in poses:
-        for part in _drone_parts(s, x, y, angle):
-            p.translucent_polygon(plane.to_screen(part), SHADE, 95)
-    if len(path) >= 2:
-        p.polyline(plane.to_screen(path), PATH, 1)
-    # The platform, with an arrow under it when it moves.
+
+
+def platform(p: Painter, plane: PlaneView, s: LanderScene) -> None:
+    """The platform, with an arrow under it when it moves."""
     half = s.platform_width / 2.0
     x0, x1 = s.platform_x - half, s.platform_x + half
     y0, y1 = s.ground_height, s.ground_height + s.platform_height
@@ -225,18 +236,25 @@ def world(p: Painter, plane: PlaneView, s: LanderScene, poses, path, spawn=False
         mid = plane.to_screen((s.platform_x, y0 - 0.6))
         length = math.copysign(min(30.0, 12 + 8 * abs(s.platform_vx)), s.platform_vx)
         p.arrow(mid, mid + np.array([length, 0]), PLATFORM_EDGE, 2, head_px=7)
-    # The sensor line from the drone to the platform's top centre.
+
+
+def sensor_line(p: Painter, plane: PlaneView, s: LanderScene, label: bool) -> None:
+    """The sensor line from the drone to the platform's top centre, with the distance as
+    `label`."""
     a, b = plane.to_screen(s.position), plane.to_screen(s.platform_top)
     p.dashed_line(a, b, SENSOR, 2, dash_px=7)
     p.disc(b, 4, SENSOR)
-    if not close_up:
+    if label:
         mid = (a + b) / 2.0
         p.text(f"{s.distance_to_platform:.1f} m", (mid[0] + 8, mid[1]), SENSOR, 18, "midleft", True)
+
+
+def drone(p: Painter, plane: PlaneView, s: LanderScene, full_px: float) -> None:
+    """The drone, and over each motor, along the body's +y, its thrust bar `full_px` long at
+    full thrust: grey = max thrust, red = this step's thrust."""
     frame, left, right = _drone_parts(s, s.position[0], s.position[1], s.angle)
     for part, color in ((frame, FRAME), (left, MOTOR), (right, MOTOR)):
         p.polygon(plane.to_screen(part), color, OUTLINE, 1)
-    # Over each motor, along the body's +y: grey = max thrust, red = this step's thrust.
-    full_px = 70 if close_up else THRUST_BAR_PX
     motor_x = (s.drone_width - s.drone_height) / 2.0
     up = rotate2d(np.array([[0.0, 1.0]]), s.angle)[0] * np.array([1.0, -1.0])  # screen v down
     for side, thrust in ((-1.0, s.thrust[0]), (1.0, s.thrust[1])):
