@@ -306,8 +306,9 @@ def fresh(link: Px4Link, stale_s: float) -> None:
         raise FlightError(f"telemetry stopped: no estimate from PX4 for {stale_s:.1f} s", 4)
 
 
-def fly(link: Px4Link, policy: Policy | None, args: argparse.Namespace) -> list[list[float]]:
-    """Takes off, flies the waypoints in OFFBOARD, returns each hold's errors (m)."""
+def take_off(link: Px4Link, args: argparse.Namespace) -> np.ndarray:
+    """Asks PX4 for the estimate's streams, arms and takes off; returns home (NED, m) once
+    the drone is in the air, still (< 0.3 m/s) and over 1 m above it."""
     s = link.state
     try:
         link.wait("PX4's heartbeat", lambda st: st.heartbeat, args.timeout)
@@ -323,19 +324,7 @@ def fly(link: Px4Link, policy: Policy | None, args: argparse.Namespace) -> list[
     link.accepted("arming", MAV.MAV_CMD_COMPONENT_ARM_DISARM, (1,), args.timeout, 2)
     nan = float("nan")
     link.accepted("takeoff", MAV.MAV_CMD_NAV_TAKEOFF, (-1, 0, 0, nan, nan, nan, nan), 30, 2)
-    link.mav.mav.command_long_send(
-        link.target,
-        1,
-        MAV.MAV_CMD_REQUEST_MESSAGE,
-        0,
-        MAV.MAVLINK_MSG_ID_HOME_POSITION,
-        0,
-        0,
-        0,
-        0,
-        0,
-        0,
-    )
+    link.command(MAV.MAV_CMD_REQUEST_MESSAGE, MAV.MAVLINK_MSG_ID_HOME_POSITION)
     home_msg = link.mav.recv_match(type="HOME_POSITION", blocking=True, timeout=5)
     home = np.array([home_msg.x, home_msg.y, home_msg.z]) if home_msg else s.position.copy()
     link.wait(
@@ -348,20 +337,52 @@ def fly(link: Px4Link, policy: Policy | None, args: argparse.Namespace) -> list[
         ),
         60,
     )
-    points = [home + np.array([n, e, -u]) for n, e, u in parse_waypoints(args.waypoints)]
+    return home
 
-    dt_ms = 1000 * (policy.dt if policy is not None else 0.02)
-    previous = np.array([args.hover_thrust, 0.0, 0.0, 0.0])
-    target = s.position.copy()
 
-    def act() -> None:
-        nonlocal previous
-        if policy is None:
-            link.send_position(target)
+class Setpoints:
+    """What goes to PX4 each control period (dt_ms): without a policy, `target` as a
+    position setpoint; with one, the policy's rates and thrust for the way to `target`."""
+
+    def __init__(self, link: Px4Link, policy: Policy | None, hover_thrust: float) -> None:
+        self.link, self.policy = link, policy
+        self.dt_ms = 1000 * (policy.dt if policy is not None else 0.02)
+        self.previous = np.array([hover_thrust, 0.0, 0.0, 0.0])
+        self.target = link.state.position.copy()
+
+    def send(self) -> None:
+        if self.policy is None:
+            self.link.send_position(self.target)
             return
-        obs = observation(s.position, s.velocity, s.q, s.rates, target, previous)
-        previous = policy(obs)
-        link.send_rates(previous)
+        s = self.link.state
+        obs = observation(s.position, s.velocity, s.q, s.rates, self.target, self.previous)
+        self.previous = self.policy(obs)
+        self.link.send_rates(self.previous)
+
+
+def in_offboard(s: State, switched_ms: int, was: bool) -> bool:
+    """Whether PX4 is in OFFBOARD, `was` whether it has been since the switch at
+    `switched_ms`: raises once it left, or when it has not shown it 3 s after the switch."""
+    if s.custom_mode == PX4_OFFBOARD:
+        return True
+    if was:
+        raise FlightError(f"PX4 left OFFBOARD (custom mode {s.custom_mode:#x})", 3)
+    if s.time_ms - switched_ms > 3000:
+        said = "; ".join(s.texts[-3:]) or "nothing"
+        raise FlightError(
+            f"PX4 refused OFFBOARD: it acknowledged the switch but stayed in custom "
+            f"mode {s.custom_mode:#x} for 3 s (PX4 said: {said})",
+            3,
+        )
+    return False
+
+
+def fly(link: Px4Link, policy: Policy | None, args: argparse.Namespace) -> list[list[float]]:
+    """Takes off, flies the waypoints in OFFBOARD, returns each hold's errors (m)."""
+    s = link.state
+    home = take_off(link, args)
+    points = [home + np.array([n, e, -u]) for n, e, u in parse_waypoints(args.waypoints)]
+    setpoints = Setpoints(link, policy, args.hover_thrust)
 
     # Stream setpoints for a second of PX4 time before asking for OFFBOARD.
     start = s.time_ms
@@ -370,15 +391,15 @@ def fly(link: Px4Link, policy: Policy | None, args: argparse.Namespace) -> list[
         link.pump(0.01)
         fresh(link, args.stale)
         if s.time_ms >= next_ms:
-            act()
-            next_ms = s.time_ms + dt_ms
+            setpoints.send()
+            next_ms = s.time_ms + setpoints.dt_ms
     link.set_mode(PX4_OFFBOARD, "the switch to OFFBOARD", 3)
     # The heartbeat that shows the new mode may come up to a second later.
-    switched_ms, in_offboard = s.time_ms, False
+    switched_ms, offboard = s.time_ms, False
 
     results = []
     for i, point in enumerate(points):
-        origin = target.copy()
+        origin = setpoints.target.copy()
         leg = np.linalg.norm(point - origin)
         leg_ms = 1000 * leg / args.speed
         t0 = s.time_ms
@@ -388,25 +409,15 @@ def fly(link: Px4Link, policy: Policy | None, args: argparse.Namespace) -> list[
         while s.time_ms < hold_end:
             link.pump(0.002)
             fresh(link, args.stale)
-            if s.custom_mode == PX4_OFFBOARD:
-                in_offboard = True
-            elif in_offboard:
-                raise FlightError(f"PX4 left OFFBOARD (custom mode {s.custom_mode:#x})", 3)
-            elif s.time_ms - switched_ms > 3000:
-                said = "; ".join(s.texts[-3:]) or "nothing"
-                raise FlightError(
-                    f"PX4 refused OFFBOARD: it acknowledged the switch but stayed in custom "
-                    f"mode {s.custom_mode:#x} for 3 s (PX4 said: {said})",
-                    3,
-                )
+            offboard = in_offboard(s, switched_ms, offboard)
             if s.time_ms < next_ms:
                 continue
-            next_ms += dt_ms
+            next_ms += setpoints.dt_ms
             if s.time_ms > next_ms:  # fell behind: do not send a burst
-                next_ms = s.time_ms + dt_ms
+                next_ms = s.time_ms + setpoints.dt_ms
             frac = min(1.0, (s.time_ms - t0) / leg_ms) if leg_ms > 0 else 1.0
-            target = origin + frac * (point - origin)
-            act()
+            setpoints.target = origin + frac * (point - origin)
+            setpoints.send()
             if s.time_ms >= hold_start:
                 errors.append(float(np.linalg.norm(s.position - point)))
         mean, worst = float(np.mean(errors)), float(np.max(errors))
