@@ -117,21 +117,16 @@ def evaluate(
     action = run.summary.get("action") if run is not None else None
     rng = np.random.default_rng(seed)
     e = make_env(p.name, action=action, backend=backend)
+
+    def random_action(obs):
+        return rng.uniform(e.action_space.low, e.action_space.high)
+
+    act = run.act if run is not None else random_action
     returns, lengths, successes, final_distances = [], [], [], []
     landing_speeds, landing_angles = [], []
     try:
         for k in range(episodes):
-            obs, info = e.reset(seed=seed + k)
-            total, length, done = 0.0, 0, False
-            while not done:
-                if run is not None:
-                    action = run.act(obs)
-                else:
-                    action = rng.uniform(e.action_space.low, e.action_space.high)
-                obs, reward, terminated, truncated, info = e.step(action.astype(np.float32))
-                total += reward
-                length += 1
-                done = terminated or truncated
+            total, length, terminated, truncated, info = run_episode(e, act, seed + k)
             returns.append(total)
             lengths.append(length)
             successes.append(bool(p.success(terminated, truncated, info)))
@@ -162,11 +157,25 @@ def evaluate(
     )
 
 
+def run_episode(e, act, seed: int) -> tuple[float, int, bool, bool, dict]:
+    """One episode of env `e` from `seed`, acting act(observation): its return, length,
+    final flags and last info."""
+    obs, info = e.reset(seed=seed)
+    total, length, done = 0.0, 0, False
+    while not done:
+        action = act(obs)
+        obs, reward, terminated, truncated, info = e.step(action.astype(np.float32))
+        total += reward
+        length += 1
+        done = terminated or truncated
+    return total, length, terminated, truncated, info
+
+
 def _mean(values: list[float]) -> float | None:
     return float(np.mean(values)) if values else None
 
 
-def main(argv: list[str] | None = None) -> int:
+def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
         "run", type=Path, nargs="?", help="train_sb3.py or fast_ppo.py output folder"
@@ -201,20 +210,13 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("--episodes must be >= 1")
     if args.random == (args.run is not None):
         parser.error("give either a run folder or --random")
-    try:
-        result = evaluate(
-            None if args.random else args.run,
-            args.episodes,
-            args.seed,
-            env=args.env,
-            backend=args.backend,
-        )
-    except (FileNotFoundError, ValueError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    return args
+
+
+def print_figures(result: dict[str, Any], episodes: int, seed: int) -> None:
     print(
-        f"{result['policy']} on {result['env_id']}, {args.episodes} episodes "
-        f"(seeds {args.seed}..{args.seed + args.episodes - 1}):"
+        f"{result['policy']} on {result['env_id']}, {episodes} episodes "
+        f"(seeds {seed}..{seed + episodes - 1}):"
     )
     print(f"  success rate {100 * result['success_rate']:.1f} %  ({result['success']})")
     print(f"  mean return {result['mean_return']:.1f} ± {result['std_return']:.1f}")
@@ -227,6 +229,22 @@ def main(argv: list[str] | None = None) -> int:
             f"max {result['landing_speed_max_m_s']:.2f} m/s; |angle| mean "
             f"{result['landing_angle_mean_rad']:.3f} rad, max {result['landing_angle_max_rad']:.3f}"
         )
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(argv)
+    try:
+        result = evaluate(
+            None if args.random else args.run,
+            args.episodes,
+            args.seed,
+            env=args.env,
+            backend=args.backend,
+        )
+    except (FileNotFoundError, ValueError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    print_figures(result, args.episodes, args.seed)
     if args.json is not None:
         args.json.write_text(json.dumps(result, indent=2) + "\n")
     if args.gif is not None:
