@@ -27,7 +27,7 @@ from training_envs import check_action, preset
 ALGORITHMS = ("ppo", "sac")
 
 
-def main(argv: list[str] | None = None) -> int:
+def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
         "--env",
@@ -80,7 +80,11 @@ def main(argv: list[str] | None = None) -> int:
         check_action(preset(args.env), args.action)
     except ValueError as exc:
         parser.error(str(exc))
+    return args
 
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(argv)
     # Imported only now: torch and stable-baselines3 take seconds to load.
     from sb3_training import train
 
@@ -98,6 +102,12 @@ def main(argv: list[str] | None = None) -> int:
         init_from=args.init_from,
         lr_decay=args.lr_decay,
     )
+    report(s, args.out)
+    return 0
+
+
+def report(s: dict, out: Path) -> None:
+    """The run's summary `s` in a few lines."""
     print(
         f"trained {s['algo'].upper()} on {s['env_id']} for {s['timesteps']:,} env steps "
         f"({s['episodes']} episodes) in {s['wall_time_s']:.1f} s: "
@@ -111,8 +121,7 @@ def main(argv: list[str] | None = None) -> int:
         )
     else:
         print("no training episode finished: train for more --timesteps")
-    print(f"wrote {args.out}/model.zip, vecnormalize.pkl, tb/, episodes.csv, learning_curve.png")
-    return 0
+    print(f"wrote {out}/model.zip, vecnormalize.pkl, tb/, episodes.csv, learning_curve.png")
 
 
 if __name__ == "__main__":
