@@ -192,6 +192,18 @@ def sampling_throughput(algo, steps_per_runner: int) -> dict[str, float]:
     )
 
 
+def run_iterations(algo, iterations: int, on_iteration) -> list[dict[str, float]]:
+    """Trains `algo` for `iterations` iterations: the figures of each, given to
+    on_iteration(i, figures, algo) (if not None) as it ends."""
+    history: list[dict[str, float]] = []
+    for i in range(iterations):
+        figures = iteration_figures(algo.train())
+        history.append(figures)
+        if on_iteration is not None:
+            on_iteration(i, figures, algo)
+    return history
+
+
 def train(
     env: str = "hover",
     num_env_runners: int = 2,
@@ -224,7 +236,6 @@ def train(
     sys.path.insert(0, str(HERE))
     start_ray(address, num_cpus)
     algo = None
-    history: list[dict[str, float]] = []
     try:
         register_env(ENV_NAME, env_creator)
         config = build_config(
@@ -240,11 +251,7 @@ def train(
             backend=backend,
         )
         algo = config.build_algo()
-        for i in range(iterations):
-            figures = iteration_figures(algo.train())
-            history.append(figures)
-            if on_iteration is not None:
-                on_iteration(i, figures, algo)
+        history = run_iterations(algo, iterations, on_iteration)
         sampling = sampling_throughput(algo, measure_sampling) if measure_sampling > 0 else None
         if checkpoint is not None:
             algo.save_to_path(str(checkpoint.resolve()))
@@ -255,7 +262,8 @@ def train(
     return {"iterations": history, "sampling": sampling}
 
 
-def main(argv: list[str] | None = None) -> int:
+def parse_args(argv: list[str] | None) -> tuple[argparse.Namespace, Any]:
+    """The arguments, checked, and the preset --env names."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
         "--env", default="hover", help="hover (QuadHover-v0) or lander (Lander2D-v0)"
@@ -307,40 +315,21 @@ def main(argv: list[str] | None = None) -> int:
         p = preset(args.env)
     except ValueError as exc:
         parser.error(str(exc))
+    return args, p
 
-    each = "each env with its own SITL" if args.backend == "sitl" else "native vector envs"
+
+def print_iteration(i: int, f: dict[str, float], algo) -> None:
     print(
-        f"RLlib PPO on {p.env_id}: {args.num_env_runners} env runners × "
-        f"{args.envs_per_env_runner} envs, {each}"
+        f"iteration {i + 1:3d}: episode return mean {f['episode_return_mean']:8.1f}  "
+        f"({f['episodes']:.0f} episodes, mean length {f['episode_len_mean']:.0f})  "
+        f"env steps {f['env_steps']:.0f}  {f['seconds']:.1f} s  "
+        f"{f['env_steps_per_s']:.0f} env steps/s",
+        flush=True,
     )
-    start = time.perf_counter()
 
-    def report(i: int, f: dict[str, float], algo) -> None:
-        print(
-            f"iteration {i + 1:3d}: episode return mean {f['episode_return_mean']:8.1f}  "
-            f"({f['episodes']:.0f} episodes, mean length {f['episode_len_mean']:.0f})  "
-            f"env steps {f['env_steps']:.0f}  {f['seconds']:.1f} s  "
-            f"{f['env_steps_per_s']:.0f} env steps/s",
-            flush=True,
-        )
 
-    result = train(
-        p.name,
-        args.num_env_runners,
-        args.iterations,
-        args.seed,
-        address=args.address,
-        num_cpus=args.num_cpus,
-        train_batch=args.train_batch,
-        minibatch=args.minibatch,
-        epochs=args.epochs,
-        envs_per_env_runner=args.envs_per_env_runner,
-        num_learners=args.num_learners,
-        checkpoint=args.checkpoint,
-        measure_sampling=args.measure_sampling,
-        on_iteration=report,
-        backend=args.backend,
-    )
+def print_totals(result: dict[str, Any], start: float) -> None:
+    """Training's and (if measured) sampling's throughput; `start`: perf_counter before Ray."""
     history = result["iterations"]
     steps = sum(f["env_steps"] for f in history)
     seconds = sum(f["seconds"] for f in history)
@@ -356,6 +345,34 @@ def main(argv: list[str] | None = None) -> int:
             f"{sampling['env_runners']:.0f} env runners in {sampling['seconds']:.1f} s: "
             f"{sampling['env_steps_per_s']:.0f} env steps/s"
         )
+
+
+def main(argv: list[str] | None = None) -> int:
+    args, p = parse_args(argv)
+    each = "each env with its own SITL" if args.backend == "sitl" else "native vector envs"
+    print(
+        f"RLlib PPO on {p.env_id}: {args.num_env_runners} env runners × "
+        f"{args.envs_per_env_runner} envs, {each}"
+    )
+    start = time.perf_counter()
+    result = train(
+        p.name,
+        args.num_env_runners,
+        args.iterations,
+        args.seed,
+        address=args.address,
+        num_cpus=args.num_cpus,
+        train_batch=args.train_batch,
+        minibatch=args.minibatch,
+        epochs=args.epochs,
+        envs_per_env_runner=args.envs_per_env_runner,
+        num_learners=args.num_learners,
+        checkpoint=args.checkpoint,
+        measure_sampling=args.measure_sampling,
+        on_iteration=print_iteration,
+        backend=args.backend,
+    )
+    print_totals(result, start)
     if args.json is not None:
         args.json.write_text(json.dumps(result, indent=2) + "\n")
     return 0
