@@ -43,14 +43,9 @@ def cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / TICK
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--seconds", type=float, default=10.0)
-    parser.add_argument("--speedup", type=int, default=100)
-    parser.add_argument("--px4", action="store_true", help="then run benchmarks/px4_speed.py")
-    parser.add_argument("--px4-speed", type=int, default=20)
-    args = parser.parse_args()
-    aps.SPEEDUP = args.speedup
+def fly_and_time(seconds: float) -> tuple[float, float, float, float, dict]:
+    """Takes ArduPilot off over flyloop (--speed-factor 0) and times `seconds` of the hover:
+    (simulated s, wall s, flyloop CPU s, ArduPilot CPU s, flyloop's counters)."""
     build = aps.ardupilot_build(aps.fresh_dir("ardupilot-build-"))
     work = aps.fresh_dir("ardupilot-bench-")
     flyloop = aps.Flyloop(find_sitl_binary(), work, speed=0)
@@ -66,7 +61,7 @@ def main() -> None:
         wall0, sim0 = time.monotonic(), ap.estimate().time_ms
         cpu0 = (cpu_seconds(flyloop.proc.pid), cpu_seconds(ap.proc.pid))
         # Read ArduPilot's messages all along (a full socket buffer would stall it).
-        while time.monotonic() - wall0 < args.seconds:
+        while time.monotonic() - wall0 < seconds:
             sim1 = ap.estimate().time_ms
         wall1 = time.monotonic()
         cpu1 = (cpu_seconds(flyloop.proc.pid), cpu_seconds(ap.proc.pid))
@@ -76,8 +71,18 @@ def main() -> None:
         flyloop.stop()
     sim = (sim1 - sim0) / 1000
     wall = wall1 - wall0
-    fly_cpu, ap_cpu = cpu1[0] - cpu0[0], cpu1[1] - cpu0[1]
-    counters = flyloop.counters()
+    return sim, wall, cpu1[0] - cpu0[0], cpu1[1] - cpu0[1], flyloop.counters()
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--seconds", type=float, default=10.0)
+    parser.add_argument("--speedup", type=int, default=100)
+    parser.add_argument("--px4", action="store_true", help="then run benchmarks/px4_speed.py")
+    parser.add_argument("--px4-speed", type=int, default=20)
+    args = parser.parse_args()
+    aps.SPEEDUP = args.speedup
+    sim, wall, fly_cpu, ap_cpu, counters = fly_and_time(args.seconds)
     frames = sim * 1200  # SIM_RATE_HZ 1200: one frame per 833 us
     print(f"ArduPilot --speedup {args.speedup}, flyloop --speed-factor 0, load {os.getloadavg()}")
     print(f"real-time factor: {sim / wall:.1f}x ({sim:.1f} simulated s in {wall:.1f} wall s)")
