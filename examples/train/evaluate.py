@@ -48,6 +48,12 @@ class SavedRun:
                 f"{summary_path} not found: is {folder} a train_sb3.py or fast_ppo.py output?"
             )
         self.summary = json.loads(summary_path.read_text())
+        if "env" not in self.summary:
+            raise ValueError(
+                f"{folder} is not a train_sb3.py or fast_ppo.py run (its summary names no env "
+                "preset); a train_offboard.py policy flies through PX4 with "
+                "examples/px4_offboard.py"
+            )
         self.preset = preset(self.summary["env"])
         if self.summary.get("algo") == "fast_ppo":
             self._load_fast_ppo(folder)

@@ -80,6 +80,15 @@ def test_evaluate_refuses_a_folder_without_a_run(tmp_path):
     assert "summary.json not found" in done.stderr
 
 
+def test_evaluate_points_an_offboard_policy_to_px4_offboard():
+    # Regression: the shipped PX4 offboard policy (train_offboard.py) gave a KeyError traceback.
+    offboard = TRAIN.parent.parent / "policies" / "px4_offboard_hover"
+    done = run_script(TRAIN / "evaluate.py", str(offboard), "--episodes", "1")
+    assert done.returncode == 2
+    assert "Traceback" not in done.stderr
+    assert "examples/px4_offboard.py" in done.stderr
+
+
 def test_train_refuses_bad_arguments(tmp_path):
     for args, message in (
         (["--env", "moon"], "unknown env 'moon'"),
