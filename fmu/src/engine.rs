@@ -145,10 +145,11 @@ const STATE_TAG: &[u8; 8] = b"FLYFMI01";
 const STATE_NAME: &str = "flyloop FMU state";
 
 impl<M: FmuModel> Engine<M> {
-    pub fn new() -> Result<Self, FmuError> {
-        let book = Book::<M::Initial>::default();
-        let model = M::build(None, &book.initial)?;
-        Ok(Engine { model, book })
+    /// The engine of `model`, which was just built from the default start values
+    /// (`M::build(None, &Default::default())`), boxed as an instance holds it.
+    pub fn boxed(model: M) -> Box<dyn Simulation> {
+        let book = Book::default();
+        Box::new(Engine { model, book })
     }
 
     /// Rebuilds the model from the start values, keeping the inputs set so far.
@@ -312,7 +313,9 @@ impl<M: FmuModel> Simulation for Engine<M> {
     }
 
     fn reset(&mut self) -> Result<(), FmuError> {
-        *self = Engine::new()?;
+        let book = Book::<M::Initial>::default();
+        self.model = M::build(None, &book.initial)?;
+        self.book = book;
         Ok(())
     }
 

@@ -20,9 +20,11 @@ pub fn tables() -> [&'static ModelTable; 2] {
 /// `token`, or `None` for an unknown one.
 pub fn simulation_for(api: Api, token: &str) -> Option<Result<Box<dyn Simulation>, FmuError>> {
     if token == Quadrotor::table().table.token(api) {
-        Some(Engine::<Quadrotor>::new().map(|e| Box::new(e) as Box<dyn Simulation>))
+        let built = <Quadrotor as FmuModel>::build(None, &Default::default());
+        Some(built.map(Engine::boxed).map_err(FmuError::from))
     } else if token == Lander2d::table().table.token(api) {
-        Some(Engine::<Lander2d>::new().map(|e| Box::new(e) as Box<dyn Simulation>))
+        let built = <Lander2d as FmuModel>::build(None, &Default::default());
+        Some(built.map(Engine::boxed).map_err(FmuError::from))
     } else {
         None
     }

@@ -2,7 +2,7 @@
 
 use crate::error::FmuError;
 use crate::exports::guard::{c_slice_mut, write_out};
-use crate::exports::shared::model_exchange::discrete_update;
+use crate::exports::shared::model_exchange::log_event_update;
 use crate::fmi2_types::*;
 use crate::instance::masks;
 
@@ -14,7 +14,8 @@ forward! {
             if eventInfo.is_null() {
                 return Err(FmuError::NullArgument("eventInfo"));
             }
-            let (changed, next) = discrete_update(i, f)?;
+            let (changed, next) = i.sim.new_discrete_states()?;
+            log_event_update(i, f, next);
             let info = fmi2EventInfo {
                 newDiscreteStatesNeeded: fmi2False,
                 terminateSimulation: fmi2False,

@@ -2,7 +2,7 @@
 //! same states, derivatives, event indicators and events as FMI 2.0's Model Exchange.
 
 use crate::exports::guard::{c_slice_mut, no_null, write_out};
-use crate::exports::shared::model_exchange::discrete_update;
+use crate::exports::shared::model_exchange::log_event_update;
 use crate::fmi3_types::*;
 use crate::instance::{Instance, masks3};
 use crate::table::ModelExchangeTable;
@@ -34,7 +34,8 @@ forward! {
         ];
         no_null(&flags)?;
         no_null(&[(nextEventTime, "nextEventTime")])?;
-        let (changed, next) = discrete_update(i, f)?;
+        let (changed, next) = i.sim.new_discrete_states()?;
+        log_event_update(i, f, next);
         let values = [false, false, false, changed, next.is_some()];
         for ((pointer, name), value) in flags.into_iter().zip(values) {
             write_out(pointer, u8::from(value), name)?;

@@ -1,26 +1,20 @@
 //! Model Exchange (each mask refuses a Co-Simulation instance): the functions that are the
 //! same in both versions, and the event update both versions' discrete-state functions run.
 
-use crate::error::FmuError;
 use crate::exports::guard::{c_slice, c_slice_mut, no_null, write_out};
 use crate::fmi2_types::fmi2Boolean;
 use crate::fmi3_types::fmi3Boolean;
 use crate::instance::{Instance, Stage, masks};
 use flyloop_core::number::Compact;
 
-/// The discrete changes of the event at the current time, logged as `function`'s event:
-/// whether the continuous states changed, and the next time event.
-pub(crate) fn discrete_update(
-    instance: &mut Instance,
-    function: &str,
-) -> Result<(bool, Option<f64>), FmuError> {
-    let (changed, next) = instance.sim.new_discrete_states()?;
+/// Logs the event update at the current time as `function`'s event, with the next time
+/// event.
+pub(crate) fn log_event_update(instance: &Instance, function: &str, next: Option<f64>) {
     instance.event(&format!(
         "{function}: t = {}, next time event {}",
         Compact(instance.sim.time()),
         next.map_or("none".to_string(), |t| Compact(t).to_string())
     ));
-    Ok((changed, next))
 }
 
 twins! {
