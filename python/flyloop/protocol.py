@@ -271,7 +271,7 @@ class Decoder:
                 if crc16(view[at + 1 : stop], FRAME_CRC_EXTRA) != crc:
                     raise ProtocolError("a task frame fails its CRC")
                 if sink is not None:
-                    self._to_sink(sink, data, at, plen)
+                    self._to_sink(sink, data, view, at, plen)
                 else:
                     self._to_arrays(out, data, at, plen)
             else:
@@ -282,9 +282,10 @@ class Decoder:
             at = total
         return out
 
-    def _to_sink(self, sink: FrameSink, data: bytes, at: int, plen: int) -> None:
+    def _to_sink(self, sink: FrameSink, data: bytes, view: memoryview, at: int, plen: int) -> None:
         """The step path: the task frame at `at` into its vehicle's row of `sink`, unless it
-        is another vehicle's, beyond the sink's arrays, or stale (see FrameSink.accepts)."""
+        is another vehicle's, beyond the sink's arrays, or stale (see FrameSink.accepts).
+        `view` is the datagram's memoryview, made once per datagram by `decode`."""
         row = sink.rows.get(data[at + 5])
         # array_id (payload bytes 8-9) is never 0, so MAVLink 2 never truncates it.
         k = (data[at + 18] | (data[at + 19] << 8)) - 1 if plen >= 10 else -1
@@ -299,7 +300,7 @@ class Decoder:
             return
         slot = row * sink.n_arrays + k
         off = slot * _FRAME_PAYLOAD
-        sink.raw[off : off + plen] = memoryview(data)[start : start + plen]
+        sink.raw[off : off + plen] = view[start : start + plen]
         if plen < _FRAME_PAYLOAD:
             # MAVLink 2 cut the payload's trailing zeros.
             sink.raw[off + plen : off + _FRAME_PAYLOAD] = self._zeros[plen:]
