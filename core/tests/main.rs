@@ -8,6 +8,7 @@ mod lander2d_landing;
 mod lander2d_model;
 mod lander2d_reward;
 mod parameter_reference;
+mod quadrotor_golden;
 mod quadrotor_grid;
 mod quadrotor_ground;
 mod quadrotor_physics;
