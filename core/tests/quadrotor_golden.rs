@@ -7,9 +7,9 @@
 
 use flyloop_core::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
 use flyloop_core::rng::SimRng;
+use flyloop_core::tasks::InfoRef;
 use flyloop_core::tasks::randomization::{ParamRange, Randomization};
 use flyloop_core::tasks::registry::{TaskConfig, TaskInstance, TaskKind};
-use flyloop_core::tasks::{InfoRef, Task};
 use nalgebra::Vector3;
 
 /// FNV-1a over 64-bit words: one number for a whole trace of bits.
