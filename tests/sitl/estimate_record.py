@@ -21,7 +21,7 @@ COLUMNS = ("time_s", "est_north", "est_east", "est_down", "north", "east", "down
 # points (north, east of home, m), each held until LEG_S after its start, the landing, and
 # GROUND_S on the ground after the disarm: about 5 minutes from arming.
 LEGS = ((10.0, 0.0), (10.0, 10.0), (0.0, 10.0), (0.0, 0.0))
-CLIMB_S = 25.0
+CLIMB_S = 35.0
 LEG_S = 45.0
 GROUND_S = 60.0
 HEIGHT_LIMIT = 0.15
