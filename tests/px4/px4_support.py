@@ -166,6 +166,11 @@ class LocalFrame:
             ned[2] + self.altitude - HOME[2],
         )
 
+    def to_flyloop(self, ned: tuple[float, float, float]) -> tuple[float, float, float]:
+        """A point of PX4's local NED → flyloop's NED from its home."""
+        origin = self.from_flyloop((0.0, 0.0, 0.0))
+        return (ned[0] - origin[0], ned[1] - origin[1], ned[2] - origin[2])
+
     def from_global(self, lat: float, lon: float, alt: float) -> tuple[float, float, float]:
         """Latitude, longitude (deg), altitude MSL (m) → a point of this frame."""
         north, east = self._scale()
