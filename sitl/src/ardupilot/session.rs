@@ -10,6 +10,7 @@ use crate::track::SessionTrack;
 use flyloop_core::ParamError;
 use flyloop_core::quadrotor::Quadrotor;
 use flyloop_core::sensors::Sensors;
+use flyloop_core::vehicle::Vehicle;
 use nalgebra::Vector3;
 use std::fmt;
 use std::net::SocketAddr;
@@ -306,7 +307,7 @@ impl Session {
         self.time_us += step_us;
         let dt = step_us as f64 * 1e-6;
         self.quad.step(dt);
-        let imu = self.sensors.sample_imu(&self.quad, dt);
+        let imu = self.sensors.sample_imu(&self.quad.kinematics(), dt);
         self.stats.steps += 1;
         self.stats.physics += start.elapsed();
         let b = &self.quad.body;

@@ -3,7 +3,7 @@
 
 use super::messages;
 use crate::config::AutopilotVehicle;
-use crate::kinematics::{Home, Kinematics};
+use crate::kinematics::Home;
 use crate::stats::Stats;
 use crate::telemetry;
 use crate::track::SessionTrack;
@@ -11,6 +11,7 @@ use crate::wire::{Encoder, StreamDecoder};
 use flyloop_core::ParamError;
 use flyloop_core::quadrotor::Quadrotor;
 use flyloop_core::sensors::Sensors;
+use flyloop_core::vehicle::Vehicle;
 use mavlink::dialects::common::{COMMAND_LONG_DATA, MavCmd, MavMessage};
 use std::time::Instant;
 
@@ -205,18 +206,18 @@ impl Session {
     /// HIL_SENSOR now, HIL_GPS when a fix is delivered, HIL_STATE_QUATERNION when due.
     fn emit(&mut self, out: &mut Vec<u8>) {
         let dt = self.step_us as f64 * 1e-6;
-        let reading = self.sensors.sample(&self.quad, dt);
+        let k = self.quad.kinematics();
+        let reading = self.sensors.sample(&k, dt);
         let sensor = messages::hil_sensor(&reading, self.time_us);
         self.encoder.push(out, SIMULATOR_SYSTEM, &sensor);
         self.track.record(self.time_us, &self.quad);
-        if let Some(fix) = self.sensors.gps(&self.quad, self.time_us as f64 * 1e-6) {
+        if let Some(fix) = self.sensors.gps(&k, self.time_us as f64 * 1e-6) {
             let stamp = self.gps_epoch_us + (fix.measured_at * 1e6).round() as u64;
             self.encoder
                 .push(out, SIMULATOR_SYSTEM, &messages::hil_gps(&fix, stamp));
         }
         if let Some(interval) = self.state_interval_us {
             if self.time_us >= self.next_state_us {
-                let k = Kinematics::of_quadrotor(&self.quad);
                 let state = telemetry::hil_state_quaternion_of(&k, &self.home, self.time_us);
                 self.encoder.push(out, SIMULATOR_SYSTEM, &state);
                 self.next_state_us += interval;
