@@ -9,7 +9,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use flyloop_core::SimRng;
-use flyloop_core::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
+use flyloop_core::quadrotor::{BodyState, Frame, Quadrotor, QuadrotorParams};
 use flyloop_core::tasks::Task;
 use flyloop_core::tasks::flight::FlightParams;
 use flyloop_core::tasks::hover::Hover;
@@ -49,6 +49,22 @@ fn quadrotor_step(c: &mut Criterion) {
             ground.step(black_box(0.01));
         })
     });
+    // Other frames (issue 33): the same flight, six and eight rotors at their hover state.
+    for name in ["hexa_x", "octo_x"] {
+        let frame = Frame::named(name).expect("shipped frame");
+        let mut multi = Quadrotor::new(QuadrotorParams::default(), body, SimRng::new(1))
+            .expect("valid defaults")
+            .with_frame(frame);
+        let h = multi.hover_motor_state().unwrap_or(0.5);
+        multi
+            .set_command(vec![h; multi.frame().rotor_count()])
+            .expect("finite command");
+        c.bench_function(&format!("quadrotor_control_step_10ms_{name}"), |b| {
+            b.iter(|| {
+                multi.step(black_box(0.01));
+            })
+        });
+    }
     let mut rng = SimRng::new(3);
     c.bench_function("normal_draw", |b| b.iter(|| black_box(rng.normal())));
 

@@ -35,11 +35,11 @@ pub struct Derivative {
     pub gear_stretch_rates: [[f64; 2]; 4],
 }
 
-/// Constants of the equations that depend only on the parameters and the frame, computed
-/// once per step.
-#[derive(Debug, Clone, Copy)]
-struct Coefficients<'f> {
-    mixing: &'f Mixing,
+/// Constants of the equations that depend only on the parameters and the frame: computed
+/// once per step by [`integrate`], kept by a vehicle until its parameters change
+/// ([`ConstantsCache`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Constants {
     /// Per thrust term: kᵢ/m, m/s² per unit of squared motor state.
     thrust: [f64; MAX_ROTORS],
     /// Per roll term: kᵢ·L·|yᵢ|, N·m.
@@ -59,8 +59,68 @@ struct Coefficients<'f> {
     inv_tau: [f64; MAX_ROTORS],
 }
 
-impl<'f> Coefficients<'f> {
-    fn new(p: &QuadrotorParams, frame: &'f Frame) -> Self {
+/// The frame's sums and the constants, as the equations read them.
+#[derive(Debug, Clone, Copy)]
+struct Coefficients<'f> {
+    mixing: &'f Mixing,
+    k: &'f Constants,
+}
+
+impl std::ops::Deref for Coefficients<'_> {
+    type Target = Constants;
+    fn deref(&self) -> &Constants {
+        self.k
+    }
+}
+
+/// The parameters [`Constants`] depend on, by their bits (the frame is fixed per vehicle).
+fn constants_key(p: &QuadrotorParams) -> [u64; 11] {
+    [
+        p.mass,
+        p.arm_length,
+        p.inertia_xx,
+        p.inertia_yy,
+        p.inertia_zz,
+        p.gravity,
+        p.thrust_coefficient,
+        p.motor_time_constant,
+        p.yaw_torque_coefficient,
+        p.air_density,
+        p.drag_area,
+    ]
+    .map(f64::to_bits)
+}
+
+/// A vehicle's [`Constants`], recomputed only when a parameter they depend on changed. Not
+/// part of the vehicle's state: equal to any other, skipped by serde, empty after a restore.
+#[derive(Debug, Clone, Default)]
+pub struct ConstantsCache(Option<([u64; 11], Constants)>);
+
+impl PartialEq for ConstantsCache {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl ConstantsCache {
+    /// The constants of `params` on `frame` (the frame must be the one the cache has served
+    /// so far: a vehicle given a new frame starts a new cache).
+    pub fn get(&mut self, params: &QuadrotorParams, frame: &Frame) -> &Constants {
+        let key = constants_key(params);
+        match self.0 {
+            Some((k, _)) if k == key => {}
+            _ => self.0 = Some((key, Constants::new(params, frame))),
+        }
+        match &self.0 {
+            Some((_, c)) => c,
+            None => unreachable!("filled just above"),
+        }
+    }
+}
+
+impl Constants {
+    /// The constants of `params` on `frame`.
+    pub fn new(p: &QuadrotorParams, frame: &Frame) -> Self {
         let rotors = frame.rotors();
         let mixing = frame.mixing();
         let k = |i: u8| {
@@ -68,8 +128,7 @@ impl<'f> Coefficients<'f> {
                 .thrust_coefficient
                 .unwrap_or(p.thrust_coefficient)
         };
-        let mut c = Coefficients {
-            mixing,
+        let mut c = Constants {
             thrust: [0.0; MAX_ROTORS],
             roll: [0.0; MAX_ROTORS],
             pitch: [0.0; MAX_ROTORS],
@@ -221,7 +280,11 @@ fn derivative_sized<const L: usize, const C: usize>(
     command: &Motors,
     wind: &Vector3<f64>,
 ) -> [f64; C] {
-    let c = Coefficients::new(params, frame);
+    let k = Constants::new(params, frame);
+    let c = Coefficients {
+        mixing: frame.mixing(),
+        k: &k,
+    };
     let command = command.padded();
     if params.ground_enabled {
         contact_rates::<L, C>(
@@ -484,16 +547,34 @@ pub fn integrate(
     wind: &Vector3<f64>,
     dt: f64,
 ) {
+    let k = Constants::new(params, frame);
+    integrate_with(params, frame, &k, state, command, wind, dt);
+}
+
+/// [`integrate`] with the [`Constants`] of `params` on `frame` computed already.
+pub fn integrate_with(
+    params: &QuadrotorParams,
+    frame: &Frame,
+    k: &Constants,
+    state: &mut BodyState,
+    command: &Motors,
+    wind: &Vector3<f64>,
+    dt: f64,
+) {
+    let c = Coefficients {
+        mixing: frame.mixing(),
+        k,
+    };
     by_size!(
         frame.rotor_count(),
-        integrate_sized(params, frame, state, command, wind, dt)
+        integrate_sized(params, &c, state, command, wind, dt)
     )
 }
 
 #[inline(always)]
 fn integrate_sized<const L: usize, const C: usize>(
     params: &QuadrotorParams,
-    frame: &Frame,
+    c: &Coefficients,
     state: &mut BodyState,
     command: &Motors,
     wind: &Vector3<f64>,
@@ -502,9 +583,9 @@ fn integrate_sized<const L: usize, const C: usize>(
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx") {
         // SAFETY: the CPU supports AVX, checked just above.
-        return unsafe { integrate_avx::<L, C>(params, frame, state, command, wind, dt) };
+        return unsafe { integrate_avx::<L, C>(params, c, state, command, wind, dt) };
     }
-    integrate_portable::<L, C>(params, frame, state, command, wind, dt)
+    integrate_portable::<L, C>(params, c, state, command, wind, dt)
 }
 
 /// [`integrate`] compiled with AVX's three-operand instructions: a third fewer instructions
@@ -514,13 +595,13 @@ fn integrate_sized<const L: usize, const C: usize>(
 #[target_feature(enable = "avx")]
 fn integrate_avx<const L: usize, const C: usize>(
     params: &QuadrotorParams,
-    frame: &Frame,
+    c: &Coefficients,
     state: &mut BodyState,
     command: &Motors,
     wind: &Vector3<f64>,
     dt: f64,
 ) {
-    integrate_portable::<L, C>(params, frame, state, command, wind, dt)
+    integrate_portable::<L, C>(params, c, state, command, wind, dt)
 }
 
 /// ceil(dt / max_substep), at least 1. A ratio within 1e-9 (relative) above a whole number
@@ -557,22 +638,21 @@ fn may_touch(
 #[inline(always)]
 fn integrate_portable<const L: usize, const C: usize>(
     params: &QuadrotorParams,
-    frame: &Frame,
+    c: &Coefficients,
     state: &mut BodyState,
     command: &Motors,
     wind: &Vector3<f64>,
     dt: f64,
 ) {
-    let c = Coefficients::new(params, frame);
     let command = command.padded();
-    if params.ground_enabled && may_touch(params, &c, state, wind, dt) {
+    if params.ground_enabled && may_touch(params, c, state, wind, dt) {
         let gear = Gear::new(params);
         let substeps = substep_count(dt, params.max_substep.min(params.contact_substep));
         let h = if substeps == 1.0 { dt } else { dt / substeps };
         let mut x = flatten_contact::<L, C>(state);
         for _ in 0..substeps as u64 {
             x = rk4(&x, h, |y| {
-                contact_rates::<L, C>(params, &c, &gear, y, command, wind)
+                contact_rates::<L, C>(params, c, &gear, y, command, wind)
             });
             gear.release_lifted_feet(&mut x);
         }
@@ -583,7 +663,7 @@ fn integrate_portable<const L: usize, const C: usize>(
     let h = if substeps == 1.0 { dt } else { dt / substeps };
     let mut x = flatten::<L>(state);
     for _ in 0..substeps as u64 {
-        x = rk4(&x, h, |y| rates::<L>(params, &c, y, command, wind));
+        x = rk4(&x, h, |y| rates::<L>(params, c, y, command, wind));
     }
     unflatten_into(&x, state);
     // No foot reached the ground: every bristle is released.
@@ -665,7 +745,11 @@ mod tests {
     fn quad_x_sums_are_the_grouped_sums() {
         let p = QuadrotorParams::default();
         let f = Frame::quad_x();
-        let c = Coefficients::new(&p, &f);
+        let k = Constants::new(&p, &f);
+        let c = Coefficients {
+            mixing: f.mixing(),
+            k: &k,
+        };
         let mut x = [0.0; 17];
         for k in 0..1000 {
             for (i, m) in x[BODY..].iter_mut().enumerate() {
@@ -695,15 +779,20 @@ mod tests {
             ..BodyState::at_rest(Vector3::new(0.3, 0.2, 2.0), 0.3, -0.2, 1.0, 0.4)
         };
         let f = Frame::quad_x();
+        let k = Constants::new(&p, &f);
+        let c = Coefficients {
+            mixing: f.mixing(),
+            k: &k,
+        };
         let (mut a, mut b) = (start, start);
         let wind = Vector3::new(3.0, -1.0, 0.2);
         for i in 0..500 {
             let m = 0.3 + 0.4 * ((i % 7) as f64 / 7.0);
             let command = Motors::from([m, 0.9 - m, 0.5, 0.45]);
             let dt = if i % 3 == 0 { 0.025 } else { 0.01 };
-            integrate_portable::<17, 25>(&p, &f, &mut a, &command, &wind, dt);
+            integrate_portable::<17, 25>(&p, &c, &mut a, &command, &wind, dt);
             // SAFETY: AVX support was checked at the top of the test.
-            unsafe { integrate_avx::<17, 25>(&p, &f, &mut b, &command, &wind, dt) };
+            unsafe { integrate_avx::<17, 25>(&p, &c, &mut b, &command, &wind, dt) };
         }
         let bits = |s: &BodyState| flatten_contact::<17, 25>(s).map(f64::to_bits);
         assert_eq!(bits(&a), bits(&b));
@@ -717,9 +806,9 @@ mod tests {
         let (mut a, mut b) = (touchdown, touchdown);
         let low = Motors::from([0.1; 4]);
         for _ in 0..200 {
-            integrate_portable::<17, 25>(&p, &f, &mut a, &low, &wind, 0.01);
+            integrate_portable::<17, 25>(&p, &c, &mut a, &low, &wind, 0.01);
             // SAFETY: AVX support was checked at the top of the test.
-            unsafe { integrate_avx::<17, 25>(&p, &f, &mut b, &low, &wind, 0.01) };
+            unsafe { integrate_avx::<17, 25>(&p, &c, &mut b, &low, &wind, 0.01) };
         }
         assert_eq!(bits(&a), bits(&b));
         assert!(a.position.z < 0.1, "{}", a.position.z);

@@ -2,7 +2,7 @@
 //! an FMU instance or a SITL vehicle holds.
 
 use super::contact::{foot_heights, rest_height};
-use super::dynamics::{accelerations, integrate};
+use super::dynamics::{ConstantsCache, accelerations, integrate_with};
 use super::frame::Frame;
 use super::params::{QuadrotorInitial, QuadrotorParams};
 use super::state::{BodyState, Motors, WindState};
@@ -33,6 +33,8 @@ pub struct Quadrotor {
     rng: SimRng,
     #[serde(skip)]
     ou_cache: OuCache,
+    #[serde(skip)]
+    constants: ConstantsCache,
 }
 
 impl Quadrotor {
@@ -55,6 +57,7 @@ impl Quadrotor {
             grid_phase: 0.0,
             rng,
             ou_cache: OuCache::default(),
+            constants: ConstantsCache::default(),
         })
     }
 
@@ -65,6 +68,7 @@ impl Quadrotor {
         self.body = self.body.with_motor_count(n).unwrap_or(self.body);
         self.command = Motors::uniform(n, self.command[0]).unwrap_or(self.command);
         self.frame = frame;
+        self.constants = ConstantsCache::default();
         self
     }
 
@@ -202,9 +206,11 @@ impl Quadrotor {
                 }
             }
             let wind = self.wind_velocity();
-            integrate(
+            let constants = self.constants.get(&self.params, &self.frame);
+            integrate_with(
                 &self.params,
                 &self.frame,
+                constants,
                 &mut self.body,
                 &self.command,
                 &wind,
