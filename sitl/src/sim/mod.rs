@@ -137,6 +137,8 @@ pub struct Sim {
     pub controller_outbox: Vec<u8>,
     /// Real-time stream output: one datagram per peer.
     pub stream: Vec<(SocketAddr, Vec<u8>)>,
+    /// `--record FILE`: every step of every vehicle.
+    pub recorder: Option<crate::record::Recorder>,
 }
 
 impl Sim {
@@ -170,6 +172,7 @@ impl Sim {
             gcs_outbox: Vec::new(),
             controller_outbox: Vec::new(),
             stream: Vec::new(),
+            recorder: None,
         })
     }
 
@@ -385,6 +388,7 @@ impl Sim {
         self.vehicles[i].step();
         self.stats.physics += start.elapsed();
         self.stats.steps += 1;
+        self.record(i);
         let from = out.len();
         self.push_vehicle_reply(i, peer, out);
         let v = &mut self.vehicles[i];
@@ -427,6 +431,13 @@ impl Sim {
         true
     }
 
+    /// Appends vehicle `i`'s step (or reset) to the recording, if one is made.
+    pub(crate) fn record(&mut self, i: usize) {
+        if let Some(r) = &mut self.recorder {
+            r.step(&mut self.vehicles[i], &self.options.home);
+        }
+    }
+
     /// HIL_STATE_QUATERNION and the task frame of vehicle `i`, as `peer` wants them.
     fn push_vehicle_reply(&mut self, i: usize, peer: usize, out: &mut Vec<u8>) {
         let Peer { state, frame, .. } = self.peers[peer];
@@ -455,7 +466,7 @@ impl Sim {
         let due = self.gcs_streams.due(now);
         for message_id in due {
             for i in 0..self.vehicles.len() {
-                if let Some(messages) = self.message(Link::Gcs, i, message_id) {
+                if let Some(messages) = self.message(i, message_id) {
                     for m in messages {
                         self.push(Link::Gcs, out, i, &m);
                     }
