@@ -1,7 +1,7 @@
 //! The recording of the MAVLink modes (`--record FILE`): a MAVLink telemetry log (`.tlog`,
 //! the format MAVProxy, MAVExplorer, QGroundControl and pymavlink read): each frame is
 //! preceded by 8 bytes, the vehicle's simulation time in µs (big-endian). Per step and
-//! vehicle: the motor command (SERVO_OUTPUT_RAW), the ground truth (HIL_STATE_QUATERNION),
+//! vehicle: the ground truth (HIL_STATE_QUATERNION), the motor command (SERVO_OUTPUT_RAW),
 //! the wind (WIND_COV) and the task frame (DEBUG_FLOAT_ARRAY: reward, termination,
 //! observation, info). The same seeds and commands give the same bytes.
 
@@ -42,8 +42,8 @@ impl Recorder {
         let time = v.clock_us.to_be_bytes();
         self.frame.clear();
         let mut messages = vec![
-            telemetry::servo_output_raw(v),
             telemetry::hil_state_quaternion(v, home),
+            telemetry::servo_output_raw(v),
             telemetry::wind_cov(v),
         ];
         let (name, clock) = (v.kind.frame_name(), v.clock_us);
