@@ -38,8 +38,15 @@ def free_port(kind: int = socket.SOCK_DGRAM) -> int:
         return s.getsockname()[1]
 
 
-def steps_per_second(sitl_args: list[str], seconds: float) -> tuple[float, int]:
-    """Lockstep steps/s over `seconds` (after 0.5 s of warm-up); and the steps made."""
+def cpu_seconds(pid: int) -> float:
+    """utime + stime of a process, s."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def steps_per_second(sitl_args: list[str], seconds: float) -> tuple[float, float, int]:
+    """Lockstep steps/s over `seconds` (after 0.5 s of warm-up), the SITL's CPU µs per step
+    over the same window (less moved by other load than the wall clock), and the steps made."""
     binary = REPO / "target" / "release" / "flyloop-sitl"
     proc = subprocess.Popen(
         [str(binary), "--listen", "127.0.0.1:0", *sitl_args],
@@ -62,9 +69,10 @@ def steps_per_second(sitl_args: list[str], seconds: float) -> tuple[float, int]:
             steps += 1
             now = time.perf_counter()
             if warm is None and now - start > 0.5:
-                warm, warm_steps = now, steps
+                warm, warm_steps, cpu0 = now, steps, cpu_seconds(proc.pid)
             if warm is not None and now - warm >= seconds:
-                return (steps - warm_steps) / (now - warm), steps
+                cpu_us = (cpu_seconds(proc.pid) - cpu0) * 1e6 / (steps - warm_steps)
+                return (steps - warm_steps) / (now - warm), cpu_us, steps
     finally:
         sock.close()
         proc.send_signal(signal.SIGINT)
@@ -86,6 +94,7 @@ def main() -> int:
     )
     print(f"CPU {cpu}, {os.cpu_count()} cores, load {os.getloadavg()[0]:.2f} at the start")
     results: dict[str, list[float]] = {"base": [], "record": [], "view": []}
+    cpu: dict[str, list[float]] = {name: [] for name in results}
     with tempfile.TemporaryDirectory() as tmp:
         tlog = Path(tmp) / "run.tlog"
         for r in range(args.rounds):
@@ -113,7 +122,8 @@ def main() -> int:
                     )
                     view.stdout.readline()
                     view.stdout.readline()  # "listening ...": ready
-                rate, steps = steps_per_second(sitl_args, args.seconds)
+                rate, cpu_us, steps = steps_per_second(sitl_args, args.seconds)
+                cpu[name].append(cpu_us)
                 if view is not None:
                     view.send_signal(signal.SIGINT)
                     view.wait(timeout=15)
@@ -124,13 +134,23 @@ def main() -> int:
                     per_minute = size / steps * 6000 / 2**20  # 6,000 steps of 10 ms
                     extra = f", recording {size / 2**20:.2f} MiB for {steps} steps"
                     extra += f" = {per_minute:.2f} MiB per simulated minute"
-                print(f"round {r + 1} {name:6s} {rate:8.0f} steps/s{extra}", flush=True)
+                line = (
+                    f"round {r + 1} {name:6s} {rate:8.0f} steps/s, SITL CPU {cpu_us:5.1f} us/step"
+                )
+                print(line + extra, flush=True)
     base = sum(results["base"]) / len(results["base"])
     for name, rates in results.items():
         mean = sum(rates) / len(rates)
         print(
             f"{name:6s} mean {mean:8.0f} steps/s = {mean / base:.3f} of base"
             f" ({', '.join(f'{x:.0f}' for x in rates)})"
+        )
+    base_cpu = sum(cpu["base"]) / len(cpu["base"])
+    for name, values in cpu.items():
+        mean = sum(values) / len(values)
+        print(
+            f"{name:6s} SITL CPU {mean:5.1f} us/step = {mean / base_cpu:.3f} of base"
+            f" ({', '.join(f'{x:.1f}' for x in values)})"
         )
     print(f"load {os.getloadavg()[0]:.2f} at the end")
     return 0

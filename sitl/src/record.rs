@@ -9,9 +9,29 @@ use crate::kinematics::Home;
 use crate::telemetry;
 use crate::vehicle::Vehicle;
 use crate::wire::Encoder;
+use mavlink::dialects::common::MavMessage;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
+
+/// The unsigned MAVLink 2 frames packed back to back in `bytes` (this SITL's own output).
+fn frames_of(bytes: &[u8]) -> impl Iterator<Item = &[u8]> {
+    let mut rest = bytes;
+    std::iter::from_fn(move || {
+        let len = 12 + usize::from(*rest.get(1)?);
+        let (frame, tail) = rest.split_at(len.min(rest.len()));
+        rest = tail;
+        Some(frame)
+    })
+}
+
+/// The message id of a MAVLink 2 frame (bytes 7..10, little-endian).
+fn message_id(frame: &[u8]) -> u32 {
+    match frame.get(7..10) {
+        Some(id) => u32::from_le_bytes([id[0], id[1], id[2], 0]),
+        None => u32::MAX,
+    }
+}
 
 /// A recording being written.
 #[derive(Debug)]
@@ -35,28 +55,38 @@ impl Recorder {
     }
 
     /// Appends what vehicle `v` did in the step that just ended (or the state a reset made).
-    pub fn step(&mut self, v: &mut Vehicle, home: &Home) {
+    /// `reply`: frames already encoded for this step (a lockstep reply: its
+    /// HIL_STATE_QUATERNION and task frame are recorded as they are, not encoded again);
+    /// what it lacks is encoded here.
+    pub fn step(&mut self, v: &mut Vehicle, home: &Home, reply: &[u8]) {
         if self.failed {
             return;
         }
-        let time = v.clock_us.to_be_bytes();
         self.frame.clear();
-        let mut messages = vec![
-            telemetry::hil_state_quaternion(v, home),
-            telemetry::servo_output_raw(v),
-            telemetry::wind_cov(v),
-        ];
-        let (name, clock) = (v.kind.frame_name(), v.clock_us);
-        messages.extend(crate::task_frame::messages(name, clock, v.frame()));
-        let mut result = Ok(());
-        for m in &messages {
-            self.frame.clear();
-            self.encoder.push(&mut self.frame, v.system_id, m);
-            result = result
-                .and_then(|()| self.out.write_all(&time))
-                .and_then(|()| self.out.write_all(&self.frame));
+        let (time, system_id) = (v.clock_us.to_be_bytes(), v.system_id);
+        let (mut has_state, mut has_frame) = (false, false);
+        for frame in frames_of(reply) {
+            has_state |= message_id(frame) == telemetry::id::HIL_STATE_QUATERNION;
+            has_frame |= message_id(frame) == telemetry::id::DEBUG_FLOAT_ARRAY;
+            self.frame.extend_from_slice(&time);
+            self.frame.extend_from_slice(frame);
         }
-        if let Err(e) = result {
+        let mut push = |out: &mut Vec<u8>, m: &MavMessage| {
+            out.extend_from_slice(&time);
+            self.encoder.push(out, system_id, m);
+        };
+        if !has_state {
+            push(&mut self.frame, &telemetry::hil_state_quaternion(v, home));
+        }
+        push(&mut self.frame, &telemetry::servo_output_raw(v));
+        push(&mut self.frame, &telemetry::wind_cov(v));
+        if !has_frame {
+            let (name, clock) = (v.kind.frame_name(), v.clock_us);
+            for m in crate::task_frame::messages(name, clock, v.frame()) {
+                push(&mut self.frame, &m);
+            }
+        }
+        if let Err(e) = self.out.write_all(&self.frame) {
             self.failed = true;
             tracing::error!(error = %e, "cannot write the recording: recording stopped");
         }

@@ -154,7 +154,7 @@ impl Sim {
                 self.stats.resets += 1;
                 self.runtime[i].running = false;
                 self.runtime[i].failsafe = false;
-                self.record(i);
+                self.record(i, &[]);
                 let accepted = MavResult::MAV_RESULT_ACCEPTED;
                 self.ack(link, out, i, header, RESET_COMMAND, accepted);
                 if let Some(p) = peer {

@@ -388,9 +388,9 @@ impl Sim {
         self.vehicles[i].step();
         self.stats.physics += start.elapsed();
         self.stats.steps += 1;
-        self.record(i);
         let from = out.len();
         self.push_vehicle_reply(i, peer, out);
+        self.record(i, &out[from..]);
         let v = &mut self.vehicles[i];
         v.last_step = (step != 0).then_some(step);
         v.last_reply.clear();
@@ -431,10 +431,11 @@ impl Sim {
         true
     }
 
-    /// Appends vehicle `i`'s step (or reset) to the recording, if one is made.
-    pub(crate) fn record(&mut self, i: usize) {
+    /// Appends vehicle `i`'s step (or reset) to the recording, if one is made; `reply`: the
+    /// frames already encoded for it (see [`crate::record::Recorder::step`]).
+    pub(crate) fn record(&mut self, i: usize, reply: &[u8]) {
         if let Some(r) = &mut self.recorder {
-            r.step(&mut self.vehicles[i], &self.options.home);
+            r.step(&mut self.vehicles[i], &self.options.home, reply);
         }
     }
 
