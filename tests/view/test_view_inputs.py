@@ -9,6 +9,7 @@ import os
 import socket
 import subprocess
 import sys
+import time
 
 import flyloop  # noqa: F401  (registers the envs)
 import gymnasium as gym
@@ -20,7 +21,7 @@ from flyloop.plot import series_of
 from flyloop.view import Watch, WatchVector
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "sitl"))
-from sitl_client import Client, Sitl  # noqa: E402
+from sitl_client import Client, Sitl, mavlink2  # noqa: E402
 
 
 def run(*args: str, timeout: float = 60, env=None) -> subprocess.CompletedProcess:
@@ -197,3 +198,59 @@ def test_a_browser_that_cannot_start_is_one_line(tmp_path):
     )
     assert out.returncode == 1 and "Traceback" not in out.stderr
     assert f"no Chromium at {tmp_path / 'no-chromium'}" in out.stderr
+
+
+def test_the_view_draws_every_vehicle_of_a_real_time_sitl(binary, tmp_path):
+    """Real time, 3 vehicles, a live view saving what it draws: each vehicle's truth on the
+    simulation clock, its motor commands, and the view's streams turned off again after."""
+    gcs = free_port()
+    sitl = Sitl(binary, "--realtime", "--vehicles", "3", "--gcs", f"127.0.0.1:{gcs}")
+    client = Client(sitl.address)
+    web, grpc = free_port(socket.SOCK_STREAM), free_port(socket.SOCK_STREAM)
+    view = subprocess.Popen(
+        [
+            sys.executable, "-m", "flyloop.view", "--listen", f"127.0.0.1:{gcs}",
+            "--web-port", str(web), "--grpc-port", str(grpc),
+            "--save", str(tmp_path / "rt.rrd"), "--seconds", "4",
+        ],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        view.stdout.readline()  # the URL
+        view.stdout.readline()  # listening: from now on for 4 s
+        end = time.monotonic() + 3.5
+        hover = [(9.81 / 40) ** 0.5] * 4
+        while time.monotonic() < end:  # commands keep the vehicles running (no failsafe)
+            for k in (1, 2, 3):
+                client.send_raw(realtime_controls(client, hover, k))
+            time.sleep(0.05)
+        assert view.wait(timeout=30) == 0, view.stderr.read()
+        # Nobody watches now: the SITL's usual telemetry only, none of the view's streams.
+        after = []
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as gcs_sock:
+            gcs_sock.bind(("127.0.0.1", gcs))
+            gcs_sock.settimeout(0.2)
+            parser, end = mavlink2.MAVLink(None), time.monotonic() + 1.5
+            while time.monotonic() < end:
+                try:
+                    after += parser.parse_buffer(gcs_sock.recv(65536)) or []
+                except TimeoutError:
+                    pass
+        kinds = {m.get_type() for m in after}
+        assert "HEARTBEAT" in kinds and not kinds & {"HIL_STATE_QUATERNION", "SERVO_OUTPUT_RAW"}
+    finally:
+        client.close()
+        sitl.stop()
+    series = series_of(tmp_path / "rt.rrd")
+    for k in (1, 2, 3):
+        t, d = series[f"/position/vehicle{k}/D/truth"]
+        assert len(t) > 20 and np.all(np.diff(t) >= 0) and t[-1] > 1.0, (k, len(t))
+        assert np.median(d) == pytest.approx(-1.5, abs=0.1)  # hover thrust holds the height
+        _, m0 = series[f"/motors/vehicle{k}_command/m0"]
+        assert np.median(m0) == pytest.approx(hover[0], abs=1e-3)  # 1000-2000 us: 0.001
+
+
+def realtime_controls(client, controls, system_id: int) -> bytes:
+    """HIL_ACTUATOR_CONTROLS without the lockstep flag (real time), from vehicle `system_id`."""
+    msg = client.mav.hil_actuator_controls_encode(0, list(controls) + [0.0] * 12, 0, 0)
+    return client.pack(msg, system_id)
