@@ -221,6 +221,11 @@ pub fn wind_cov(v: &Vehicle) -> MavMessage {
 }
 
 pub fn home_position(v: &Vehicle, home: &Home) -> MavMessage {
+    home_position_of(home, v.clock_us)
+}
+
+/// HOME_POSITION of `home` (the local origin) at simulation time `time_usec`.
+pub fn home_position_of(home: &Home, time_usec: u64) -> MavMessage {
     let g = home.global(&nalgebra::Vector3::zeros());
     MavMessage::HOME_POSITION(HOME_POSITION_DATA {
         latitude: g.lat,
@@ -233,7 +238,7 @@ pub fn home_position(v: &Vehicle, home: &Home) -> MavMessage {
         approach_x: 0.0,
         approach_y: 0.0,
         approach_z: 0.0,
-        time_usec: v.clock_us,
+        time_usec,
     })
 }
 

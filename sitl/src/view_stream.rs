@@ -1,5 +1,6 @@
 //! The autopilot modes' ground truth for a live view (`--view ADDR`): HIL_STATE_QUATERNION
-//! every [`VIEW_INTERVAL_US`] of simulation time and a HEARTBEAT every simulated second,
+//! every [`VIEW_INTERVAL_US`] of simulation time, a HEARTBEAT and HOME_POSITION (`--home`)
+//! every simulated second,
 //! over UDP to `python -m flyloop.view --listen ADDR`, which draws it beside the autopilot's
 //! own estimate (docs/view.md). Off unless asked for.
 
@@ -72,6 +73,10 @@ impl ViewStream {
                 mavlink_version: 3,
             });
             self.encoder.push(&mut self.out, 1, &heartbeat);
+            // Where the truth's local frame is (`--home`): the view places the autopilot's
+            // estimate by its origin relative to this.
+            let home = crate::telemetry::home_position_of(&self.home, time_us);
+            self.encoder.push(&mut self.out, 1, &home);
         }
         let k = Kinematics::of_quadrotor(quad);
         let state = hil_state_quaternion_of(&k, &self.home, time_us);

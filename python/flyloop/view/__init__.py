@@ -132,6 +132,10 @@ class Viewer:
                         " --gcs pointed there (default 127.0.0.1:14550)?"
                     )
         finally:
+            # What has arrived is drawn before the end (at most 2 s more).
+            end = time.monotonic() + 2.0
+            while time.monotonic() < end and poll(listeners, timeout=0.0):
+                pass
             for listener in listeners:
                 listener.close()
         return view

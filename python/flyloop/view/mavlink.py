@@ -52,53 +52,64 @@ def enu_to_ned(v) -> list[float]:
 
 @dataclass
 class _Vehicle:
+    """A vehicle flyloop simulates (its truth), by system id."""
+
     frame: Frame | None = None
     home: tuple[float, float, float] = DEFAULT_HOME
     position: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     arrays: dict[int, list[float]] = field(default_factory=dict)
     arrays_time: int = -1
     truth_seen: bool = False
-    estimate_position: list[float] | None = None
-    estimate_time: float = 0.0
-    # The autopilot's local origin in the truth's frame (NED from home, m): from its
+
+
+@dataclass
+class _Autopilot:
+    """An autopilot's estimate (by where it comes from and its system id)."""
+
+    position: list[float] | None = None
+    # Its local origin in the truth's frame (NED from the truth's home, m): from its
     # GPS_GLOBAL_ORIGIN; zero until it says.
-    estimate_origin: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    origin: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
 
 
 class MavlinkScene:
-    """Draws what MAVLink messages say. `handle(msg)` with a decoded pymavlink message; the
-    time is the message's simulation time (the SITL's and the autopilot's clocks are the
-    same in every mode: lockstep, PX4's simulator and ArduPilot's JSON link)."""
+    """Draws what MAVLink messages say: `handle(msg, source)` with a decoded pymavlink message
+    and where it came from (a flyloop-sitl and a PX4 may both be system 1). The time is the
+    message's simulation time (the SITL's and the autopilot's clocks are the same in every
+    mode: lockstep, PX4's simulator and ArduPilot's JSON link)."""
 
     def __init__(self, scene: Scene) -> None:
         self.scene = scene
-        self.autopilot: dict[int, int] = {}  # system id -> MAV_AUTOPILOT of its HEARTBEAT
+        self.kinds: dict[tuple, int] = {}  # (source, system id) -> MAV_AUTOPILOT of its HEARTBEAT
         self.vehicles: dict[int, _Vehicle] = {}
+        self.autopilots: dict[tuple, _Autopilot] = {}
         self.truth_messages = 0
         self.estimate_messages = 0
 
     def _vehicle(self, sysid: int) -> _Vehicle:
         return self.vehicles.setdefault(sysid, _Vehicle())
 
-    def is_autopilot(self, sysid: int) -> bool:
-        return self.autopilot.get(sysid, GENERIC) != GENERIC
+    def is_autopilot(self, key: tuple) -> bool:
+        return self.kinds.get(key, GENERIC) != GENERIC
 
-    def handle(self, msg) -> None:
-        kind = msg.get_type()
-        sysid = msg.get_srcSystem()
-        handler = getattr(self, "_on_" + kind.lower(), None)
+    def handle(self, msg, source=None) -> None:
+        handler = getattr(self, "_on_" + msg.get_type().lower(), None)
         if handler is not None:
-            handler(sysid, msg)
+            handler((source, msg.get_srcSystem()), msg)
 
-    def _on_heartbeat(self, sysid: int, m) -> None:
+    def _on_heartbeat(self, key: tuple, m) -> None:
         if m.autopilot != mavlink2.MAV_AUTOPILOT_INVALID:  # a ground station's own heartbeat
-            self.autopilot.setdefault(sysid, m.autopilot)
+            self.kinds[key] = m.autopilot
 
-    def _on_home_position(self, sysid: int, m) -> None:
-        if not self.is_autopilot(sysid):
-            self._vehicle(sysid).home = (m.latitude / 1e7, m.longitude / 1e7, m.altitude / 1e3)
+    # ---- flyloop's truth ----
 
-    def _on_hil_state_quaternion(self, sysid: int, m) -> None:
+    def _on_home_position(self, key: tuple, m) -> None:
+        if not self.is_autopilot(key):
+            home = (m.latitude / 1e7, m.longitude / 1e7, m.altitude / 1e3)
+            self._vehicle(key[1]).home = home
+
+    def _on_hil_state_quaternion(self, key: tuple, m) -> None:
+        sysid = key[1]
         v = self._vehicle(sysid)
         lat0, lon0, alt0 = v.home
         north = math.radians(m.lat / 1e7 - lat0) * EARTH_RADIUS
@@ -107,42 +118,41 @@ class MavlinkScene:
         v.truth_seen = True
         self.scene.time(m.time_usec / 1e6)
         rates = (m.rollspeed, m.pitchspeed, m.yawspeed)
+        frame = v.frame or Frame.quad_x()
         self.scene.vehicle(
-            f"vehicle{sysid}",
-            v.position,
-            m.attitude_quaternion,
-            v.frame or Frame.quad_x(),
-            rates_frd=rates,
+            f"vehicle{sysid}", v.position, m.attitude_quaternion, frame, rates_frd=rates
         )
         self.truth_messages += 1
 
-    def _on_servo_output_raw(self, sysid: int, m) -> None:
+    def _on_servo_output_raw(self, key: tuple, m) -> None:
         raw = [getattr(m, f"servo{i}_raw") for i in range(1, 17)]
-        v = self._vehicle(sysid)
-        if self.is_autopilot(sysid):  # its motors are the frame's first outputs
+        if self.is_autopilot(key):  # its motors are the frame's first outputs
+            v = self._vehicle(self._truth_of(key))
+            name = f"vehicle{self._truth_of(key)}_autopilot"
             raw = raw[: len(v.frame.spins) if v.frame else 4]
-        elif sysid not in self.autopilot and not v.truth_seen:
-            return  # a system not yet heard of: maybe an autopilot before its HEARTBEAT
+        else:
+            v = self._vehicle(key[1])
+            if key not in self.kinds and not v.truth_seen:
+                return  # from a system not yet heard of: maybe an autopilot before its HEARTBEAT
+            name = f"vehicle{key[1]}_command"
+            self.scene.time(m.time_usec / 1e6)
         used = [r for r in raw if r]
         if v.frame is None and used:
             v.frame = Frame.for_motors(len(used))
-        if self.is_autopilot(sysid):
-            name = f"vehicle{self._truth_of(sysid)}_autopilot"
-        else:
-            self.scene.time(m.time_usec / 1e6)
-            name = f"vehicle{sysid}_command"
         self.scene.motors(name, [(r - 1000) / 1000 for r in used])
 
-    def _on_wind_cov(self, sysid: int, m) -> None:
-        if self.is_autopilot(sysid):
+    def _on_wind_cov(self, key: tuple, m) -> None:
+        if self.is_autopilot(key):
             return
         self.scene.time(m.time_usec / 1e6)
-        self.scene.wind(
-            f"vehicle{sysid}", self._vehicle(sysid).position, [m.wind_x, m.wind_y, m.wind_z]
-        )
+        position = self._vehicle(key[1]).position
+        self.scene.wind(f"vehicle{key[1]}", position, [m.wind_x, m.wind_y, m.wind_z])
 
-    def _on_debug_float_array(self, sysid: int, m) -> None:
+    def _on_debug_float_array(self, key: tuple, m) -> None:
         """The task frame: its arrays gathered (protocol.md §6), then reward, ends, target."""
+        if self.is_autopilot(key):
+            return
+        sysid = key[1]
         v = self._vehicle(sysid)
         if m.time_usec != v.arrays_time:
             v.arrays, v.arrays_time = {}, m.time_usec
@@ -169,27 +179,36 @@ class MavlinkScene:
 
     # ---- an autopilot's estimate ----
 
-    def _on_gps_global_origin(self, sysid: int, m) -> None:
-        if self.is_autopilot(sysid):
-            lat0, lon0, alt0 = DEFAULT_HOME
-            north = math.radians(m.latitude / 1e7 - lat0) * EARTH_RADIUS
-            east = (
-                math.radians(m.longitude / 1e7 - lon0) * EARTH_RADIUS * math.cos(math.radians(lat0))
-            )
-            self._vehicle(sysid).estimate_origin = [north, east, -(m.altitude / 1e3 - alt0)]
+    def _truth_of(self, key: tuple) -> int:
+        """The truth an autopilot's estimate is drawn beside: the vehicle with its system id,
+        else the only one flyloop sends (PX4 instance i has system id i + 1, flyloop's
+        --view stream 1)."""
+        truths = [s for s, v in self.vehicles.items() if v.truth_seen]
+        return truths[0] if key[1] not in truths and len(truths) == 1 else key[1]
 
-    def _on_local_position_ned(self, sysid: int, m) -> None:
-        if self.is_autopilot(sysid):
-            v = self._vehicle(sysid)
-            o = v.estimate_origin
-            v.estimate_position = [m.x + o[0], m.y + o[1], m.z + o[2]]
-            v.estimate_time = m.time_boot_ms / 1e3
+    def _on_gps_global_origin(self, key: tuple, m) -> None:
+        """The autopilot's local origin, as NED from the truth's home. One more than 1 km
+        away means the two were given different homes (e.g. ArduPilot's own --home): both
+        frames then start at the vehicle's start point, and the offset is taken as 0."""
+        if not self.is_autopilot(key):
+            return
+        lat0, lon0, alt0 = self._vehicle(self._truth_of(key)).home
+        north = math.radians(m.latitude / 1e7 - lat0) * EARTH_RADIUS
+        east = math.radians(m.longitude / 1e7 - lon0) * EARTH_RADIUS * math.cos(math.radians(lat0))
+        origin = [north, east, -(m.altitude / 1e3 - alt0)]
+        if math.hypot(*origin) < 1000.0:
+            self.autopilots.setdefault(key, _Autopilot()).origin = origin
 
-    def _on_attitude_quaternion(self, sysid: int, m) -> None:
-        self._estimate(sysid, m.time_boot_ms / 1e3, [m.q1, m.q2, m.q3, m.q4])
+    def _on_local_position_ned(self, key: tuple, m) -> None:
+        if self.is_autopilot(key):
+            a = self.autopilots.setdefault(key, _Autopilot())
+            a.position = [m.x + a.origin[0], m.y + a.origin[1], m.z + a.origin[2]]
 
-    def _on_attitude(self, sysid: int, m) -> None:
-        if self.autopilot.get(sysid) == mavlink2.MAV_AUTOPILOT_ARDUPILOTMEGA:
+    def _on_attitude_quaternion(self, key: tuple, m) -> None:
+        self._estimate(key, m.time_boot_ms / 1e3, [m.q1, m.q2, m.q3, m.q4])
+
+    def _on_attitude(self, key: tuple, m) -> None:
+        if self.kinds.get(key) == mavlink2.MAV_AUTOPILOT_ARDUPILOTMEGA:
             cr, sr = math.cos(m.roll / 2), math.sin(m.roll / 2)
             cp, sp = math.cos(m.pitch / 2), math.sin(m.pitch / 2)
             cy, sy = math.cos(m.yaw / 2), math.sin(m.yaw / 2)
@@ -199,24 +218,17 @@ class MavlinkScene:
                 cr * sp * cy + sr * cp * sy,
                 cr * cp * sy - sr * sp * cy,
             ]
-            self._estimate(sysid, m.time_boot_ms / 1e3, q)
+            self._estimate(key, m.time_boot_ms / 1e3, q)
 
-    def _estimate(self, sysid: int, t_s: float, q) -> None:
-        v = self._vehicle(sysid)
-        if not self.is_autopilot(sysid) or v.estimate_position is None:
+    def _estimate(self, key: tuple, t_s: float, q) -> None:
+        a = self.autopilots.get(key)
+        if not self.is_autopilot(key) or a is None or a.position is None:
             return
         self.scene.time(t_s)
-        frame = v.frame or Frame.quad_x()
-        name = f"vehicle{self._truth_of(sysid)}"
-        self.scene.vehicle(name, v.estimate_position, q, frame, estimate=True)
+        truth = self._vehicle(self._truth_of(key))
+        frame = truth.frame or Frame.quad_x()
+        self.scene.vehicle(f"vehicle{self._truth_of(key)}", a.position, q, frame, estimate=True)
         self.estimate_messages += 1
-
-    def _truth_of(self, sysid: int) -> int:
-        """The truth an autopilot's estimate is drawn beside: the vehicle with its system id,
-        else the only one flyloop sends (PX4 instance i has system id i + 1, flyloop's
-        --view stream 1)."""
-        truths = [s for s, v in self.vehicles.items() if v.truth_seen]
-        return truths[0] if sysid not in truths and len(truths) == 1 else sysid
 
 
 def _decode(parser, data: bytes) -> list:
@@ -273,7 +285,7 @@ class Listener:
             parser = self.peers.setdefault(peer, mavlink2.MAVLink(None))
             for msg in _decode(parser, data):
                 n += 1
-                self.view.handle(msg)
+                self.view.handle(msg, peer)
                 if msg.get_type() == "HEARTBEAT" and peer not in self.asked:
                     if msg.autopilot == GENERIC:
                         self._ask(peer, STREAM_INTERVAL_US)
