@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from flyloop.plot import series_of
+from flyloop.plot import series_of, series_of_ulg
 from flyloop.view.screenshot import Browser, hub_pixels
 from px4_support import TAKEOFF_ALT, settle
 
@@ -72,5 +72,18 @@ def test_px4_takeoff_in_the_live_view_with_the_estimate_beside_the_truth(pair, t
     assert -d_true.min() > TAKEOFF_ALT - 0.5
     _, n_estimate = series["/position/vehicle1/N/estimate"]
     assert np.isfinite(n_estimate).all()
+
+    # docs/view.md's plot with PX4's own log (.ulg, written while armed): its estimate beside
+    # the truth (its local frame's origin is about home: 0.6 m allowed).
+    ulg = sorted((Path(px4.log.name).parent / "log").glob("*/*.ulg"))[-1]
+    png = tmp_path / "px4_plot.png"
+    plot = ["-m", "flyloop.plot", str(tmp_path / "px4.rrd"), "--ulg", str(ulg), "-o", str(png)]
+    plotted = subprocess.run([sys.executable, *plot], capture_output=True, text=True, timeout=120)
+    assert plotted.returncode == 0 and png.stat().st_size > 20_000, plotted.stderr
+    t_ulg, d_ulg = series_of_ulg(ulg)["/position/vehicle1/D/estimate"]
+    up = t_ulg[(t_ulg >= t_true[0]) & (t_ulg <= t_true[-1]) & (-d_ulg > 1.0)]
+    assert len(up) > 100
+    gap = np.abs(np.interp(up, t_ulg, d_ulg) - np.interp(up, t_true, d_true))
+    assert gap.max() < 0.6, gap.max()
     assert n_ground >= 30, "no vehicle drawn"
     assert risen > 40, f"the vehicle did not take off on the screen: {tmp_path / 'px4.png'}"

@@ -139,7 +139,8 @@ class MavlinkScene:
         used = [r for r in raw if r]
         if v.frame is None and used:
             v.frame = Frame.for_motors(len(used))
-        self.scene.motors(name, [(r - 1000) / 1000 for r in used])
+        # Below 1000 us (PX4's disarmed 900) is off: 0.
+        self.scene.motors(name, [max(0.0, (r - 1000) / 1000) for r in used])
 
     def _on_wind_cov(self, key: tuple, m) -> None:
         if self.is_autopilot(key):
