@@ -34,7 +34,7 @@ pub mod snapshot;
 pub mod tasks;
 pub mod variables;
 
-pub use error::{InputError, ParamError, Role};
+pub use error::{CommandError, InputError, ParamError, Role};
 pub use params::{ParamSpec, Parameters, ValueKind};
 pub use rng::SimRng;
 pub use snapshot::SnapshotError;

@@ -11,8 +11,11 @@ A fenced block is checked when the line before it is a marker comment:
 - ``<!-- check: doctest FILE -->``: the Rust block is the doc example of FILE (run by
   ``cargo test --doc``), line for line.
 - ``<!-- check: tested-by PATH -->``: the commands run in the tests under PATH (too long
-  for this file); every script the block names must appear there (or be a test file there).
+  for this file); every script and preset (``.py``, ``.toml``, ``.parm``) the block names must
+  appear there (or be a test file there).
 - ``<!-- check: sitl-config -->``: the TOML block is a ``--config`` file flyloop-sitl accepts.
+- ``<!-- check: autopilot-config -->``: the TOML block is a ``--config`` file of the PX4 and
+  ArduPilot modes (vehicle parameters and a ``[frame]``) that flyloop-sitl accepts.
 - ``<!-- check: ci -->``: the README's two top commands; ``.ci/run`` runs each line as written.
 
 Every fenced block carries a marker: a block without one fails. Beyond the blocks: the README
@@ -117,7 +120,7 @@ def environment(sitl: Path) -> dict[str, str]:
 
 def test_the_markers_are_known_and_the_core_blocks_are_checked():
     known = {"run", "python", "python-sitl", "sitl-commands", "doctest", "tested-by", "ci"}
-    known.add("sitl-config")
+    known.update({"sitl-config", "autopilot-config"})
     assert {b.kind for b in ALL if b.kind} <= known
     unchecked = [f"{b.where} ({b.language})" for b in ALL if b.kind is None]
     assert not unchecked, f"blocks that no test or CI step runs: {unchecked}"
@@ -320,8 +323,9 @@ def test_long_commands_are_run_by_their_tests(block: Block):
     tests = sorted((REPO / block.argument).rglob("*.py"))
     assert tests, block.argument
     corpus = "\n".join(t.read_text() for t in tests)
+    named = (".py", ".toml", ".parm")
     words = [shlex.split(c) for c in commands(block)]
-    scripts = {w for c in words for w in c if w.endswith(".py")}
+    scripts = {w for c in words for w in c if w.endswith(named)}
     # `python -m MODULE`: a test that runs the module names it as "MODULE".
     modules = {c[i + 1] for c in words for i, w in enumerate(c[:-1]) if w == "-m"}
     assert scripts or modules
@@ -334,6 +338,23 @@ def test_long_commands_are_run_by_their_tests(block: Block):
         assert is_a_test or Path(script).name in corpus, (
             f"{block.where}: {script} is run by no test in {block.argument}"
         )
+
+
+@pytest.mark.parametrize("block", of_kind("autopilot-config"), ids=lambda b: b.id)
+def test_frame_configs_are_accepted_by_the_autopilot_modes(
+    block: Block, sitl_binary: Path, tmp_path: Path
+):
+    config = tmp_path / "vehicle.toml"
+    config.write_text(block.text)
+    result = subprocess.run(
+        [str(sitl_binary), "--config", str(config), "--print-autopilot-params", "px4"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert result.returncode == 0, f"{block.where}: {result.stderr}"
+    rotors = block.text.count("[[frame.rotor]]")
+    assert f"CA_ROTOR_COUNT {rotors}\n" in result.stdout, result.stdout
 
 
 @pytest.mark.parametrize("block", of_kind("sitl-config"), ids=lambda b: b.id)

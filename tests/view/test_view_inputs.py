@@ -254,3 +254,15 @@ def realtime_controls(client, controls, system_id: int) -> bytes:
     """HIL_ACTUATOR_CONTROLS without the lockstep flag (real time), from vehicle `system_id`."""
     msg = client.mav.hil_actuator_controls_encode(0, list(controls) + [0.0] * 12, 0, 0)
     return client.pack(msg, system_id)
+
+
+@pytest.mark.parametrize("n", [2, 4, 6, 8])
+def test_frames_drawn_for_each_motor_count(n):
+    """The lander (2), quad X (4), hexa X (6), octo X (8): rotors at the arm's length (the
+    lander's at half its width), spins balanced (as many CW as CCW)."""
+    from flyloop.view.scene import Frame
+
+    f = Frame.for_motors(n)
+    assert len(f.rotors) == len(f.spins) == n and sum(f.spins) == 0
+    radii = np.linalg.norm(f.rotors, axis=1)
+    assert np.allclose(radii, radii[0]) and radii[0] > 0

@@ -34,6 +34,22 @@ DRAW_SCALE = 3.0  # vehicles are drawn this many times their size (a 0.1 m arm i
 GROUND_HALF = 5.0  # m: the ground grid is ±this around home
 
 
+_S60, _C22, _S22 = math.sin(math.pi / 3), math.cos(math.pi / 8), math.sin(math.pi / 8)
+# The core's shipped hexa X and octo X (core/src/quadrotor/frame.rs, PX4's motor order):
+# (forward, left) in arm lengths and spin (+1 CW, -1 CCW), until the extension exposes the
+# core's rotor tables; the quad X comes from rendering's ROTOR_POSITION_SIGNS.
+SHIPPED = {
+    6: [
+        (0, -1, 1), (0, 1, -1), (_S60, 0.5, 1),
+        (-_S60, -0.5, -1), (_S60, -0.5, -1), (-_S60, 0.5, 1),
+    ],
+    8: [
+        (_C22, -_S22, 1), (-_C22, _S22, 1), (_S22, -_C22, -1), (-_C22, -_S22, -1),
+        (_C22, _S22, -1), (-_S22, _C22, -1), (_S22, _C22, 1), (-_S22, -_C22, 1),
+    ],
+}  # fmt: skip
+
+
 @dataclass(frozen=True)
 class Frame:
     """A vehicle's geometry in the body frame FRD: rotor centres (n, 3) m and spins (n,)
@@ -57,7 +73,18 @@ class Frame:
         return Frame(rotors, (-1, 1), 0.15 * width)
 
     @staticmethod
+    def table(rows, arm_length: float = HOVER.defaults["arm_length"]) -> Frame:
+        """From rotor rows (forward, left in arm lengths, spin +1 CW / -1 CCW), body FLU."""
+        fl = np.array([(forward, left) for forward, left, _ in rows]) * arm_length
+        rotors = np.c_[fl[:, 0], -fl[:, 1], np.zeros(len(fl))]
+        return Frame(rotors, tuple(spin for _, _, spin in rows), 0.3 * arm_length)
+
+    @staticmethod
     def for_motors(n: int) -> Frame:
+        """The frame a vehicle with `n` motor outputs flies: the lander (2), the quad X (4),
+        the core's hexa X (6) or octo X (8)."""
+        if n in SHIPPED:
+            return Frame.table(SHIPPED[n])
         return Frame.lander() if n == 2 else Frame.quad_x()
 
 

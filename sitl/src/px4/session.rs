@@ -55,7 +55,8 @@ impl Session {
     /// The vehicle at rest on its landing gear at the origin, facing north.
     pub fn new(options: &SessionOptions) -> Result<Self, ParamError> {
         let c = &options.vehicle;
-        let mut quad = Quadrotor::standing(c.quadrotor.clone(), options.seed)?;
+        let mut quad =
+            Quadrotor::standing(c.quadrotor.clone(), options.seed)?.with_frame(c.frame.clone());
         // One step with the motors off: the state PX4's first controls meet.
         quad.step(options.step_us.max(1) as f64 * 1e-6);
         let sensors = Sensors::new(c.sensors.clone(), options.seed)?;
@@ -162,11 +163,12 @@ impl Session {
         steps
     }
 
-    /// Motor commands from controls[0..4]; a non-finite one refuses the whole set (counted),
-    /// and the previous command holds.
+    /// Motor commands from controls[0..n], one per rotor (PX4's motor n is the frame's rotor
+    /// n); a non-finite one refuses the whole set (counted), and the previous command holds.
     fn apply_controls(&mut self, controls: &[f32; 16]) {
-        let command = [0, 1, 2, 3].map(|i| f64::from(controls[i]));
-        if let Err(e) = self.quad.set_command(command) {
+        let n = self.quad.frame().rotor_count();
+        let command: Vec<f64> = controls[..n].iter().map(|&c| f64::from(c)).collect();
+        if let Err(e) = self.quad.set_command(&command) {
             self.stats.refused_controls += 1;
             tracing::warn!(
                 refused = self.stats.refused_controls,
