@@ -79,6 +79,15 @@ def steps_per_second(sitl_args: list[str], seconds: float) -> tuple[float, float
         proc.wait(timeout=10)
 
 
+def summary(results: dict[str, list[float]], unit: str, fmt: str) -> None:
+    """Each set-up's mean, as a ratio to the base's, and its rounds."""
+    base = sum(results["base"]) / len(results["base"])
+    for name, values in results.items():
+        mean = sum(values) / len(values)
+        rounds = ", ".join(format(x, fmt) for x in values)
+        print(f"{name:6s} mean {mean:{fmt}} {unit} = {mean / base:.3f} of base ({rounds})")
+
+
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--seconds", type=float, default=5.0)
@@ -138,20 +147,8 @@ def main() -> int:
                     f"round {r + 1} {name:6s} {rate:8.0f} steps/s, SITL CPU {cpu_us:5.1f} us/step"
                 )
                 print(line + extra, flush=True)
-    base = sum(results["base"]) / len(results["base"])
-    for name, rates in results.items():
-        mean = sum(rates) / len(rates)
-        print(
-            f"{name:6s} mean {mean:8.0f} steps/s = {mean / base:.3f} of base"
-            f" ({', '.join(f'{x:.0f}' for x in rates)})"
-        )
-    base_cpu = sum(cpu["base"]) / len(cpu["base"])
-    for name, values in cpu.items():
-        mean = sum(values) / len(values)
-        print(
-            f"{name:6s} SITL CPU {mean:5.1f} us/step = {mean / base_cpu:.3f} of base"
-            f" ({', '.join(f'{x:.1f}' for x in values)})"
-        )
+    summary(results, "steps/s", ".0f")
+    summary(cpu, "us/step SITL CPU", ".1f")
     print(f"load {os.getloadavg()[0]:.2f} at the end")
     return 0
 
