@@ -9,7 +9,11 @@ PX4 SITL build from $FLYLOOP_PX4 (PX4_SIM_SPEED_FACTOR=--px4-speed), arms it, ta
 - flyloop's CPU per 4 ms step, and its own work per step (physics + sensors + encoding, from
   its counters: no socket calls).
 
-    FLYLOOP_PX4=... .venv/bin/python benchmarks/px4_speed.py [--seconds 10] [--px4-speed 10]
+    FLYLOOP_PX4=... .venv/bin/python benchmarks/px4_speed.py [--seconds 10] [--px4-speed 10] \
+        [--view]
+
+`--view`: the same with the live view connected (flyloop-sitl --view, `python -m flyloop.view`
+talking to PX4's ground-station port for its estimate: docs/view.md), to measure its cost.
 
 Run it on a quiet machine (nothing compiling).
 """
@@ -18,6 +22,9 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
+import socket
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -38,6 +45,12 @@ def cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / TICK
 
 
+def _free_port(kind: int) -> int:
+    with socket.socket(socket.AF_INET, kind) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
 def position_time_ms(px4) -> int:
     return px4.estimate().time_ms
 
@@ -46,16 +59,31 @@ def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--seconds", type=float, default=10.0)
     parser.add_argument("--px4-speed", type=int, default=10)
+    parser.add_argument("--view", action="store_true", help="with the live view connected")
     args = parser.parse_args()
     px4_support.SPEED = args.px4_speed
     root = px4_support.px4_root(px4_support.fresh_dir("px4-build-"))
     instance = px4_support.free_instance()
     work = px4_support.fresh_dir("px4-bench-")
     # Unpaced: each step as soon as PX4 answers.
-    flyloop = px4_support.Flyloop(find_sitl_binary(), instance, work, speed=0)
+    view_args = view = None
+    if args.view:
+        truth = _free_port(socket.SOCK_DGRAM)
+        view_args = ["--view", f"127.0.0.1:{truth}"]
+    flyloop = px4_support.Flyloop(find_sitl_binary(), instance, work, *(view_args or []), speed=0)
     px4 = None
     try:
         px4 = px4_support.Px4(root, instance, px4_support.fresh_dir("px4-work-"))
+        if args.view:
+            view = subprocess.Popen(
+                [
+                    sys.executable, "-m", "flyloop.view", "--listen", f"127.0.0.1:{truth}",
+                    "--connect", f"127.0.0.1:{18570 + instance}", "--wait", "120",
+                    "--web-port", str(_free_port(socket.SOCK_STREAM)),
+                    "--grpc-port", str(_free_port(socket.SOCK_STREAM)),
+                ],
+                stdout=subprocess.DEVNULL,
+            )  # fmt: skip
         px4.heartbeat(60)
         px4.arm_when_ready(60)
         px4.takeoff()
@@ -72,6 +100,8 @@ def main() -> None:
     finally:
         if px4 is not None:
             px4.kill()
+        if view is not None:
+            px4_support.stop(view, signal.SIGINT)
         flyloop.stop()
     sim = (sim1 - sim0) / 1000
     wall = wall1 - wall0
@@ -79,6 +109,7 @@ def main() -> None:
     steps = sim / 0.004
     stats = flyloop.stderr().split("stopped: ", 1)[1].split()
     counters = dict(kv.split("=") for kv in stats)
+    print(f"with the live view: {args.view}; load {os.getloadavg()[0]:.2f}")
     print(f"real-time factor: {sim / wall:.1f}x ({sim:.1f} simulated s in {wall:.1f} wall s)")
     share = 100 * fly_cpu / px4_cpu
     print(f"CPU: flyloop {fly_cpu:.2f} s, PX4 {px4_cpu:.2f} s, flyloop/PX4 = {share:.1f} %")

@@ -38,6 +38,16 @@ enum StartError {
         path: std::path::PathBuf,
         source: std::io::Error,
     },
+    #[error("cannot open a socket to send to the view at {target}: {source}")]
+    View {
+        target: SocketAddr,
+        source: std::io::Error,
+    },
+    #[error("cannot write the recording {path}: {source}")]
+    Record {
+        path: std::path::PathBuf,
+        source: std::io::Error,
+    },
     #[error("cannot start the runtime: {0}")]
     Runtime(#[from] std::io::Error),
 }
@@ -115,6 +125,9 @@ fn start_px4(args: Args) -> Result<(), StartError> {
     })?;
     if let Some(track) = track(&args, session.quadrotor().frame().rotor_count())? {
         session.track.set(track);
+    }
+    if let Some(view) = view_stream(&args)? {
+        session.track.set_view(view);
     }
     let listener =
         std::net::TcpListener::bind(args.px4_listen).map_err(|source| StartError::Bind {
@@ -202,6 +215,16 @@ fn track(args: &Args, rotors: usize) -> Result<Option<Track>, StartError> {
     Ok(Some(track))
 }
 
+/// The live view's stream of the autopilot modes (`--view`), if asked for.
+fn view_stream(args: &Args) -> Result<Option<crate::view_stream::ViewStream>, StartError> {
+    let Some(target) = args.view else {
+        return Ok(None);
+    };
+    let stream = crate::view_stream::ViewStream::new(target, args.home)
+        .map_err(|source| StartError::View { target, source })?;
+    Ok(Some(stream))
+}
+
 /// The vehicle of the autopilot modes: `--config`, else the Iris preset.
 fn vehicle_config(args: &Args) -> Result<AutopilotVehicle, StartError> {
     Ok(match &args.config {
@@ -220,6 +243,9 @@ fn start_ardupilot(args: Args) -> Result<(), StartError> {
     })?;
     if let Some(track) = track(&args, session.quadrotor().frame().rotor_count())? {
         session.track.set(track);
+    }
+    if let Some(view) = view_stream(&args)? {
+        session.track.set_view(view);
     }
     let socket =
         std::net::UdpSocket::bind(args.ardupilot_listen).map_err(|source| StartError::Bind {
@@ -249,6 +275,12 @@ fn start_ardupilot(args: Args) -> Result<(), StartError> {
 }
 
 fn start(args: Args) -> Result<(), StartError> {
+    if (args.px4 || args.ardupilot) && args.record.is_some() {
+        return Err(StartError::Options(
+            "--record is for lockstep and real time; PX4 and ArduPilot mode record with --track"
+                .to_string(),
+        ));
+    }
     if let Some(autopilot) = args.print_autopilot_params {
         let vehicle = vehicle_config(&args)?;
         let text = match autopilot {
@@ -304,7 +336,15 @@ fn start_mavlink(args: Args, task: TaskKind, config: TaskConfig) -> Result<(), S
     options.state_in_reply = !args.no_state_reply;
     options.failsafe_timeout = args.failsafe_timeout();
     options.state_rate_hz = args.state_rate;
-    let sim = Sim::new(options, Instant::now())?;
+    let mut sim = Sim::new(options, Instant::now())?;
+    if let Some(path) = &args.record {
+        let recorder =
+            crate::record::Recorder::create(path).map_err(|source| StartError::Record {
+                path: path.clone(),
+                source,
+            })?;
+        sim.recorder = Some(recorder);
+    }
 
     let controller = bind("controller", args.listen)?;
     let gcs = match args.gcs {

@@ -120,6 +120,16 @@ pub struct Args {
     #[arg(long)]
     pub track: Option<PathBuf>,
 
+    /// PX4 and ArduPilot modes: send the ground truth (HIL_STATE_QUATERNION at 50 Hz of
+    /// simulation time) to a live view listening at this UDP address (docs/view.md).
+    #[arg(long)]
+    pub view: Option<SocketAddr>,
+
+    /// Lockstep and real time: record every step of every vehicle (motor command, ground
+    /// truth, wind, task frame) to this MAVLink telemetry log (.tlog; docs/view.md).
+    #[arg(long)]
+    pub record: Option<PathBuf>,
+
     /// PX4 and ArduPilot modes: simulation time between two rows of the track, µs (4000 =
     /// every PX4 step).
     #[arg(long, default_value_t = crate::track::TRACK_INTERVAL_US, value_parser = clap::value_parser!(u64).range(1..))]

@@ -18,8 +18,15 @@ pub const DEFAULT_STREAMS: &[(u32, Duration)] = &[
     (id::HOME_POSITION, Duration::from_secs(5)),
 ];
 
-/// Messages that may be streamed on request but are off by default.
-const OPTIONAL_STREAMS: &[u32] = &[id::HIL_STATE_QUATERNION, id::AUTOPILOT_VERSION];
+/// Messages that may be streamed on request but are off by default (a live view asks for
+/// the truth, the motor commands, the wind and the task frame: docs/view.md).
+const OPTIONAL_STREAMS: &[u32] = &[
+    id::HIL_STATE_QUATERNION,
+    id::AUTOPILOT_VERSION,
+    id::SERVO_OUTPUT_RAW,
+    id::WIND_COV,
+    id::DEBUG_FLOAT_ARRAY,
+];
 
 /// Shortest interval accepted (50 Hz).
 const MIN_INTERVAL: Duration = Duration::from_millis(20);

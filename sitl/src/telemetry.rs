@@ -14,10 +14,12 @@ pub mod id {
     pub const SYS_STATUS: u32 = 1;
     pub const ATTITUDE: u32 = 30;
     pub const LOCAL_POSITION_NED: u32 = 32;
+    pub const SERVO_OUTPUT_RAW: u32 = 36;
     pub const GLOBAL_POSITION_INT: u32 = 33;
     pub const VFR_HUD: u32 = 74;
     pub const HIL_STATE_QUATERNION: u32 = 115;
     pub const AUTOPILOT_VERSION: u32 = 148;
+    pub const WIND_COV: u32 = 231;
     pub const HOME_POSITION: u32 = 242;
     pub const DEBUG_FLOAT_ARRAY: u32 = 350;
 }
@@ -148,17 +150,19 @@ pub fn local_position_ned(v: &Vehicle) -> MavMessage {
     })
 }
 
+/// The motor commands as fractions of their range, [0, 1] (the lander's [−1, 1] too).
+fn command_fractions(v: &Vehicle) -> impl Iterator<Item = f64> + '_ {
+    let (lo, hi) = v.task.action_bounds();
+    v.command
+        .iter()
+        .zip(lo.into_iter().zip(hi))
+        .map(|(c, (l, h))| (c - l) / (h - l))
+}
+
 pub fn vfr_hud(v: &Vehicle, home: &Home) -> MavMessage {
     let k = v.task.kinematics();
     let n = v.command.len().max(1) as f64;
-    let (lo, hi) = v.task.action_bounds();
-    let throttle: f64 = v
-        .command
-        .iter()
-        .zip(lo.iter().zip(&hi))
-        .map(|(c, (l, h))| (c - l) / (h - l))
-        .sum::<f64>()
-        / n;
+    let throttle = command_fractions(v).sum::<f64>() / n;
     MavMessage::VFR_HUD(VFR_HUD_DATA {
         airspeed: k.airspeed() as f32,
         groundspeed: k.velocity.xy().norm() as f32,
@@ -169,7 +173,59 @@ pub fn vfr_hud(v: &Vehicle, home: &Home) -> MavMessage {
     })
 }
 
+/// The motor commands in effect as PWM µs, 1000 (off / the range's low end) to 2000, in the
+/// actuator-channel order of protocol.md §4; unused channels 0. `time_usec` is the
+/// simulation time (µs, wrapping at 2^32 as the field is 32 bits).
+pub fn servo_output_raw(v: &Vehicle) -> MavMessage {
+    let mut pwm = [0u16; 16];
+    for (p, f) in pwm.iter_mut().zip(command_fractions(v)) {
+        *p = round_u16(1000.0 + 1000.0 * f.clamp(0.0, 1.0));
+    }
+    MavMessage::SERVO_OUTPUT_RAW(SERVO_OUTPUT_RAW_DATA {
+        time_usec: v.clock_us as u32,
+        servo1_raw: pwm[0],
+        servo2_raw: pwm[1],
+        servo3_raw: pwm[2],
+        servo4_raw: pwm[3],
+        servo5_raw: pwm[4],
+        servo6_raw: pwm[5],
+        servo7_raw: pwm[6],
+        servo8_raw: pwm[7],
+        port: 0,
+        servo9_raw: pwm[8],
+        servo10_raw: pwm[9],
+        servo11_raw: pwm[10],
+        servo12_raw: pwm[11],
+        servo13_raw: pwm[12],
+        servo14_raw: pwm[13],
+        servo15_raw: pwm[14],
+        servo16_raw: pwm[15],
+    })
+}
+
+/// The wind at the vehicle (velocity − air velocity), world NED, m/s, at simulation time.
+pub fn wind_cov(v: &Vehicle) -> MavMessage {
+    let k = Kinematics::of_task(&v.task);
+    let wind = crate::kinematics::enu_to_ned(&(k.velocity - k.air_velocity));
+    MavMessage::WIND_COV(WIND_COV_DATA {
+        time_usec: v.clock_us,
+        wind_x: wind.x as f32,
+        wind_y: wind.y as f32,
+        wind_z: wind.z as f32,
+        var_horiz: 0.0,
+        var_vert: 0.0,
+        wind_alt: k.position.z as f32,
+        horiz_accuracy: 0.0,
+        vert_accuracy: 0.0,
+    })
+}
+
 pub fn home_position(v: &Vehicle, home: &Home) -> MavMessage {
+    home_position_of(home, v.clock_us)
+}
+
+/// HOME_POSITION of `home` (the local origin) at simulation time `time_usec`.
+pub fn home_position_of(home: &Home, time_usec: u64) -> MavMessage {
     let g = home.global(&nalgebra::Vector3::zeros());
     MavMessage::HOME_POSITION(HOME_POSITION_DATA {
         latitude: g.lat,
@@ -182,7 +238,7 @@ pub fn home_position(v: &Vehicle, home: &Home) -> MavMessage {
         approach_x: 0.0,
         approach_y: 0.0,
         approach_z: 0.0,
-        time_usec: v.clock_us,
+        time_usec,
     })
 }
 
@@ -303,6 +359,30 @@ mod tests {
         assert_eq!((s.vx, s.vy, s.vz), (0, 0, 0));
         // At rest, hover thrust balances gravity: the accelerometer reads about −1 g.
         assert!((i32::from(s.zacc) + 1000).abs() <= 3, "{}", s.zacc);
+    }
+
+    #[test]
+    fn motor_commands_as_pwm_and_the_wind_at_rest() {
+        let mut v = hover();
+        v.set_controls(&[0.0, 0.25, 0.5, 1.0]).unwrap();
+        let MavMessage::SERVO_OUTPUT_RAW(s) = servo_output_raw(&v) else {
+            unreachable!()
+        };
+        let pwm = [s.servo1_raw, s.servo2_raw, s.servo3_raw, s.servo4_raw];
+        assert_eq!((pwm, s.servo5_raw), ([1000, 1250, 1500, 2000], 0));
+        // At rest the wind is all the airspeed there is (the default wind is horizontal).
+        let MavMessage::WIND_COV(w) = wind_cov(&v) else {
+            unreachable!()
+        };
+        let MavMessage::HIL_STATE_QUATERNION(h) = hil_state_quaternion(&v, &Home::default()) else {
+            unreachable!()
+        };
+        let speed = (w.wind_x.powi(2) + w.wind_y.powi(2)).sqrt();
+        assert!(speed > 0.5 && w.wind_z == 0.0, "{w:?}");
+        assert!(
+            (speed * 100.0 - f32::from(h.true_airspeed)).abs() <= 1.0,
+            "{w:?} {h:?}"
+        );
     }
 
     #[test]

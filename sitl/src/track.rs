@@ -92,9 +92,9 @@ impl Track {
 }
 
 /// A session's track: none, or one being written until a write fails (logged, and the
-/// track ends; the flight goes on).
+/// track ends; the flight goes on); and the live view's stream (`--view`), if any.
 #[derive(Debug, Default)]
-pub struct SessionTrack(Option<Track>);
+pub struct SessionTrack(Option<Track>, Option<crate::view_stream::ViewStream>);
 
 impl SessionTrack {
     /// Writes the ground truth to `track` from now on.
@@ -102,14 +102,25 @@ impl SessionTrack {
         self.0 = Some(track);
     }
 
+    /// Sends the ground truth to a live view from now on.
+    pub fn set_view(&mut self, view: crate::view_stream::ViewStream) {
+        self.1 = Some(view);
+    }
+
     /// A new autopilot connection (see [`Track::connect`]).
     pub fn connect(&mut self) {
         self.write(Track::connect);
+        if let Some(view) = &mut self.1 {
+            view.connect();
+        }
     }
 
-    /// A row for `quad` at `time_us` when one is due.
+    /// A row for `quad` at `time_us` when one is due (and the view's state).
     pub fn record(&mut self, time_us: u64, quad: &Quadrotor) {
         self.write(|track| track.record(time_us, quad));
+        if let Some(view) = &mut self.1 {
+            view.send(time_us, quad);
+        }
     }
 
     /// Writes out buffered rows (on disconnect, silence and shutdown).

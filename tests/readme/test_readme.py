@@ -324,8 +324,15 @@ def test_long_commands_are_run_by_their_tests(block: Block):
     assert tests, block.argument
     corpus = "\n".join(t.read_text() for t in tests)
     named = (".py", ".toml", ".parm")
-    scripts = {w for c in commands(block) for w in shlex.split(c) if w.endswith(named)}
-    assert scripts
+    words = [shlex.split(c) for c in commands(block)]
+    scripts = {w for c in words for w in c if w.endswith(named)}
+    # `python -m MODULE`: a test that runs the module names it as "MODULE".
+    modules = {c[i + 1] for c in words for i, w in enumerate(c[:-1]) if w == "-m"}
+    assert scripts or modules
+    for module in modules:
+        assert f'"{module}"' in corpus, (
+            f"{block.where}: {module} is run by no test in {block.argument}"
+        )
     for script in scripts:
         is_a_test = (REPO / script) in tests
         assert is_a_test or Path(script).name in corpus, (

@@ -124,7 +124,7 @@ impl Sim {
             Some(id::AUTOPILOT_VERSION)
         };
         for i in targets {
-            let reply = message_id.and_then(|m| self.message(link, i, m));
+            let reply = message_id.and_then(|m| self.message(i, m));
             let result = if reply.is_some() {
                 MavResult::MAV_RESULT_ACCEPTED
             } else {
@@ -154,6 +154,7 @@ impl Sim {
                 self.stats.resets += 1;
                 self.runtime[i].running = false;
                 self.runtime[i].failsafe = false;
+                self.record(i, &[]);
                 let accepted = MavResult::MAV_RESULT_ACCEPTED;
                 self.ack(link, out, i, header, RESET_COMMAND, accepted);
                 if let Some(p) = peer {
@@ -218,12 +219,7 @@ impl Sim {
 
     /// The message `message_id` of vehicle `i` (one or more MAVLink messages), if this SITL
     /// sends it.
-    pub(super) fn message(
-        &mut self,
-        link: Link,
-        i: usize,
-        message_id: u32,
-    ) -> Option<Vec<MavMessage>> {
+    pub(super) fn message(&mut self, i: usize, message_id: u32) -> Option<Vec<MavMessage>> {
         let status = self.status(i);
         let home = self.options.home;
         let v = &mut self.vehicles[i];
@@ -237,7 +233,9 @@ impl Sim {
             id::HIL_STATE_QUATERNION => vec![telemetry::hil_state_quaternion(v, &home)],
             id::AUTOPILOT_VERSION => vec![telemetry::autopilot_version(v)],
             id::HOME_POSITION => vec![telemetry::home_position(v, &home)],
-            id::DEBUG_FLOAT_ARRAY if link == Link::Controller => {
+            id::SERVO_OUTPUT_RAW => vec![telemetry::servo_output_raw(v)],
+            id::WIND_COV => vec![telemetry::wind_cov(v)],
+            id::DEBUG_FLOAT_ARRAY => {
                 let (name, time) = (v.kind.frame_name(), v.clock_us);
                 crate::task_frame::messages(name, time, v.frame()).collect()
             }

@@ -137,6 +137,8 @@ pub struct Sim {
     pub controller_outbox: Vec<u8>,
     /// Real-time stream output: one datagram per peer.
     pub stream: Vec<(SocketAddr, Vec<u8>)>,
+    /// `--record FILE`: every step of every vehicle.
+    pub recorder: Option<crate::record::Recorder>,
 }
 
 impl Sim {
@@ -170,6 +172,7 @@ impl Sim {
             gcs_outbox: Vec::new(),
             controller_outbox: Vec::new(),
             stream: Vec::new(),
+            recorder: None,
         })
     }
 
@@ -387,6 +390,7 @@ impl Sim {
         self.stats.steps += 1;
         let from = out.len();
         self.push_vehicle_reply(i, peer, out);
+        self.record(i, &out[from..]);
         let v = &mut self.vehicles[i];
         v.last_step = (step != 0).then_some(step);
         v.last_reply.clear();
@@ -427,6 +431,14 @@ impl Sim {
         true
     }
 
+    /// Appends vehicle `i`'s step (or reset) to the recording, if one is made; `reply`: the
+    /// frames already encoded for it (see [`crate::record::Recorder::step`]).
+    pub(crate) fn record(&mut self, i: usize, reply: &[u8]) {
+        if let Some(r) = &mut self.recorder {
+            r.step(&mut self.vehicles[i], &self.options.home, reply);
+        }
+    }
+
     /// HIL_STATE_QUATERNION and the task frame of vehicle `i`, as `peer` wants them.
     fn push_vehicle_reply(&mut self, i: usize, peer: usize, out: &mut Vec<u8>) {
         let Peer { state, frame, .. } = self.peers[peer];
@@ -455,7 +467,7 @@ impl Sim {
         let due = self.gcs_streams.due(now);
         for message_id in due {
             for i in 0..self.vehicles.len() {
-                if let Some(messages) = self.message(Link::Gcs, i, message_id) {
+                if let Some(messages) = self.message(i, message_id) {
                     for m in messages {
                         self.push(Link::Gcs, out, i, &m);
                     }

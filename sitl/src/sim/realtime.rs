@@ -65,6 +65,7 @@ impl Sim {
                 self.vehicles[i].step();
                 self.stats.physics += start.elapsed();
                 self.stats.steps += 1;
+                self.record(i, &[]);
                 steps += 1;
                 self.stream_step(i, now);
                 if self.vehicles[i].last.terminated {
@@ -104,6 +105,7 @@ impl Sim {
         match self.vehicles[i].reset(seed) {
             Ok(()) => {
                 self.stats.resets += 1;
+                self.record(i, &[]);
                 let text = format!(
                     "vehicle {system_id}: episode ended, reset with seed {seed}; waiting for a command"
                 );

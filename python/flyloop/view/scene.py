@@ -1,0 +1,260 @@
+"""What the view draws, in Rerun: the world in NED (north, east, down: MAVLink's frame, so the
+SITL's, PX4's and ArduPilot's messages go in as they are), each vehicle as a body with its
+rotors (from the frame's geometry), trail, target, wind arrow, motor commands, and an
+autopilot's estimate beside the truth. Time is the simulation clock (timeline ``sim_time``)."""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+import rerun as rr
+import rerun.blueprint as rrb
+
+from ..rendering.quadrotor import ROTOR_POSITION_SIGNS, ROTOR_SPIN
+from ..tasks import HOVER, LANDING
+
+TIMELINE = "sim_time"
+# The vehicle's hub: a colour the browser test looks for (it appears nowhere else).
+HUB = (255, 0, 200)
+ESTIMATE = (255, 150, 0)
+ROTOR_CCW, ROTOR_CW, ARM = (70, 200, 90), (235, 90, 80), (60, 60, 70)
+GROUND, PAD, TRAIL, TARGET, WIND = (
+    (150, 155, 150),
+    (40, 40, 40),
+    (60, 140, 220),
+    (0, 170, 60),
+    (0, 80, 220),
+)
+TRAIL_POINTS = 600  # the trail's last points
+TRAIL_EVERY_S = 0.1  # the trail is re-drawn this often (simulated seconds)
+DRAW_SCALE = 3.0  # vehicles are drawn this many times their size (a 0.1 m arm is small)
+GROUND_HALF = 5.0  # m: the ground grid is ±this around home
+
+
+_S60, _C22, _S22 = math.sin(math.pi / 3), math.cos(math.pi / 8), math.sin(math.pi / 8)
+# The core's shipped hexa X and octo X (core/src/quadrotor/frame.rs, PX4's motor order):
+# (forward, left) in arm lengths and spin (+1 CW, -1 CCW), until the extension exposes the
+# core's rotor tables; the quad X comes from rendering's ROTOR_POSITION_SIGNS.
+SHIPPED = {
+    6: [
+        (0, -1, 1), (0, 1, -1), (_S60, 0.5, 1),
+        (-_S60, -0.5, -1), (_S60, -0.5, -1), (-_S60, 0.5, 1),
+    ],
+    8: [
+        (_C22, -_S22, 1), (-_C22, _S22, 1), (_S22, -_C22, -1), (-_C22, -_S22, -1),
+        (_C22, _S22, -1), (-_S22, _C22, -1), (_S22, _C22, 1), (-_S22, -_C22, 1),
+    ],
+}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Frame:
+    """A vehicle's geometry in the body frame FRD: rotor centres (n, 3) m and spins (n,)
+    (−1 counter-clockwise, +1 clockwise, seen from above). The one place the view reads a
+    frame's rotor layout from (the core's tables will replace these two)."""
+
+    rotors: np.ndarray
+    spins: tuple[int, ...]
+    rotor_radius: float
+
+    @staticmethod
+    def quad_x(arm_length: float = HOVER.defaults["arm_length"]) -> Frame:
+        # ROTOR_POSITION_SIGNS are (forward, left): FRD is (forward, -left, 0).
+        fl = ROTOR_POSITION_SIGNS * (arm_length / math.sqrt(2.0))
+        rotors = np.c_[fl[:, 0], -fl[:, 1], np.zeros(len(fl))]
+        return Frame(rotors, tuple(ROTOR_SPIN), 0.38 * arm_length)
+
+    @staticmethod
+    def lander(width: float = LANDING.defaults["drone_width"]) -> Frame:
+        rotors = np.array([[-width / 2, 0.0, 0.0], [width / 2, 0.0, 0.0]])
+        return Frame(rotors, (-1, 1), 0.15 * width)
+
+    @staticmethod
+    def table(rows, arm_length: float = HOVER.defaults["arm_length"]) -> Frame:
+        """From rotor rows (forward, left in arm lengths, spin +1 CW / -1 CCW), body FLU."""
+        fl = np.array([(forward, left) for forward, left, _ in rows]) * arm_length
+        rotors = np.c_[fl[:, 0], -fl[:, 1], np.zeros(len(fl))]
+        return Frame(rotors, tuple(spin for _, _, spin in rows), 0.3 * arm_length)
+
+    @staticmethod
+    def for_motors(n: int) -> Frame:
+        """The frame a vehicle with `n` motor outputs flies: the lander (2), the quad X (4),
+        the core's hexa X (6) or octo X (8)."""
+        if n in SHIPPED:
+            return Frame.table(SHIPPED[n])
+        return Frame.lander() if n == 2 else Frame.quad_x()
+
+
+def _circle(center: np.ndarray, radius: float, n: int = 24) -> np.ndarray:
+    a = np.linspace(0.0, 2.0 * math.pi, n + 1)
+    return center + np.c_[radius * np.cos(a), radius * np.sin(a), np.zeros(n + 1)]
+
+
+def quat_enu_to_ned(q_wxyz) -> np.ndarray:
+    """Body FLU → world ENU quaternion [w, x, y, z] to body FRD → world NED (protocol.md §5)."""
+    h = math.sqrt(0.5)
+    return _mul(
+        _mul(np.array([0.0, h, h, 0.0]), np.asarray(q_wxyz, float)), np.array([0.0, 1.0, 0.0, 0.0])
+    )
+
+
+def _mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return np.array(
+        [
+            w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+            w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+            w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
+        ]
+    )
+
+
+def blueprint() -> rrb.Blueprint:
+    """The layout: the 3D world beside the motor commands, position, attitude and rates over
+    time."""
+    # South-west of home, looking at 2 m up: the rotors show, and a climb to 5 m stays in view.
+    eye = rrb.EyeControls3D(position=[-4.5, -4.5, -4.0], look_target=[0.0, 0.0, -2.0])
+    world = rrb.Spatial3DView(origin="/world", name="world (NED)", eye_controls=eye)
+    plots = rrb.Vertical(
+        rrb.TimeSeriesView(origin="/motors", name="motor commands"),
+        rrb.TimeSeriesView(origin="/position", name="position (NED, m)"),
+        rrb.TimeSeriesView(origin="/attitude", name="attitude (deg)"),
+        rrb.TimeSeriesView(origin="/rates", name="body rates (deg/s)"),
+    )
+    return rrb.Blueprint(rrb.Horizontal(world, plots, column_shares=[3, 2]), collapse_panels=True)
+
+
+class Scene:
+    """Logs the world to a Rerun recording stream (`rec`)."""
+
+    def __init__(self, rec: rr.RecordingStream) -> None:
+        self.rec = rec
+        self._drawn: set[str] = set()
+        self._trails: dict[str, deque] = {}
+        self._trail_at: dict[str, float] = {}
+        self._now = 0.0
+        self._world()
+
+    def _log(self, path: str, *what, static: bool = False) -> None:
+        self.rec.log(path, *what, static=static)
+
+    def _world(self) -> None:
+        self._log("/world", rr.ViewCoordinates.RIGHT_HAND_Z_DOWN, static=True)
+        ticks = np.arange(-GROUND_HALF, GROUND_HALF + 0.5, 1.0)
+        lines = [[[t, -GROUND_HALF, 0], [t, GROUND_HALF, 0]] for t in ticks]
+        lines += [[[-GROUND_HALF, t, 0], [GROUND_HALF, t, 0]] for t in ticks]
+        self._log("/world/ground", rr.LineStrips3D(lines, colors=[GROUND], radii=0.01), static=True)
+        pad = [_circle(np.zeros(3), 0.5), [[-0.5, 0, 0], [0.5, 0, 0]], [[0, -0.5, 0], [0, 0.5, 0]]]
+        self._log("/world/pad", rr.LineStrips3D(pad, colors=[PAD], radii=0.02), static=True)
+        north = rr.Arrows3D(
+            origins=[[0, 0, 0]], vectors=[[1, 0, 0]], colors=[(220, 40, 40)], labels=["N"]
+        )
+        self._log("/world/north", north, static=True)
+
+    def time(self, t_s: float) -> None:
+        """What is logged next happened at simulation time `t_s`."""
+        self._now = float(t_s)
+        self.rec.set_time(TIMELINE, duration=self._now)
+
+    def _body(self, path: str, frame: Frame, color, hub: bool) -> None:
+        """The static geometry under `path` (body frame FRD), drawn once."""
+        if path in self._drawn:
+            return
+        self._drawn.add(path)
+        s = DRAW_SCALE
+        rotors = frame.rotors * s
+        arms = [[[0, 0, 0], list(r)] for r in rotors]
+        self._log(
+            f"{path}/arms",
+            rr.LineStrips3D(arms, colors=[color if not hub else ARM], radii=0.012 * s),
+            static=True,
+        )
+        discs = [_circle(r, frame.rotor_radius * s) for r in rotors]
+        colors = [ROTOR_CCW if spin < 0 else ROTOR_CW for spin in frame.spins]
+        self._log(
+            f"{path}/rotors",
+            rr.LineStrips3D(discs, colors=colors if hub else [color], radii=0.008 * s),
+            static=True,
+        )
+        nose = [[0, 0, 0], [float(np.max(np.abs(rotors[:, 0]))) * 1.3 or 0.1, 0, 0]]
+        self._log(
+            f"{path}/nose", rr.LineStrips3D([nose], colors=[color], radii=0.012 * s), static=True
+        )
+        if hub:
+            half = 0.04 * s
+            box = rr.Boxes3D(half_sizes=[[half, half, half / 2]], colors=[HUB], fill_mode="solid")
+            self._log(f"{path}/hub", box, static=True)
+
+    def vehicle(
+        self,
+        name: str,
+        position_ned,
+        quaternion_ned,
+        frame: Frame,
+        *,
+        rates_frd=None,
+        estimate: bool = False,
+    ) -> None:
+        """The vehicle's pose (truth, or an autopilot's `estimate`), body rates (FRD, rad/s)
+        and trail."""
+        path = f"/world/{name}" + ("_estimate" if estimate else "")
+        self._body(path, frame, ESTIMATE if estimate else ARM, hub=not estimate)
+        w, x, y, z = (float(v) for v in quaternion_ned)
+        p = [float(v) for v in position_ned]
+        self._log(path, rr.Transform3D(translation=p, quaternion=rr.Quaternion(xyzw=[x, y, z, w])))
+        kind = "estimate" if estimate else "truth"
+        for axis, value in zip("NED", p, strict=True):
+            self._log(f"/position/{name}/{axis}/{kind}", rr.Scalars(value))
+        roll, pitch, yaw = euler_ned([w, x, y, z])
+        for axis, value in zip(("roll", "pitch", "yaw"), (roll, pitch, yaw), strict=True):
+            self._log(f"/attitude/{name}/{axis}/{kind}", rr.Scalars(math.degrees(value)))
+        for axis, value in zip("pqr", rates_frd if rates_frd is not None else (), strict=False):
+            self._log(f"/rates/{name}/{axis}/{kind}", rr.Scalars(math.degrees(float(value))))
+        self._trail(path, p, ESTIMATE if estimate else TRAIL)
+
+    def _trail(self, path: str, p: list[float], color) -> None:
+        trail = self._trails.setdefault(path, deque(maxlen=TRAIL_POINTS))
+        trail.append(p)
+        now = self._now
+        if now - self._trail_at.get(path, -math.inf) >= TRAIL_EVERY_S:
+            self._trail_at[path] = now
+            self._log(f"{path}_trail", rr.LineStrips3D([list(trail)], colors=[color], radii=0.015))
+
+    def motors(self, name: str, fractions) -> None:
+        """Motor commands in [0, 1], one series per motor."""
+        for i, f in enumerate(fractions):
+            self._log(f"/motors/{name}/m{i}", rr.Scalars(float(f)))
+
+    def target(self, name: str, target_ned) -> None:
+        point = rr.Points3D(
+            [[float(v) for v in target_ned]], colors=[TARGET], radii=0.08, labels=["target"]
+        )
+        self._log(f"/world/{name}_target", point)
+
+    def wind(self, name: str, position_ned, wind_ned) -> None:
+        """The wind at the vehicle, an arrow of 0.3 m per m/s."""
+        vec = [0.3 * float(v) for v in wind_ned]
+        arrow = rr.Arrows3D(
+            origins=[[float(v) for v in position_ned]], vectors=[vec], colors=[WIND]
+        )
+        self._log(f"/world/{name}_wind", arrow)
+
+    def task(self, name: str, reward: float, terminated: bool, truncated: bool) -> None:
+        self._log(f"/task/{name}/reward", rr.Scalars(float(reward)))
+        if terminated or truncated:
+            what = "terminated" if terminated else "truncated"
+            self._log(f"/task/{name}/events", rr.TextLog(f"episode {what}", level="WARN"))
+
+
+def euler_ned(q_wxyz) -> tuple[float, float, float]:
+    """Roll, pitch, yaw (ZYX) of a body FRD → world NED quaternion, rad."""
+    w, x, y, z = q_wxyz
+    roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+    pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
+    yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    return roll, pitch, yaw

@@ -1,0 +1,89 @@
+"""docs/view.md's PX4 flight in the live view: flyloop-sitl --px4 --view sends the truth,
+`python -m flyloop.view` talks to PX4's ground-station port for its estimate; PX4 takes off.
+The view's recording must hold both, the estimate beside the truth (within 0.5 m once
+airborne), and the browser must draw the vehicle."""
+
+from __future__ import annotations
+
+import signal
+import socket
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+from flyloop.plot import series_of, series_of_ulg
+from flyloop.view.screenshot import Browser, hub_pixels
+from px4_support import TAKEOFF_ALT, settle
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "view"))
+from flight import free_port, rise  # noqa: E402
+
+
+def test_px4_takeoff_in_the_live_view_with_the_estimate_beside_the_truth(pair, tmp_path):
+    truth_port = free_port()
+    flyloop = pair.flyloop("--view", f"127.0.0.1:{truth_port}")
+    web, grpc = free_port(socket.SOCK_STREAM), free_port(socket.SOCK_STREAM)
+    px4 = pair.px4()
+    view = subprocess.Popen(
+        [
+            sys.executable, "-m", "flyloop.view",
+            "--listen", f"127.0.0.1:{truth_port}",
+            "--connect", f"127.0.0.1:{18570 + px4.instance}",
+            "--web-port", str(web), "--grpc-port", str(grpc),
+            "--save", str(tmp_path / "px4.rrd"), "--wait", "120",
+        ],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        url = view.stdout.readline().split("open ", 1)[1].strip()
+        px4.heartbeat(60)
+        px4.arm_when_ready(60)
+        px4.takeoff()
+        frame = px4.frame()
+        home = px4.home()
+        browser = Browser()
+        try:
+            browser.open(url)
+            ground, n_ground = browser.wait_for_vehicle(30, timeout=90)
+            settle(px4, (home[0], home[1], home[2] - TAKEOFF_ALT), 0.3, 60)
+            risen, air = rise(browser, hub_pixels(ground)[:, 0], 40, timeout=90)
+            (tmp_path / "px4.png").write_bytes(air)
+        finally:
+            browser.close()
+    finally:
+        view.send_signal(signal.SIGINT)
+        view.wait(timeout=20)
+        flyloop.stop()
+    assert view.returncode == 0, view.stderr.read()
+    del frame
+
+    series = series_of(tmp_path / "px4.rrd")
+    t_true, d_true = series["/position/vehicle1/D/truth"]
+    t_est, d_est = series["/position/vehicle1/D/estimate"]
+    assert len(t_true) > 100 and len(t_est) > 100
+    # Airborne (above 1 m): the estimate, moved into the truth's frame, beside the truth.
+    # Where both were drawn (under load the view may stop with one stream behind the other).
+    up = t_est[(t_est <= t_true[-1]) & (-d_est > 1.0)]
+    assert len(up) > 50
+    truth_at = np.interp(up, t_true, d_true)
+    gap = np.abs(np.interp(up, t_est, d_est) - truth_at)
+    assert gap.max() < 0.5, gap.max()
+    assert -d_true.min() > TAKEOFF_ALT - 0.5
+    _, n_estimate = series["/position/vehicle1/N/estimate"]
+    assert np.isfinite(n_estimate).all()
+
+    # docs/view.md's plot with PX4's own log (.ulg, written while armed): its estimate beside
+    # the truth (its local frame's origin is about home: 0.6 m allowed).
+    ulg = sorted((Path(px4.log.name).parent / "log").glob("*/*.ulg"))[-1]
+    png = tmp_path / "px4_plot.png"
+    plot = ["-m", "flyloop.plot", str(tmp_path / "px4.rrd"), "--ulg", str(ulg), "-o", str(png)]
+    plotted = subprocess.run([sys.executable, *plot], capture_output=True, text=True, timeout=120)
+    assert plotted.returncode == 0 and png.stat().st_size > 20_000, plotted.stderr
+    t_ulg, d_ulg = series_of_ulg(ulg)["/position/vehicle1/D/estimate"]
+    up = t_ulg[(t_ulg >= t_true[0]) & (t_ulg <= t_true[-1]) & (-d_ulg > 1.0)]
+    assert len(up) > 100
+    gap = np.abs(np.interp(up, t_ulg, d_ulg) - np.interp(up, t_true, d_true))
+    assert gap.max() < 0.6, gap.max()
+    assert n_ground >= 30, "no vehicle drawn"
+    assert risen > 40, f"the vehicle did not take off on the screen: {tmp_path / 'px4.png'}"

@@ -1,0 +1,268 @@
+"""The view, the recordings and the plot without a browser: what a recording holds (the SITL's
+--record: every step, the same bytes for the same seed and commands; an env's Watch: every
+step, equal to the env's info), the plot's PNG, and bad input: one clear line, never a
+traceback alone, never a hang."""
+
+from __future__ import annotations
+
+import os
+import socket
+import subprocess
+import sys
+import time
+
+import flyloop  # noqa: F401  (registers the envs)
+import gymnasium as gym
+import numpy as np
+import pytest
+from flight import free_port
+from flyloop import find_sitl_binary
+from flyloop.plot import series_of
+from flyloop.view import Watch, WatchVector
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "sitl"))
+from sitl_client import Client, Sitl, mavlink2  # noqa: E402
+
+
+def run(*args: str, timeout: float = 60, env=None) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, *args], capture_output=True, text=True, timeout=timeout, env=env
+    )
+
+
+@pytest.fixture(scope="module")
+def binary():
+    return find_sitl_binary(build=True)
+
+
+def record(binary, path, steps: int = 200) -> list:
+    sitl = Sitl(binary, "--gcs", "off", "--record", str(path))
+    client = Client(sitl.address)
+    try:
+        client.reset(5)
+        states = []
+        for k in range(steps):
+            msgs = client.step([0.5, 0.5, 0.5, 0.5] if k < 100 else [0.45, 0.5, 0.45, 0.5])
+            states += [m for m in msgs if m.get_type() == "HIL_STATE_QUATERNION"]
+    finally:
+        client.close()
+        assert sitl.stop() == 0
+    return states
+
+
+def test_sitl_recording_holds_every_step_and_is_reproducible(binary, tmp_path):
+    states = record(binary, tmp_path / "a.tlog")
+    record(binary, tmp_path / "b.tlog")
+    a = (tmp_path / "a.tlog").read_bytes()
+    assert a == (tmp_path / "b.tlog").read_bytes()
+    series = series_of(tmp_path / "a.tlog")
+    t, roll = series["/attitude/vehicle1/roll/truth"]
+    assert len(t) == 201  # the reset and 200 steps
+    assert [round(x * 1e6) for x in t[1:]] == [s.time_usec for s in states]
+    _, m0 = series["/motors/vehicle1_command/m0"]
+    assert m0[1:101] == pytest.approx(0.5) and m0[101:] == pytest.approx(0.45)
+    assert "/task/vehicle1/reward" in series
+    # 4 messages per step (motor command, truth, wind, task frame): the size per simulated minute.
+    minute = len(a) / (t[-1] - t[0]) * 60
+    print(
+        f"SITL recording: {len(a)} bytes for {t[-1] - t[0]:.2f} s:"
+        f" {minute / 2**20:.2f} MiB per simulated minute"
+    )
+
+
+def test_env_watch_records_every_step(tmp_path):
+    env = Watch(
+        gym.make("flyloop/QuadHover-v0", backend="native", max_steps=300),
+        serve=False,
+        save=tmp_path / "eval.rrd",
+    )
+    obs, info = env.reset(seed=1)
+    positions = [info["position"]]
+    rewards, done = [], False
+    while not done:
+        obs, reward, terminated, truncated, info = env.step(np.full(4, 0.5, np.float32))
+        positions.append(info["position"])
+        rewards.append(reward)
+        done = terminated or truncated
+    env.close()
+    series = series_of(tmp_path / "eval.rrd")
+    t, up = series["/position/vehicle1/D/truth"]
+    assert len(t) == len(positions)
+    np.testing.assert_allclose(-up, [p[2] for p in positions], atol=1e-6)
+    _, r = series["/task/vehicle1/reward"]
+    np.testing.assert_allclose(r, rewards, atol=1e-6)
+    assert (tmp_path / "eval.rrd").stat().st_size > 10_000
+    # docs/view.md's replay and plot of an evaluation.
+    web, grpc = free_port(socket.SOCK_STREAM), free_port(socket.SOCK_STREAM)
+    replay = run(
+        "-m", "flyloop.view", str(tmp_path / "eval.rrd"), "--seconds", "0",
+        "--web-port", str(web), "--grpc-port", str(grpc),
+    )  # fmt: skip
+    assert replay.returncode == 0 and "replayed" in replay.stdout, replay.stderr
+    png = tmp_path / "eval.png"
+    plotted = run("-m", "flyloop.plot", str(tmp_path / "eval.rrd"), "-o", str(png))
+    assert plotted.returncode == 0 and png.stat().st_size > 20_000, plotted.stderr
+
+
+def test_vector_watch_records_the_chosen_env(tmp_path):
+    envs = gym.make_vec(
+        "flyloop/QuadHover-v0",
+        num_envs=4,
+        vectorization_mode="vector_entry_point",
+        backend="native",
+    )
+    envs = WatchVector(envs, index=2, serve=False, save=tmp_path / "vec.rrd")
+    obs, infos = envs.reset(seed=0)
+    north = [infos["position"][2][1]]
+    for _ in range(50):
+        obs, rewards, terminated, truncated, infos = envs.step(np.full((4, 4), 0.5, np.float32))
+        north.append(infos["position"][2][1])  # ENU y is north
+    envs.close()
+    t, n = series_of(tmp_path / "vec.rrd")["/position/env2/N/truth"]
+    np.testing.assert_allclose(n, north, atol=1e-6)
+    assert t[-1] == pytest.approx(0.5)
+
+
+def test_plot_writes_a_png_of_a_recording(binary, tmp_path):
+    record(binary, tmp_path / "run.tlog")
+    out = run("-m", "flyloop.plot", str(tmp_path / "run.tlog"), "-o", str(tmp_path / "run.png"))
+    assert out.returncode == 0, out.stderr
+    from PIL import Image
+
+    img = np.asarray(Image.open(tmp_path / "run.png").convert("RGB"))
+    assert img.shape[0] > 600 and (img < 200).any(axis=2).mean() > 0.01  # lines were drawn
+
+
+@pytest.mark.parametrize(
+    "content, expected",
+    [
+        (b"", "no MAVLink"),
+        (b"\x89PNG\r\n\x1a\n" + bytes(range(256)) * 4, "no MAVLink"),
+    ],
+)
+def test_a_foreign_recording_is_one_line(tmp_path, content, expected):
+    path = tmp_path / "foreign.tlog"
+    path.write_bytes(content)
+    for args in (
+        ["-m", "flyloop.plot", str(path)],
+        ["-m", "flyloop.view", str(path), "--seconds", "0"],
+    ):
+        out = run(*args)
+        assert out.returncode == 1 and "Traceback" not in out.stderr, out.stderr
+        assert (
+            expected in out.stderr
+            and str(path) in out.stderr
+            and len(out.stderr.strip().splitlines()) == 1
+        )
+
+
+def test_a_truncated_recording_replays_what_it_holds(binary, tmp_path):
+    record(binary, tmp_path / "full.tlog")
+    data = (tmp_path / "full.tlog").read_bytes()
+    (tmp_path / "cut.tlog").write_bytes(data[: len(data) // 2 + 7])
+    t, _ = series_of(tmp_path / "cut.tlog")["/position/vehicle1/N/truth"]
+    assert 90 < len(t) < 110
+    bad = tmp_path / "bad.rrd"
+    bad.write_bytes(b"RRF2" + bytes(100))
+    out = run("-m", "flyloop.plot", str(bad))
+    assert out.returncode == 1 and "Traceback" not in out.stderr and str(bad) in out.stderr, (
+        out.stderr
+    )
+
+
+def test_a_view_pointed_at_nothing_says_so(tmp_path):
+    port = free_port()
+    out = run(
+        "-m",
+        "flyloop.view",
+        "--listen",
+        f"127.0.0.1:{port}",
+        "--wait",
+        "1",
+        "--web-port",
+        str(free_port(socket.SOCK_STREAM)),
+        "--grpc-port",
+        str(free_port(socket.SOCK_STREAM)),
+    )
+    assert out.returncode == 1, out.stderr
+    assert (
+        f"no MAVLink on udp 127.0.0.1:{port} within 1 s" in out.stderr
+        and "Traceback" not in out.stderr
+    )
+
+
+def test_a_browser_that_cannot_start_is_one_line(tmp_path):
+    env = {**os.environ, "FLYLOOP_CHROMIUM": str(tmp_path / "no-chromium")}
+    out = run(
+        "-m", "flyloop.view.screenshot", "http://127.0.0.1:1/", str(tmp_path / "x.png"), env=env
+    )
+    assert out.returncode == 1 and "Traceback" not in out.stderr
+    assert f"no Chromium at {tmp_path / 'no-chromium'}" in out.stderr
+
+
+def test_the_view_draws_every_vehicle_of_a_real_time_sitl(binary, tmp_path):
+    """Real time, 3 vehicles, a live view saving what it draws: each vehicle's truth on the
+    simulation clock, its motor commands, and the view's streams turned off again after."""
+    gcs = free_port()
+    sitl = Sitl(binary, "--realtime", "--vehicles", "3", "--gcs", f"127.0.0.1:{gcs}")
+    client = Client(sitl.address)
+    web, grpc = free_port(socket.SOCK_STREAM), free_port(socket.SOCK_STREAM)
+    view = subprocess.Popen(
+        [
+            sys.executable, "-m", "flyloop.view", "--listen", f"127.0.0.1:{gcs}",
+            "--web-port", str(web), "--grpc-port", str(grpc),
+            "--save", str(tmp_path / "rt.rrd"), "--seconds", "4",
+        ],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        view.stdout.readline()  # the URL
+        view.stdout.readline()  # listening: from now on for 4 s
+        end = time.monotonic() + 3.5
+        hover = [(9.81 / 40) ** 0.5] * 4
+        while time.monotonic() < end:  # commands keep the vehicles running (no failsafe)
+            for k in (1, 2, 3):
+                client.send_raw(realtime_controls(client, hover, k))
+            time.sleep(0.05)
+        assert view.wait(timeout=30) == 0, view.stderr.read()
+        # Nobody watches now: the SITL's usual telemetry only, none of the view's streams.
+        after = []
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as gcs_sock:
+            gcs_sock.bind(("127.0.0.1", gcs))
+            gcs_sock.settimeout(0.2)
+            parser, end = mavlink2.MAVLink(None), time.monotonic() + 1.5
+            while time.monotonic() < end:
+                try:
+                    after += parser.parse_buffer(gcs_sock.recv(65536)) or []
+                except TimeoutError:
+                    pass
+        kinds = {m.get_type() for m in after}
+        assert "HEARTBEAT" in kinds and not kinds & {"HIL_STATE_QUATERNION", "SERVO_OUTPUT_RAW"}
+    finally:
+        client.close()
+        sitl.stop()
+    series = series_of(tmp_path / "rt.rrd")
+    for k in (1, 2, 3):
+        t, d = series[f"/position/vehicle{k}/D/truth"]
+        assert len(t) > 20 and np.all(np.diff(t) >= 0) and t[-1] > 1.0, (k, len(t))
+        assert np.median(d) == pytest.approx(-1.5, abs=0.1)  # hover thrust holds the height
+        _, m0 = series[f"/motors/vehicle{k}_command/m0"]
+        assert np.median(m0) == pytest.approx(hover[0], abs=1e-3)  # 1000-2000 us: 0.001
+
+
+def realtime_controls(client, controls, system_id: int) -> bytes:
+    """HIL_ACTUATOR_CONTROLS without the lockstep flag (real time), from vehicle `system_id`."""
+    msg = client.mav.hil_actuator_controls_encode(0, list(controls) + [0.0] * 12, 0, 0)
+    return client.pack(msg, system_id)
+
+
+@pytest.mark.parametrize("n", [2, 4, 6, 8])
+def test_frames_drawn_for_each_motor_count(n):
+    """The lander (2), quad X (4), hexa X (6), octo X (8): rotors at the arm's length (the
+    lander's at half its width), spins balanced (as many CW as CCW)."""
+    from flyloop.view.scene import Frame
+
+    f = Frame.for_motors(n)
+    assert len(f.rotors) == len(f.spins) == n and sum(f.spins) == 0
+    radii = np.linalg.norm(f.rotors, axis=1)
+    assert np.allclose(radii, radii[0]) and radii[0] > 0
