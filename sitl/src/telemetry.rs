@@ -205,7 +205,7 @@ pub fn servo_output_raw(v: &Vehicle) -> MavMessage {
 
 /// The wind at the vehicle (velocity − air velocity), world NED, m/s, at simulation time.
 pub fn wind_cov(v: &Vehicle) -> MavMessage {
-    let k = Kinematics::of_task(&v.task);
+    let k = v.task.kinematics();
     let wind = crate::kinematics::enu_to_ned(&(k.velocity - k.air_velocity));
     MavMessage::WIND_COV(WIND_COV_DATA {
         time_usec: v.clock_us,

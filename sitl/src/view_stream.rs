@@ -4,10 +4,11 @@
 //! over UDP to `python -m flyloop.view --listen ADDR`, which draws it beside the autopilot's
 //! own estimate (docs/view.md). Off unless asked for.
 
-use crate::kinematics::{Home, Kinematics};
+use crate::kinematics::Home;
 use crate::telemetry::hil_state_quaternion_of;
 use crate::wire::Encoder;
 use flyloop_core::quadrotor::Quadrotor;
+use flyloop_core::vehicle::Vehicle;
 use mavlink::dialects::common::*;
 use std::io;
 use std::net::{SocketAddr, UdpSocket};
@@ -78,7 +79,7 @@ impl ViewStream {
             let home = crate::telemetry::home_position_of(&self.home, time_us);
             self.encoder.push(&mut self.out, 1, &home);
         }
-        let k = Kinematics::of_quadrotor(quad);
+        let k = quad.kinematics();
         let state = hil_state_quaternion_of(&k, &self.home, time_us);
         self.encoder.push(&mut self.out, 1, &state);
         let _ = self.socket.send_to(&self.out, self.target);
