@@ -4,7 +4,8 @@
 //!   thread pool), writing into numpy arrays the caller preallocated; N = 1 serves the
 //!   single env.
 //! - [`tables::describe`]: a task's observation bounds, action bounds, control period, info
-//!   layout and parameter table, straight from the core, so Python keeps no copy.
+//!   layout and parameter table, straight from the core, so Python keeps no copy;
+//!   [`tables::frames`] the shipped frames' rotor tables.
 //! - [`sitl_command::sitl_main`]: the `flyloop-sitl` program as a library call (the wheel's
 //!   console command).
 //!
@@ -32,6 +33,7 @@ fn _panic_for_test(message: &str) {
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<batch::Batch>()?;
     m.add_function(wrap_pyfunction!(tables::describe, m)?)?;
+    m.add_function(wrap_pyfunction!(tables::frames, m)?)?;
     m.add_function(wrap_pyfunction!(sitl_command::sitl_main, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_test, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

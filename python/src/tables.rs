@@ -2,6 +2,8 @@
 //! [`describe`], everything the Python package needs to declare spaces and check arguments.
 
 use flyloop_core::params::ValueKind;
+use flyloop_core::quadrotor::Frame;
+use flyloop_core::quadrotor::frame::shipped_names;
 use flyloop_core::tasks::InfoValue;
 use flyloop_core::tasks::randomization::ParamRange;
 use flyloop_core::tasks::registry::param_rows;
@@ -134,3 +136,21 @@ pub fn describe<'py>(
     out.set_item("parameters", rows)?;
     Ok(out)
 }
+
+/// The core's shipped frames (`core/src/quadrotor/frame.rs`), so no Python module keeps a
+/// copy of a rotor table: `{name: [(x, y, spin), ...]}`, each rotor's position forward and left
+/// in arm lengths (body FLU) and its spin (+1 clockwise, −1 counter-clockwise seen from
+/// above), in motor order.
+#[pyfunction]
+pub fn frames(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let out = PyDict::new(py);
+    for name in shipped_names() {
+        let frame = Frame::named(name).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let rotors: Vec<(f64, f64, i8)> = (frame.rotors().iter())
+            .map(|r| (r.x, r.y, r.spin.sign() as i8))
+            .collect();
+        out.set_item(name, rotors)?;
+    }
+    Ok(out)
+}
+

@@ -112,7 +112,7 @@ def test_orbit_move_and_reset():
 
 
 def test_rotor_spin_is_px4_quad_x():
-    assert ROTOR_SPIN == (-1, -1, 1, 1)  # CCW, CCW, CW, CW as core/src/quadrotor/dynamics.rs
+    assert ROTOR_SPIN == (-1, -1, 1, 1)  # CCW, CCW, CW, CW: the core's quad_x (frame.rs)
 
 
 def test_quaternion_rotation_and_euler_round_trip():

@@ -28,9 +28,11 @@
 //! (2 ms: ω·h = 0.22): 5 substeps for a 10 ms control step, 2 for PX4's 4 ms step. A step in
 //! which no foot can reach the ground keeps `max_substep` and never evaluates the contact.
 
-use super::dynamics::BRISTLES;
 use super::params::QuadrotorParams;
 use super::state::BodyState;
+
+/// Bristle values at the end of a contact state: x, y per foot.
+pub(crate) const BRISTLES: usize = 8;
 
 /// Signs (forward, left) of the four feet: front-right, rear-left, front-left, rear-right
 /// (the quad X's rotor order, whatever the frame).

@@ -11,7 +11,7 @@
 //! 6, 8 or 12, its unused motors held at zero), then the 8 bristles when a foot may touch. The
 //! quad X runs exactly the operations it ran before frames existed.
 
-use super::contact::{Gear, gear_reach};
+use super::contact::{BRISTLES, Gear, gear_reach};
 use super::frame::{Frame, MAX_ROTORS};
 use super::mixing::Mixing;
 use super::params::QuadrotorParams;
@@ -21,8 +21,6 @@ use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 /// Rigid-body values at the head of every flat state: position 0..3, velocity 3..6,
 /// quaternion w, x, y, z 6..10, body rates 10..13.
 pub(crate) const BODY: usize = 13;
-/// Bristle values at the end of a contact state: x, y per foot.
-pub(crate) const BRISTLES: usize = 8;
 
 /// Time derivative of a [`BodyState`] (same shape: velocity, acceleration, q̇, ω̇, ṁ, ṡ).
 #[derive(Debug, Clone, Copy)]

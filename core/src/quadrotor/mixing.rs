@@ -10,7 +10,7 @@
 //! so its bits did not move. A term's coefficient comes from one member (all members have
 //! the same), computed from the vehicle's parameters each step (`dynamics::Coefficients`).
 
-use super::frame::{MAX_ROTORS, Rotor, Spin};
+use super::rotor::{MAX_ROTORS, Rotor, Spin};
 use nalgebra::DMatrix;
 
 /// Motor indices of one side of a term, in motor order.

@@ -11,6 +11,7 @@ pub mod frame;
 mod mixing;
 pub mod model;
 pub mod params;
+mod rotor;
 mod seam;
 pub mod state;
 pub mod variables;

@@ -1,6 +1,6 @@
 //! The quadrotor's state: rigid body, motors and wind. Plain data, serde.
 
-use super::frame::MAX_ROTORS;
+use super::rotor::MAX_ROTORS;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::fmt;

@@ -11,14 +11,19 @@ from typing import Any
 
 import numpy as np
 
+from .. import _native
 from ..tasks import HOVER
 from .camera import OrbitCamera, Projector
 from .canvas import Painter, View
 
-# Rotor i sits at (forward, left) * L/sqrt(2) in the body frame: PX4 quad-X order.
-ROTOR_POSITION_SIGNS = np.array([(1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (-1.0, -1.0)])
-# Spin seen from above: -1 counter-clockwise, +1 clockwise (the core's ROTOR_SPIN).
-ROTOR_SPIN = (-1, -1, 1, 1)
+# The core's quad X (core/src/quadrotor/frame.rs, PX4's motor order): rotor i sits at
+# (forward, left) * L/sqrt(2) in the body frame, spinning -1 counter-clockwise or +1 clockwise
+# seen from above. Read from the core's table, signs only, so the drawing stays as it was.
+_QUAD_X = _native.frames()["quad_x"]
+ROTOR_POSITION_SIGNS = np.array(
+    [(math.copysign(1.0, x), math.copysign(1.0, y)) for x, y, _ in _QUAD_X]
+)
+ROTOR_SPIN = tuple(spin for _, _, spin in _QUAD_X)
 ROTOR_NAMES = ("FR", "RL", "FL", "RR")
 GROUND, GRID, GRID_MAJOR, AXIS_X = (226, 230, 222), (188, 192, 186), (160, 165, 158), (220, 40, 40)
 AXIS_Y, AXIS_Z, BOUNDS, BODY = (30, 160, 60), (40, 90, 230), (150, 160, 200), (0, 100, 200)

@@ -13,6 +13,7 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
+from .. import _native
 from ..rendering.quadrotor import ROTOR_POSITION_SIGNS, ROTOR_SPIN
 from ..tasks import HOVER, LANDING
 
@@ -34,27 +35,18 @@ DRAW_SCALE = 3.0  # vehicles are drawn this many times their size (a 0.1 m arm i
 GROUND_HALF = 5.0  # m: the ground grid is ±this around home
 
 
-_S60, _C22, _S22 = math.sin(math.pi / 3), math.cos(math.pi / 8), math.sin(math.pi / 8)
-# The core's shipped hexa X and octo X (core/src/quadrotor/frame.rs, PX4's motor order):
-# (forward, left) in arm lengths and spin (+1 CW, -1 CCW), until the extension exposes the
-# core's rotor tables; the quad X comes from rendering's ROTOR_POSITION_SIGNS.
-SHIPPED = {
-    6: [
-        (0, -1, 1), (0, 1, -1), (_S60, 0.5, 1),
-        (-_S60, -0.5, -1), (_S60, -0.5, -1), (-_S60, 0.5, 1),
-    ],
-    8: [
-        (_C22, -_S22, 1), (-_C22, _S22, 1), (_S22, -_C22, -1), (-_C22, -_S22, -1),
-        (_C22, _S22, -1), (-_S22, _C22, -1), (_S22, _C22, 1), (-_S22, -_C22, 1),
-    ],
-}  # fmt: skip
+# The core's shipped hexa X and octo X (core/src/quadrotor/frame.rs, PX4's motor order), read
+# from the core: (forward, left) in arm lengths and spin (+1 CW, -1 CCW); the quad X comes from
+# rendering's ROTOR_POSITION_SIGNS (the same table).
+_FRAMES = _native.frames()
+SHIPPED = {6: _FRAMES["hexa_x"], 8: _FRAMES["octo_x"]}
 
 
 @dataclass(frozen=True)
 class Frame:
     """A vehicle's geometry in the body frame FRD: rotor centres (n, 3) m and spins (n,)
     (−1 counter-clockwise, +1 clockwise, seen from above). The one place the view reads a
-    frame's rotor layout from (the core's tables will replace these two)."""
+    frame's rotor layout from (the core's tables, through the extension)."""
 
     rotors: np.ndarray
     spins: tuple[int, ...]
