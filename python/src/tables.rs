@@ -153,4 +153,3 @@ pub fn frames(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     }
     Ok(out)
 }
-
