@@ -182,3 +182,52 @@ fn same_seed_same_bytes() {
     assert_eq!(run(7), run(7));
     assert_ne!(run(7), run(8));
 }
+
+/// Issue 33: a frame given in full in a config file (five rotors, defined here only) is the
+/// vehicle PX4 flies: controls[0..5] drive its five motors, the sixth output is not a motor,
+/// and at full command it climbs off its gear.
+#[test]
+fn a_frame_from_a_config_file_flies_on_its_own_rotor_count() {
+    let mut text = String::from("mass = 1.5\n[frame]\nname = \"penta\"\n");
+    for i in 0..5 {
+        let a = std::f64::consts::TAU * f64::from(i) / 5.0;
+        let spin = if i % 2 == 0 { "cw" } else { "ccw" };
+        text += &format!(
+            "[[frame.rotor]]\nx = {}\ny = {}\nspin = \"{spin}\"\n",
+            a.cos(),
+            a.sin()
+        );
+    }
+    let vehicle = AutopilotVehicle::parse(&text).unwrap();
+    let mut s = Session::new(&SessionOptions {
+        vehicle,
+        step_us: 4000,
+        seed: 3,
+    })
+    .unwrap();
+    let mut out = Vec::new();
+    s.connect(1_000_000, &mut out);
+    let mut c = [0.0f32; 16];
+    c[..5].fill(1.0);
+    c[5] = 0.3;
+    let m = MavMessage::HIL_ACTUATOR_CONTROLS(HIL_ACTUATOR_CONTROLS_DATA {
+        controls: c,
+        mode: MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED,
+        flags: HilActuatorControlsFlags::HIL_ACTUATOR_CONTROLS_FLAGS_LOCKSTEP,
+        ..Default::default()
+    });
+    let mut bytes = Vec::new();
+    let mut encoder = Encoder::default();
+    for _ in 0..250 {
+        encoder.push(&mut bytes, 1, &m);
+    }
+    assert_eq!(s.receive(&bytes, &mut out), 250);
+    assert_eq!(s.quadrotor().command(), [1.0; 5]);
+    assert_eq!(s.quadrotor().body.motors.len(), 5);
+    assert!(
+        s.quadrotor().body.position.z > 1.0,
+        "{}",
+        s.quadrotor().body.position.z
+    );
+    assert_eq!(s.stats.refused_controls, 0);
+}
