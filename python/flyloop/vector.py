@@ -189,6 +189,23 @@ class FlyloopVectorEnv(VectorEnv):
             self._columns.infos(out.info),
         )
 
+    def reset_ended(self) -> tuple[np.ndarray, np.ndarray, dict[str, Any]]:
+        """Autoreset within the step, for APIs that want it (flyloop.sb3): every sub-env the
+        last step ended starts its next episode now, with the seed the next step would have
+        drawn, so the next step steps it with its action. Returns the indices of those
+        sub-envs, their first observations and their infos (arrays over them; masks left
+        out). Native backend only."""
+        if not hasattr(self._backend, "reset_rows"):
+            raise ValueError("reset_ended needs backend='native'")
+        out = self._out
+        ended = out.terminated | out.truncated
+        rows = np.flatnonzero(ended)
+        for i in rows:
+            self._seeds[i] = self._draw(int(i))
+        self._backend.reset_rows(ended, self._seeds, out)
+        infos = self._columns.infos(out.info[rows])
+        return rows, out.obs[rows], {k: v for k, v in infos.items() if not k.startswith("_")}
+
     def _give(self, array: np.ndarray) -> np.ndarray:
         return array.copy() if self._copy else array
 
