@@ -38,6 +38,19 @@ def test_fast_ppo_learns_quadhover_on_the_native_vector_env(tmp_path):
     assert (tmp_path / "learning_curve.png").is_file()
     assert (tmp_path / "native" / "progress.csv").is_file()
 
+    # evaluate.py records a hover episode and names its outcome in hover's words (it called
+    # a held target "landed").
+    gif, figures = tmp_path / "hover.gif", tmp_path / "eval.json"
+    done = run_script(
+        TRAIN / "evaluate.py", str(tmp_path / "native"), "--episodes", "1",
+        "--json", str(figures), "--gif", str(gif),
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr[-3000:]
+    held = json.loads(figures.read_text())["success_rate"] == 1.0
+    words = "held the target" if held else "did not hold the target"
+    assert f"steps, {words}" in done.stdout and "landed" not in done.stdout, done.stdout
+    assert gif.read_bytes()[:6] == b"GIF89a"
+
 
 @pytest.mark.training
 def test_fast_ppo_learns_the_same_over_the_sitl_as_in_process(tmp_path, sitl_binary):
