@@ -5,9 +5,12 @@ vector env learns exactly the same thing."""
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
+import time
 
 import pytest
-from training_support import TRAIN, run_script
+from training_support import REPO, TRAIN, run_script
 
 # The lander's short run: 20 updates of 128 envs x 128 steps (~23 CPU seconds). Measured
 # (seed 0, held-out seeds 1,000,000..1,000,019): mean return 2.6 against -302.6 for random
@@ -164,3 +167,29 @@ def test_training_table_reads_one_row_per_task_with_one_figure_per_seed(tmp_path
         s = summary(tmp_path / f"hover_s{seed}", "native")
         assert s["seed"] == seed and s["env_steps"] == 8192
         assert f"{100 * s['evaluation']['success_rate']:.1f} %" in cells[3]
+
+
+def test_fast_ppo_says_each_phase_from_its_first_second(tmp_path):
+    """Regression: nothing showed for the first seconds (torch and the envs loading) nor
+    while it evaluated and drew. Now each phase is one stderr line as it starts."""
+    start = time.monotonic()
+    proc = subprocess.Popen(
+        [sys.executable, str(TRAIN / "fast_ppo.py"), "--timesteps", "4096", "--num-envs", "16"]
+        + ["--eval-episodes", "2", "--out", str(tmp_path), "--no-progress-bar"],
+        cwd=REPO,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    first = proc.stderr.readline()
+    waited = time.monotonic() - start
+    out, err = proc.communicate(timeout=300)
+    assert proc.returncode == 0, err[-3000:]
+    # Before torch is imported (seconds): only the interpreter's start-up before it.
+    assert first == "fast_ppo: loading torch and the envs\n", first
+    assert waited < 3.0, waited
+    said = [line.split(": ", 1)[1] for line in err.splitlines() if line.startswith("fast_ppo: ")]
+    assert [s.split()[0] for s in said] == ["training", "evaluating", "drawing"], said
+    assert said[0] == (
+        "training hover on the native backend: 2 updates of 16 envs x 128 steps (4,096 env steps)"
+    )
