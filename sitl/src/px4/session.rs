@@ -4,6 +4,7 @@
 use super::messages;
 use crate::config::AutopilotVehicle;
 use crate::kinematics::{Home, Kinematics};
+use crate::speed::SpeedLog;
 use crate::stats::Stats;
 use crate::telemetry;
 use crate::track::SessionTrack;
@@ -49,6 +50,8 @@ pub struct Session {
     /// Ground-truth CSV (`--track`), if any.
     pub track: SessionTrack,
     pub stats: Stats,
+    /// Simulated time against wall time, logged while PX4 steps.
+    pub speed: SpeedLog,
 }
 
 impl Session {
@@ -79,6 +82,7 @@ impl Session {
             encoder: Encoder::default(),
             track: SessionTrack::default(),
             stats: Stats::default(),
+            speed: SpeedLog::default(),
         })
     }
 
@@ -198,6 +202,7 @@ impl Session {
         self.stats.steps += 1;
         self.emit(out);
         self.stats.physics += start.elapsed();
+        self.speed.observe(self.time_us);
     }
 
     /// HIL_SENSOR now, HIL_GPS when a fix is delivered, HIL_STATE_QUATERNION when due.
