@@ -53,16 +53,6 @@ def dummy_vec_env(env_id: str, n_envs: int, *, unit_actions: bool = False, **kwa
     return DummyVecEnv([make] * n_envs)
 
 
-def _info_dicts(columns: dict[str, Any], n: int) -> list[dict[str, Any]]:
-    """Per-env info dicts from the vector env's arrays (the `_key` masks left out): the same
-    values and types as a single env's info."""
-    keys = [k for k in columns if not k.startswith("_")]
-    values = [columns[k].tolist() if columns[k].ndim == 1 else list(columns[k]) for k in keys]
-    if not keys:
-        return [{} for _ in range(n)]
-    return [dict(zip(keys, row, strict=True)) for row in zip(*values, strict=True)]
-
-
 class NativeVecEnv(VecEnv):
     """stable-baselines3 VecEnv over one native vector env (see the module's docstring).
 
@@ -107,10 +97,10 @@ class NativeVecEnv(VecEnv):
 
     def reset(self) -> np.ndarray:
         seeds = None if all(s is None for s in self._seeds) else self._seeds
-        obs, infos = self.venv.reset(seed=seeds)
+        obs, _ = self.venv.reset(seed=seeds)
         self._reset_seeds()
         self._reset_options()
-        self.reset_infos = _info_dicts(infos, self.num_envs)
+        self.reset_infos = self.venv.info_dicts()
         return obs
 
     def step_async(self, actions: np.ndarray) -> None:
@@ -122,20 +112,22 @@ class NativeVecEnv(VecEnv):
         actions, self._actions = self._actions, None
         if self._to_env is not None:
             actions = self._to_env(np.asarray(actions, np.float32))
-        obs, rewards, terminated, truncated, columns = self.venv.step(actions)
-        dones = terminated | truncated
-        infos = _info_dicts(columns, self.num_envs)
-        for info, time_limit in zip(infos, (truncated & ~terminated).tolist(), strict=True):
+        # The arrays of the step (the vector env's own: copied before its autoreset below).
+        out = self.venv.step_arrays(actions)
+        obs, rewards = out.obs.copy(), out.rewards.astype(np.float32)
+        dones = out.terminated | out.truncated
+        infos = self.venv.info_dicts()
+        time_limits = (out.truncated & ~out.terminated).tolist()
+        for info, time_limit in zip(infos, time_limits, strict=True):
             info["TimeLimit.truncated"] = time_limit
         if dones.any():
-            # `obs` is the vector env's copy: its ended rows become the new episodes'.
             for i in np.flatnonzero(dones).tolist():
                 infos[i]["terminal_observation"] = obs[i].copy()
-            ended, first_obs, first_columns = self.venv.reset_ended()
-            for i, info in zip(ended.tolist(), _info_dicts(first_columns, len(ended)), strict=True):
+            ended, first_obs, first_infos = self.venv.reset_ended()
+            for i, info in zip(ended.tolist(), first_infos, strict=True):
                 self.reset_infos[i] = info
             obs[ended] = first_obs
-        return obs, rewards.astype(np.float32), dones, infos
+        return obs, rewards, dones, infos
 
     def close(self) -> None:
         self.venv.close()

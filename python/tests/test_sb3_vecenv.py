@@ -11,6 +11,7 @@ import warnings
 import gymnasium as gym
 import numpy as np
 import pytest
+import torch
 from stable_baselines3 import PPO, SAC
 from stable_baselines3.common.env_checker import _check_obs, _check_unsupported_spaces
 from stable_baselines3.common.evaluation import evaluate_policy
@@ -26,6 +27,8 @@ import flyloop
 import flyloop.sb3
 from flyloop.registration import ENVS
 
+# The networks are tiny: one torch thread (more only contend with the envs on 2 CPUs).
+torch.set_num_threads(1)
 # Short episodes and random actions: many episodes end (crash, bounds, time limit) in a few
 # hundred steps, so the auto-reset is exercised often.
 SHORT = {"max_steps": 60}
