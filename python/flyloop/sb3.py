@@ -13,7 +13,8 @@ ended it, returns the new episode's first observation and puts the last one in
 `infos[i]["terminal_observation"]`. This VecEnv does SB3's: after each step the sub-envs that
 ended start their next episode at once (`FlyloopVectorEnv.reset_ended`), with the seeds the
 gymnasium vector env and single envs draw. So with `venv.seed(s)` it gives the episodes of
-`DummyVecEnv` over single envs seeded `s + i`, bit for bit, several times faster.
+`DummyVecEnv` over single envs seeded `s + i`, bit for bit, stepped 2-6x faster
+(docs/performance.md).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from typing import Any
 import gymnasium
 import numpy as np
 from gymnasium.wrappers.utils import rescale_box
+from stable_baselines3.common.vec_env import DummyVecEnv
 from stable_baselines3.common.vec_env.base_vec_env import VecEnv, VecEnvIndices
 
 from .registration import ENVS
@@ -37,11 +39,12 @@ def make_vec_env(env_id: str, n_envs: int, **kwargs: Any) -> NativeVecEnv:
     return NativeVecEnv(env_id, n_envs, **kwargs)
 
 
-def dummy_vec_env(env_id: str, n_envs: int, *, unit_actions: bool = False, **kwargs: Any):
+def dummy_vec_env(
+    env_id: str, n_envs: int, *, unit_actions: bool = False, **kwargs: Any
+) -> DummyVecEnv:
     """The same envs as single envs in SB3's DummyVecEnv, one env object each: the reference
     `make_vec_env` equals, and the way to SB3 for the SITL backend (`backend="sitl"`: a
     flyloop-sitl process per env)."""
-    from stable_baselines3.common.vec_env import DummyVecEnv
 
     def make() -> gymnasium.Env:
         env = gymnasium.make(env_id, **{"backend": "native", **kwargs})
