@@ -1,5 +1,6 @@
 """stable-baselines3 on the native batch: a `VecEnv` whose sub-envs are the rows of one native
-vector env, stepped in one call (needs stable-baselines3; imported only from here).
+vector env, stepped in one call (needs stable-baselines3, the `train` extra; `import flyloop`
+does not import it).
 
     import flyloop.sb3
     from stable_baselines3 import PPO
@@ -24,8 +25,15 @@ from typing import Any
 import gymnasium
 import numpy as np
 from gymnasium.wrappers.utils import rescale_box
-from stable_baselines3.common.vec_env import DummyVecEnv
-from stable_baselines3.common.vec_env.base_vec_env import VecEnv, VecEnvIndices
+
+try:
+    from stable_baselines3.common.vec_env import DummyVecEnv
+    from stable_baselines3.common.vec_env.base_vec_env import VecEnv, VecEnvIndices
+except ModuleNotFoundError as exc:  # an optional dependency: say which and how to get it
+    raise ModuleNotFoundError(
+        f"flyloop.sb3 needs stable-baselines3 ({exc}): pip install 'flyloop[train]' "
+        "or pip install stable-baselines3"
+    ) from exc
 
 from .registration import ENVS
 from .vector import FlyloopVectorEnv

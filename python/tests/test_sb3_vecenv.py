@@ -317,3 +317,16 @@ def test_the_sitl_way_to_sb3_gives_the_same_episodes(sitl_binary):
     finally:
         ours.close()
         sitl.close()
+
+
+def test_without_stable_baselines3_the_import_says_what_to_install():
+    # sys.modules[name] = None makes Python refuse that import, as if it were not installed.
+    code = "import sys; sys.modules['stable_baselines3'] = None; import flyloop.sb3"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 1
+    last = done.stderr.strip().splitlines()[-1]
+    assert last.startswith("ModuleNotFoundError: flyloop.sb3 needs stable-baselines3"), last
+    assert "pip install 'flyloop[train]'" in last
+    # flyloop itself does not need it.
+    code = "import sys; sys.modules['stable_baselines3'] = None; import flyloop, gymnasium"
+    assert subprocess.run([sys.executable, "-c", code]).returncode == 0
