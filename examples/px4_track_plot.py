@@ -21,6 +21,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+# The columns the plot draws (flyloop-sitl --track writes them, among others).
+COLUMNS = {"connection", "time_us", "north", "east", "down", "m0"}
+
 
 def read(path: Path) -> tuple[list[dict[str, float]], bool]:
     """The track's complete rows, and whether a partial last row was left out: the SITL may
@@ -63,6 +66,9 @@ def main() -> None:
         sys.exit(f"px4_track_plot.py: cannot read {track}: {exc}")
     if not rows:
         sys.exit(f"px4_track_plot.py: {track} has no complete row yet")
+    missing = sorted(COLUMNS - set(rows[0]))
+    if missing:
+        sys.exit(f"px4_track_plot.py: {track} is not a flyloop-sitl --track file: no {missing}")
     plot(rows, out, *sys.argv[3:])
     note = " (its last row, still being written, left out)" if partial else ""
     print(f"plotted {len(rows)} rows of {track}{note} to {out}")

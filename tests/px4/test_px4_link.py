@@ -169,6 +169,16 @@ def test_speed_is_logged_and_a_track_still_being_written_plots(sitl_binary, tmp_
         assert done.returncode == 0, done.stderr
         assert f"plotted {rows} rows" in done.stdout and "left out" in done.stdout
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        # Not a track, or no file: one line naming it, no traceback.
+        other = tmp_path / "other.csv"
+        other.write_text("a,b\n1,2\n")
+        bad = ((other, "is not a flyloop-sitl --track file"), (tmp_path, "cannot read"))
+        for path, said in bad:
+            done = subprocess.run(
+                [sys.executable, str(script), str(path), str(png)], capture_output=True, text=True
+            )
+            assert done.returncode == 1 and said in done.stderr, done.stderr
+            assert "Traceback" not in done.stderr
     finally:
         stop(proc)
     logged = log.read_text()
