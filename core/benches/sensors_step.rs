@@ -11,6 +11,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use flyloop_core::SimRng;
 use flyloop_core::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
 use flyloop_core::sensors::{SensorParams, Sensors};
+use flyloop_core::vehicle::Vehicle;
 use nalgebra::Vector3;
 use std::hint::black_box;
 
@@ -27,15 +28,15 @@ fn sensors_step(c: &mut Criterion) {
     quad.set_command([hover; 4]).unwrap();
     let mut sensors = Sensors::new(SensorParams::default(), 1).unwrap();
     c.bench_function("sensors_sample", |b| {
-        b.iter(|| black_box(sensors.sample(black_box(&quad), DT)))
+        b.iter(|| black_box(sensors.sample(black_box(&quad.kinematics()), DT)))
     });
     let mut t = 0.0;
     c.bench_function("px4_step_physics_and_sensors_4ms", |b| {
         b.iter(|| {
             quad.step(DT);
             t += DT;
-            let r = sensors.sample(&quad, DT);
-            black_box((r, sensors.gps(&quad, t)))
+            let r = sensors.sample(&quad.kinematics(), DT);
+            black_box((r, sensors.gps(&quad.kinematics(), t)))
         })
     });
 }

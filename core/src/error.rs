@@ -71,6 +71,10 @@ pub enum ParamError {
     /// A TOML or JSON parameter file that does not parse; the message names the key or line.
     #[error("invalid parameter file: {0}")]
     Parse(String),
+    /// A frame's rotor table that is not a flyable multirotor; the message names the rotor
+    /// and the field.
+    #[error(transparent)]
+    Frame(#[from] crate::quadrotor::frame::FrameError),
 }
 
 /// " unit", or nothing for a dimensionless variable: "1" says nothing after a number.
@@ -103,6 +107,21 @@ pub struct InputError {
     /// Its position in the input array.
     pub index: usize,
     pub value: f64,
+}
+
+/// An input vector (the motor commands, a continuous state) of the wrong length, or with a
+/// value that is not a finite number.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum CommandError {
+    #[error("{what} has {got} values, the vehicle takes {expected}")]
+    WrongLength {
+        /// What the vector is ("motor command", "continuous state").
+        what: &'static str,
+        expected: usize,
+        got: usize,
+    },
+    #[error(transparent)]
+    NotFinite(#[from] InputError),
 }
 
 /// `Ok` when every value is finite, else an [`InputError`] naming the first one that is not.

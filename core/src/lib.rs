@@ -22,6 +22,7 @@
 //! ```
 
 pub mod error;
+pub mod frames;
 pub mod lander2d;
 pub mod number;
 pub mod params;
@@ -33,8 +34,9 @@ pub mod sensors;
 pub mod snapshot;
 pub mod tasks;
 pub mod variables;
+pub mod vehicle;
 
-pub use error::{InputError, ParamError, Role};
+pub use error::{CommandError, InputError, ParamError, Role};
 pub use params::{ParamSpec, Parameters, ValueKind};
 pub use rng::SimRng;
 pub use snapshot::SnapshotError;

@@ -103,7 +103,7 @@ fn the_snapshot_keeps_the_grid_phase() {
     assert_eq!(a.body, b.body);
     // Bytes of another version are refused, not misread.
     let mut bytes = a.save().unwrap();
-    let at = bytes.windows(8).position(|w| w == b"FLYQUA04").unwrap();
-    bytes[at + 7] = b'3';
+    let at = bytes.windows(8).position(|w| w == b"FLYQUA05").unwrap();
+    bytes[at + 7] = b'4';
     assert!(Quadrotor::restore(&bytes).is_err());
 }

@@ -164,7 +164,7 @@ fn ccw_cw_imbalance_yaws_the_documented_way() {
     }
     // Initial yaw acceleration = Σ spin·c·T / Izz with T from the lagged motors (all at h).
     let mut fresh = vehicle(still_air(), body);
-    fresh.body.motors = [h + 0.05, h + 0.05, h - 0.05, h - 0.05];
+    fresh.body.motors = [h + 0.05, h + 0.05, h - 0.05, h - 0.05].into();
     let t_fast = 10.0 * (h + 0.05f64).powi(2);
     let t_slow = 10.0 * (h - 0.05f64).powi(2);
     let expected = 0.02 * 2.0 * (t_slow - t_fast) / 0.02;
@@ -352,7 +352,19 @@ fn non_finite_commands_are_refused_and_out_of_range_ones_clamped() {
     );
     quad.set_command([0.2, 0.3, 0.4, 0.5]).unwrap();
     let err = quad.set_command([0.1, f64::NAN, 0.1, 0.1]).unwrap_err();
-    assert_eq!(err.index, 1);
+    assert_eq!(
+        err.to_string(),
+        "motor command 1 is NaN, not a finite number"
+    );
+    assert_eq!(quad.command(), [0.2, 0.3, 0.4, 0.5]);
+    // Regression (issue 33): a command vector of the wrong length is refused whole, never
+    // truncated or padded.
+    let err = quad.set_command([0.9; 6]).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "motor command has 6 values, the vehicle takes 4"
+    );
+    assert!(quad.set_command([0.9; 3]).is_err());
     assert_eq!(quad.command(), [0.2, 0.3, 0.4, 0.5]);
     assert!(quad.set_command([f64::INFINITY, 0.0, 0.0, 0.0]).is_err());
     quad.set_command([-1.0, 2.0, 0.5, 1.0]).unwrap();

@@ -3,9 +3,9 @@
 
 // Helpers are test code too: a failed setup is a failed test.
 
+use flyloop_core::frames::flu_to_frd;
 use flyloop_core::params::Parameters;
 use flyloop_core::quadrotor::QuadrotorParams;
-use flyloop_core::sensors::frames::flu_to_frd;
 use flyloop_core::tasks::flight::FlightParams;
 use flyloop_core::tasks::hover::Hover;
 use flyloop_core::tasks::randomization::{ParamRange, Randomization, VehicleParams};

@@ -4,7 +4,10 @@
 
 use crate::support;
 
-use flyloop_core::quadrotor::dynamics::{STATE_LEN, derivative_vector};
+use flyloop_core::quadrotor::dynamics::{derivative_vector, state_len};
+
+/// The quad's continuous states: 13 rigid-body values, 4 motors, 8 bristles.
+const STATE_LEN: usize = 25;
 use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial, QuadrotorParams};
 use flyloop_fmu::exports::*;
 use flyloop_fmu::fmi2_types::fmi2Status::{fmi2Error, fmi2OK};
@@ -103,8 +106,10 @@ fn derivatives_are_the_cores_right_hand_side_bit_for_bit() {
         assert_eq!(fmi2SetContinuousStates(fmu.c, x.as_ptr(), x.len()), fmi2OK);
     }
     quad.set_continuous_state(&x).unwrap();
+    assert_eq!(state_len(quad.frame().rotor_count()), STATE_LEN);
     let core = derivative_vector(
         &quad.params,
+        quad.frame(),
         &quad.body,
         &quad.command(),
         &quad.wind_velocity(),

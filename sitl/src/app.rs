@@ -1,6 +1,7 @@
 //! The `flyloop-sitl` program: options, sockets, then the server loop until SIGINT / SIGTERM.
 //! A library function so the binary and the Python wheel's `flyloop-sitl` command share it.
 
+use crate::autopilot_params::{self, Autopilot};
 use crate::cli::{Args, GcsTarget, ListFormat};
 use crate::config::{self, AutopilotVehicle, ConfigError};
 use crate::px4::server::Pacing;
@@ -112,7 +113,7 @@ fn start_px4(args: Args) -> Result<(), StartError> {
         step_us,
         seed: args.seed,
     })?;
-    if let Some(track) = track(&args)? {
+    if let Some(track) = track(&args, session.quadrotor().frame().rotor_count())? {
         session.track.set(track);
     }
     let listener =
@@ -187,15 +188,16 @@ fn quadrotor_only(args: &Args, mode_flag: &str) -> Result<(), StartError> {
 }
 
 /// The ground-truth CSV of the autopilot modes (`--track`), if asked for.
-fn track(args: &Args) -> Result<Option<Track>, StartError> {
+fn track(args: &Args, rotors: usize) -> Result<Option<Track>, StartError> {
     let Some(path) = &args.track else {
         return Ok(None);
     };
-    let track =
-        Track::create(path, args.track_interval_us).map_err(|source| StartError::Track {
+    let track = Track::create(path, args.track_interval_us, rotors).map_err(|source| {
+        StartError::Track {
             path: path.clone(),
             source,
-        })?;
+        }
+    })?;
     Ok(Some(track))
 }
 
@@ -215,7 +217,7 @@ fn start_ardupilot(args: Args) -> Result<(), StartError> {
         vehicle,
         seed: args.seed,
     })?;
-    if let Some(track) = track(&args)? {
+    if let Some(track) = track(&args, session.quadrotor().frame().rotor_count())? {
         session.track.set(track);
     }
     let socket =
@@ -249,6 +251,17 @@ fn start_ardupilot(args: Args) -> Result<(), StartError> {
 }
 
 fn start(args: Args) -> Result<(), StartError> {
+    if let Some(autopilot) = args.print_autopilot_params {
+        let vehicle = vehicle_config(&args)?;
+        let text = match autopilot {
+            Autopilot::Px4 => autopilot_params::px4(&vehicle.frame, &vehicle.quadrotor),
+            Autopilot::Ardupilot => {
+                autopilot_params::ardupilot(&vehicle.frame).map_err(StartError::Options)?
+            }
+        };
+        print!("{text}");
+        return Ok(());
+    }
     if args.px4 {
         return start_px4(args);
     }

@@ -133,6 +133,12 @@ pub struct Args {
     /// Print the task frame layout (DEBUG_FLOAT_ARRAY indices) and exit.
     #[arg(long)]
     pub describe_frame: bool,
+
+    /// Print the autopilot parameters that match the vehicle's frame (the Iris preset or
+    /// --config's `[frame]`) and exit: `px4` (`NAME VALUE` lines, for PX4_PARAM_NAME=VALUE)
+    /// or `ardupilot` (a .parm file).
+    #[arg(long, value_enum)]
+    pub print_autopilot_params: Option<crate::autopilot_params::Autopilot>,
 }
 
 /// `--model`'s values: the core's model names.

@@ -7,7 +7,7 @@
 
 use flyloop_core::ParamError;
 use flyloop_core::params::Parameters;
-use flyloop_core::quadrotor::QuadrotorParams;
+use flyloop_core::quadrotor::{Frame, QuadrotorParams};
 use flyloop_core::sensors::SensorParams;
 use flyloop_core::tasks::randomization::ParamRange;
 use flyloop_core::tasks::registry::{TaskConfig, TaskKind, from_values_and_ranges, param_rows};
@@ -24,6 +24,9 @@ pub enum ConfigError {
     #[error("config file {path}: {source}")]
     Invalid { path: PathBuf, source: ParamError },
 }
+
+/// The autopilot modes' table of the vehicle's rotors (`core/src/quadrotor/frame.rs`).
+pub const FRAME_TABLE: &str = "frame";
 
 /// The config file's table of randomisation ranges: `[randomize]` with `name = [low, high]`.
 pub const RANDOMIZE_TABLE: &str = "randomize";
@@ -114,6 +117,8 @@ pub const IRIS_PRESET: &str = include_str!("../presets/px4_iris.toml");
 pub struct AutopilotVehicle {
     pub quadrotor: QuadrotorParams,
     pub sensors: SensorParams,
+    /// The rotor table (`[frame]`: `name = "hexa_x"`, or a whole table); the quad X if none.
+    pub frame: Frame,
 }
 
 impl AutopilotVehicle {
@@ -123,10 +128,19 @@ impl AutopilotVehicle {
         Self::parse(IRIS_PRESET).unwrap_or_default()
     }
 
-    /// Quadrotor and sensor parameters by their core names, in one flat table; no
-    /// randomisation.
+    /// Quadrotor and sensor parameters by their core names, in one flat table, and the
+    /// frame in its own `[frame]` table; no randomisation.
     pub fn parse(text: &str) -> Result<Self, ParamError> {
-        let table: toml::Table = toml::from_str(text)?;
+        let mut table: toml::Table = toml::from_str(text)?;
+        let frame = match table.remove(FRAME_TABLE) {
+            None => Frame::quad_x(),
+            Some(toml::Value::Table(t)) => Frame::from_toml_table(t)?,
+            Some(_) => {
+                return Err(ParamError::Parse(format!(
+                    "`{FRAME_TABLE}` must be a table: `name = \"hexa_x\"`, or `name` and one `[[{FRAME_TABLE}.rotor]]` per rotor"
+                )));
+            }
+        };
         let file = walk(&table, autopilot_name)?;
         if file.ranges.is_some() {
             return Err(ParamError::Parse(format!(
@@ -140,6 +154,7 @@ impl AutopilotVehicle {
         Ok(AutopilotVehicle {
             quadrotor: QuadrotorParams::from_values(quad)?,
             sensors: SensorParams::from_values(sensors)?,
+            frame,
         })
     }
 }

@@ -2,9 +2,6 @@
 //! body FLU) and the lander's plane (mapped into ENU/FLU here) become world NED and body
 //! FRD, and local metres become latitude / longitude / altitude around the home point.
 
-use flyloop_core::lander2d::Lander2d;
-use flyloop_core::quadrotor::Quadrotor;
-use flyloop_core::tasks::registry::TaskInstance;
 use nalgebra::{UnitQuaternion, Vector3};
 
 /// Standard gravity for milli-g units (mG), m/s².
@@ -12,104 +9,14 @@ pub const STANDARD_GRAVITY: f64 = 9.80665;
 use flyloop_core::sensors::Geodetic;
 pub use flyloop_core::sensors::gps::EARTH_RADIUS;
 
-/// A vehicle's state in the core's frames.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Kinematics {
-    /// Position, world ENU, m.
-    pub position: Vector3<f64>,
-    /// Velocity, world ENU, m/s.
-    pub velocity: Vector3<f64>,
-    /// Attitude, body FLU → world ENU.
-    pub attitude: UnitQuaternion<f64>,
-    /// Angular velocity in the body frame FLU, rad/s.
-    pub body_rates: Vector3<f64>,
-    /// Kinematic acceleration (total force / mass, gravity included), world ENU, m/s².
-    pub acceleration: Vector3<f64>,
-    /// Gravitational acceleration of the model, m/s² (positive).
-    pub gravity: f64,
-    /// Velocity relative to the air, world ENU, m/s.
-    pub air_velocity: Vector3<f64>,
-}
+/// A vehicle's state in the core's frames (the core's vehicle seam).
+pub use flyloop_core::vehicle::Kinematics;
 
-pub use flyloop_core::sensors::frames::{attitude_ned, enu_to_ned, flu_to_frd};
+pub use flyloop_core::frames::{attitude_ned, enu_to_ned, flu_to_frd};
 
 /// Roll, pitch, yaw (ZYX) of the NED/FRD attitude, rad; yaw in (−π, π], 0 = north.
 pub fn euler_ned(attitude_enu: &UnitQuaternion<f64>) -> (f64, f64, f64) {
     attitude_ned(attitude_enu).euler_angles()
-}
-
-impl Kinematics {
-    /// The state of `task`'s vehicle.
-    pub fn of_task(task: &TaskInstance) -> Self {
-        match task {
-            TaskInstance::Hover(t) => Kinematics::of_quadrotor(t.quadrotor()),
-            TaskInstance::Waypoints(t) => Kinematics::of_quadrotor(t.quadrotor()),
-            TaskInstance::Landing(t) => Kinematics::of_lander(t.lander()),
-        }
-    }
-
-    /// The quadrotor's state, already in ENU/FLU.
-    pub fn of_quadrotor(q: &Quadrotor) -> Self {
-        let b = &q.body;
-        Kinematics {
-            position: b.position,
-            velocity: b.velocity,
-            attitude: q.attitude(),
-            body_rates: b.body_rates,
-            acceleration: q.accelerations().0,
-            gravity: q.params.gravity,
-            air_velocity: q.air_velocity(),
-        }
-    }
-
-    /// The lander's plane is the world's east–up plane: x → east, y → up, north = 0, the
-    /// body's forward axis along the lander's +x. Its angle is counter-clockwise as seen with
-    /// east to the right and up on top, i.e. looking north, so it turns the body about the
-    /// north axis by −angle: a positive angle lifts the nose (a positive FRD pitch).
-    pub fn of_lander(l: &Lander2d) -> Self {
-        let d = l.drone();
-        let [ax, ay] = l.acceleration();
-        let [air_x, air_y] = l.air_velocity();
-        Kinematics {
-            position: Vector3::new(d.x, 0.0, d.y),
-            velocity: Vector3::new(d.vx, 0.0, d.vy),
-            attitude: UnitQuaternion::from_axis_angle(&Vector3::y_axis(), -d.angle),
-            body_rates: Vector3::new(0.0, -d.angular_velocity, 0.0),
-            acceleration: Vector3::new(ax, 0.0, ay),
-            gravity: l.params().gravity,
-            air_velocity: Vector3::new(air_x, 0.0, air_y),
-        }
-    }
-
-    /// Position north, east, down from the local origin, m.
-    pub fn position_ned(&self) -> Vector3<f64> {
-        enu_to_ned(&self.position)
-    }
-
-    /// Velocity north, east, down, m/s.
-    pub fn velocity_ned(&self) -> Vector3<f64> {
-        enu_to_ned(&self.velocity)
-    }
-
-    /// Body rates about FRD x, y, z (roll, pitch, yaw rate), rad/s.
-    pub fn body_rates_frd(&self) -> Vector3<f64> {
-        flu_to_frd(&self.body_rates)
-    }
-
-    /// What an accelerometer measures (acceleration minus gravity) in body FRD, m/s²: about
-    /// (0, 0, −g) in a level hover.
-    pub fn specific_force_frd(&self) -> Vector3<f64> {
-        flyloop_core::sensors::imu::specific_force_frd(
-            &self.attitude,
-            &self.acceleration,
-            self.gravity,
-        )
-    }
-
-    /// Speed relative to the air, m/s.
-    pub fn airspeed(&self) -> f64 {
-        self.air_velocity.norm()
-    }
 }
 
 /// The home point: the local origin's latitude, longitude (deg) and altitude (m above MSL).
@@ -261,7 +168,7 @@ mod tests {
 
     #[test]
     fn a_lander_tilted_counter_clockwise_pitches_nose_up_in_frd() {
-        use flyloop_core::lander2d::{Lander2dInitial, Lander2dParams};
+        use flyloop_core::lander2d::{Lander2d, Lander2dInitial, Lander2dParams};
         for angle in [0.3, -0.3] {
             let initial = Lander2dInitial {
                 initial_x: 12.0,
@@ -271,7 +178,7 @@ mod tests {
                 ..Lander2dInitial::default()
             };
             let lander = Lander2d::from_initial(Lander2dParams::default(), &initial).unwrap();
-            let k = Kinematics::of_lander(&lander);
+            let k = lander.kinematics();
             // The nose (body x forward) points east and, for a positive angle, up.
             let nose = k.attitude * Vector3::x();
             assert!(

@@ -18,6 +18,7 @@
 
 pub mod app;
 pub mod ardupilot;
+pub mod autopilot_params;
 pub mod cli;
 pub mod commands;
 pub mod config;

@@ -36,7 +36,7 @@ pub enum Status {
 /// Ground truth for a controller: attitude (FRD → NED), body rates, global position,
 /// NED velocity, airspeed and the accelerometer's specific force, at simulation time.
 pub fn hil_state_quaternion(v: &Vehicle, home: &Home) -> MavMessage {
-    hil_state_quaternion_of(&Kinematics::of_task(&v.task), home, v.clock_us)
+    hil_state_quaternion_of(&v.task.kinematics(), home, v.clock_us)
 }
 
 /// HIL_STATE_QUATERNION of state `k` at simulation time `time_usec` (µs).
@@ -96,7 +96,7 @@ pub fn heartbeat(v: &Vehicle, status: Status) -> MavMessage {
 }
 
 pub fn attitude(v: &Vehicle) -> MavMessage {
-    let k = Kinematics::of_task(&v.task);
+    let k = v.task.kinematics();
     let (roll, pitch, yaw) = crate::kinematics::euler_ned(&k.attitude);
     let rates = k.body_rates_frd();
     MavMessage::ATTITUDE(ATTITUDE_DATA {
@@ -112,13 +112,13 @@ pub fn attitude(v: &Vehicle) -> MavMessage {
 
 /// Heading in centidegrees [0, 36000).
 fn heading_cdeg(v: &Vehicle) -> u16 {
-    let (_, _, yaw) = crate::kinematics::euler_ned(&Kinematics::of_task(&v.task).attitude);
+    let (_, _, yaw) = crate::kinematics::euler_ned(&v.task.kinematics().attitude);
     let deg = yaw.to_degrees().rem_euclid(360.0);
     round_u16(deg * 100.0) % 36000
 }
 
 pub fn global_position_int(v: &Vehicle, home: &Home) -> MavMessage {
-    let k = Kinematics::of_task(&v.task);
+    let k = v.task.kinematics();
     let g = home.global(&k.position);
     let vel = k.velocity_ned();
     MavMessage::GLOBAL_POSITION_INT(GLOBAL_POSITION_INT_DATA {
@@ -135,7 +135,7 @@ pub fn global_position_int(v: &Vehicle, home: &Home) -> MavMessage {
 }
 
 pub fn local_position_ned(v: &Vehicle) -> MavMessage {
-    let k = Kinematics::of_task(&v.task);
+    let k = v.task.kinematics();
     let p = k.position_ned();
     let vel = k.velocity_ned();
     MavMessage::LOCAL_POSITION_NED(LOCAL_POSITION_NED_DATA {
@@ -150,7 +150,7 @@ pub fn local_position_ned(v: &Vehicle) -> MavMessage {
 }
 
 pub fn vfr_hud(v: &Vehicle, home: &Home) -> MavMessage {
-    let k = Kinematics::of_task(&v.task);
+    let k = v.task.kinematics();
     let n = v.command.len().max(1) as f64;
     let (lo, hi) = v.task.action_bounds();
     let throttle: f64 = v

@@ -4,7 +4,8 @@
 //!
 //! Columns: `connection` (1 for the first autopilot, 2 after a reconnect or restart, …),
 //! `time_us` (simulation time = the autopilot's clock), `north,east,down` (m from home), `vn,ve,vd` (m/s),
-//! `roll,pitch,yaw` (rad, FRD → NED), `m0..m3` (motor states in [0, 1]), `grounded` (0/1),
+//! `roll,pitch,yaw` (rad, FRD → NED), `m0..m{n-1}` (motor states in [0, 1], one per rotor),
+//! `grounded` (0/1),
 //! `p,q,r` (body rates, rad/s, FRD).
 
 use crate::kinematics::{attitude_ned, enu_to_ned, flu_to_frd};
@@ -16,9 +17,14 @@ use std::path::Path;
 /// Simulation time between two rows by default, µs (50 Hz).
 pub const TRACK_INTERVAL_US: u64 = 20_000;
 
-/// The CSV header line.
-pub const HEADER: &str =
-    "connection,time_us,north,east,down,vn,ve,vd,roll,pitch,yaw,m0,m1,m2,m3,grounded,p,q,r";
+/// The CSV header line of a vehicle with `rotors` rotors.
+pub fn header(rotors: usize) -> String {
+    let motors: Vec<String> = (0..rotors).map(|i| format!("m{i}")).collect();
+    format!(
+        "connection,time_us,north,east,down,vn,ve,vd,roll,pitch,yaw,{},grounded,p,q,r",
+        motors.join(",")
+    )
+}
 
 /// A track file being written.
 #[derive(Debug)]
@@ -30,10 +36,11 @@ pub struct Track {
 }
 
 impl Track {
-    /// Creates (truncates) `path` and writes the header; a row every `interval_us`.
-    pub fn create(path: &Path, interval_us: u64) -> io::Result<Self> {
+    /// Creates (truncates) `path` and writes the header of a vehicle with `rotors` rotors; a
+    /// row every `interval_us`.
+    pub fn create(path: &Path, interval_us: u64, rotors: usize) -> io::Result<Self> {
         let mut out = BufWriter::new(File::create(path)?);
-        writeln!(out, "{HEADER}")?;
+        writeln!(out, "{}", header(rotors))?;
         Ok(Track {
             out,
             next_us: 0,
@@ -59,25 +66,18 @@ impl Track {
         let p = enu_to_ned(&b.position);
         let v = enu_to_ned(&b.velocity);
         let (roll, pitch, yaw) = attitude_ned(&quad.attitude()).euler_angles();
-        let m = b.motors;
         let w = flu_to_frd(&b.body_rates);
+        write!(
+            self.out,
+            "{},{time_us},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.5},{:.5},{:.5}",
+            self.connection, p.x, p.y, p.z, v.x, v.y, v.z, roll, pitch, yaw,
+        )?;
+        for m in b.motors {
+            write!(self.out, ",{m:.4}")?;
+        }
         writeln!(
             self.out,
-            "{},{time_us},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.5},{:.5},{:.5},{:.4},{:.4},{:.4},{:.4},{},{:.5},{:.5},{:.5}",
-            self.connection,
-            p.x,
-            p.y,
-            p.z,
-            v.x,
-            v.y,
-            v.z,
-            roll,
-            pitch,
-            yaw,
-            m[0],
-            m[1],
-            m[2],
-            m[3],
+            ",{},{:.5},{:.5},{:.5}",
             u8::from(quad.is_grounded()),
             w.x,
             w.y,

@@ -210,7 +210,16 @@ class ArduPilot:
     """An ArduCopter SITL instance in its own working directory, flying flyloop (servo
     packets to flyloop's port), and a pymavlink link to its TCP port 5760 + 10i."""
 
-    def __init__(self, build: Build, instance: int, flyloop_port: int, workdir: Path, *extra):
+    def __init__(
+        self,
+        build: Build,
+        instance: int,
+        flyloop_port: int,
+        workdir: Path,
+        *extra,
+        parm: Path = PARM,
+    ):
+        """`parm`: flyloop's parameter file on top of copter.parm (the Iris's by default)."""
         self.instance = instance
         workdir.mkdir(parents=True, exist_ok=True)
         self.log = open(workdir / "arducopter.log", "w+")
@@ -221,7 +230,7 @@ class ArduPilot:
                 "--model",
                 "JSON:127.0.0.1",
                 "--defaults",
-                f"{build.copter_parm},{PARM}",
+                f"{build.copter_parm},{parm}",
                 "--home",
                 home,
                 "--speedup",
@@ -417,6 +426,33 @@ class Hold:
         h = max(math.hypot(s.position[0] - north, s.position[1] - east) for s in self.samples)
         v = max(abs(s.relative_alt - alt) for s in self.samples)
         return h, v
+
+
+def fly_mission(ap, flyloop):
+    """GUIDED, arm, takeoff to TAKEOFF_ALT, hold, 10 m north, hold, LAND and ArduPilot's own
+    disarm, then flyloop stopped; returns the holds (each with its north, east) and flyloop's
+    track."""
+    ap.wait_for_gps(120)
+    ap.mode(GUIDED)
+    ap.arm()
+    ap.takeoff()
+    settle(ap, 0.0, 0.0, TAKEOFF_ALT, 0.25, 60)
+    collect(ap, 2.0)  # the climb's overshoot dies out
+    hover = collect(ap, 3.0)
+    ap.goto(10.0, 0.0, TAKEOFF_ALT)
+    settle(ap, 10.0, 0.0, TAKEOFF_ALT, 0.25, 60)
+    collect(ap, 2.0)
+    away = collect(ap, 3.0)
+    ap.mode(LAND)
+    ap.wait_for(
+        "the automatic disarm after landing",
+        lambda m: m.get_srcSystem() == ap.target and not ap.armed(m),
+        90,
+        "HEARTBEAT",
+    )
+    time.sleep(0.5)  # a little rest on the ground in the track
+    flyloop.stop()
+    return [(hover, (0.0, 0.0)), (away, (10.0, 0.0))], flyloop.rows()
 
 
 def collect(source, seconds: float) -> Hold:

@@ -10,7 +10,14 @@ import pytest
 from flyloop import find_sitl_binary
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "sitl"))
-from ardupilot_support import ArduPilot, Flyloop, ardupilot_build, free_instance, fresh_dir  # noqa: E402
+from ardupilot_support import (  # noqa: E402
+    PARM,
+    ArduPilot,
+    Flyloop,
+    ardupilot_build,
+    free_instance,
+    fresh_dir,
+)
 
 
 @pytest.fixture(scope="session")
@@ -36,10 +43,15 @@ def pair(build, sitl_binary):
             started.append(f)
             return f
 
-        def ardupilot(self, flyloop: Flyloop, *extra: str, connect: bool = True) -> ArduPilot:
-            """An ArduPilot flying `flyloop`; with `connect`, the test's pymavlink link on its
-            TCP port (else a ground station must connect: ArduPilot waits for one)."""
-            a = ArduPilot(build, free_instance(), flyloop.port, fresh_dir("arducopter-"), *extra)
+        def ardupilot(
+            self, flyloop: Flyloop, *extra: str, connect: bool = True, parm: Path = PARM
+        ) -> ArduPilot:
+            """An ArduPilot flying `flyloop` with flyloop's `parm` file; with `connect`, the
+            test's pymavlink link on its TCP port (else a ground station must connect:
+            ArduPilot waits for one)."""
+            a = ArduPilot(
+                build, free_instance(), flyloop.port, fresh_dir("arducopter-"), *extra, parm=parm
+            )
             started.append(a)
             if connect:
                 a.connect()

@@ -135,9 +135,8 @@ def test_mavproxy_flies_guided_takeoff_goto_and_land_through_ardupilot(pair, tmp
         _, across, up = truth_vs_estimate_parts(rows, hold, 1)
         print(f"hold at {north, east}: truth vs estimate {across:.3f} m across, {up:.3f} m up")
         assert across < 0.5, f"truth vs estimate {across:.3f} m across at {north, east}"
-        # Open: in this test (about 160 s of ArduPilot's clock, twice the pymavlink flight's)
-        # ArduPilot's height estimate falls 0.4-0.7 m below the truth after the move in most
-        # runs, while the pymavlink flight keeps within 0.08 m; until that is understood,
-        # the height is held to 1 m here.
-        assert up < 1.0, f"truth vs estimate {up:.3f} m in height at {north, east}"
+        # This longer flight (about 160 s of ArduPilot's clock) used to end 0.4-0.7 m below
+        # the truth: the accelerometer bias wandered faster than EKF3 follows (docs/core.md,
+        # "Sensors"). Held to the estimate-vs-truth flight's limit now.
+        assert up < 0.15, f"truth vs estimate {up:.3f} m in height at {north, east}"
     check_landed(rows, 10.0, 0.0)

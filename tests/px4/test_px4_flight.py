@@ -12,50 +12,24 @@ import sys
 import time
 from pathlib import Path
 
-from px4_support import TAKEOFF_ALT, check_mission, collect, settle, truth_vs_estimate
+from px4_support import (
+    TAKEOFF_ALT,
+    check_mission,
+    collect,
+    fly_mission,
+    launch,
+    settle,
+    truth_vs_estimate,
+)
 
 ALT = TAKEOFF_ALT
-
-
-def launch(px4):
-    """Waits for PX4, arms it as soon as it is ready and commands the takeoff; returns PX4's
-    local frame and the takeoff target in it."""
-    px4.heartbeat(60)
-    px4.arm_when_ready(60)
-    px4.takeoff()
-    frame = px4.frame()
-    home = px4.home()
-    return frame, (home[0], home[1], home[2] - ALT)
-
-
-def offset(point, north=0.0, east=0.0):
-    return (point[0] + north, point[1] + east, point[2])
 
 
 def test_px4_takes_off_holds_flies_10_m_and_lands_on_flyloop(pair):
     flyloop = pair.flyloop()
     px4 = pair.px4()
-    frame, hover_target = launch(px4)
-    settle(px4, hover_target, 0.25, 60)
-    collect(px4, 2.0)  # let the climb's overshoot die out
-    hover = collect(px4, 3.0)
-    away_target = offset(hover_target, north=10.0)
-    px4.goto(frame, away_target)
-    settle(px4, away_target, 0.25, 60)
-    collect(px4, 2.0)
-    away = collect(px4, 3.0)
-    px4.land()
-    px4.wait_for(
-        "the automatic disarm after landing",
-        lambda m: m.get_srcSystem() == px4.target and not px4.armed(m),
-        90,
-        "HEARTBEAT",
-    )
-    time.sleep(0.5)  # a little rest on the ground in the track
-    flyloop.stop()
-    rows = flyloop.rows()
-
-    check_mission(rows, [(hover, hover_target), (away, away_target)], frame)
+    frame, holds, rows = fly_mission(px4, flyloop)
+    check_mission(rows, holds, frame)
 
     # docs/px4.md's plot script draws this track.
     png = flyloop.track.with_suffix(".png")

@@ -11,8 +11,11 @@ A fenced block is checked when the line before it is a marker comment:
 - ``<!-- check: doctest FILE -->``: the Rust block is the doc example of FILE (run by
   ``cargo test --doc``), line for line.
 - ``<!-- check: tested-by PATH -->``: the commands run in the tests under PATH (too long
-  for this file); every script the block names must appear there (or be a test file there).
+  for this file); every script and preset (``.py``, ``.toml``, ``.parm``) the block names must
+  appear there (or be a test file there).
 - ``<!-- check: sitl-config -->``: the TOML block is a ``--config`` file flyloop-sitl accepts.
+- ``<!-- check: autopilot-config -->``: the TOML block is a ``--config`` file of the PX4 and
+  ArduPilot modes (vehicle parameters and a ``[frame]``) that flyloop-sitl accepts.
 - ``<!-- check: ci -->``: the README's two top commands; ``.ci/run`` runs each line as written.
 
 Python blocks must run without a warning. Every fenced block carries a marker: a block
@@ -123,7 +126,7 @@ def environment(sitl: Path) -> dict[str, str]:
 
 def test_the_markers_are_known_and_the_core_blocks_are_checked():
     known = {"run", "python", "python-sitl", "sitl-commands", "doctest", "tested-by", "ci"}
-    known.add("sitl-config")
+    known.update({"sitl-config", "autopilot-config"})
     assert {b.kind for b in ALL if b.kind} <= known
     unchecked = [f"{b.where} ({b.language})" for b in ALL if b.kind is None]
     assert not unchecked, f"blocks that no test or CI step runs: {unchecked}"
@@ -331,13 +334,31 @@ def test_long_commands_are_run_by_their_tests(block: Block):
     tests = sorted((REPO / block.argument).rglob("*.py"))
     assert tests, block.argument
     corpus = "\n".join(t.read_text() for t in tests)
-    scripts = {w for c in commands(block) for w in shlex.split(c) if w.endswith(".py")}
+    named = (".py", ".toml", ".parm")
+    scripts = {w for c in commands(block) for w in shlex.split(c) if w.endswith(named)}
     assert scripts
     for script in scripts:
         is_a_test = (REPO / script) in tests
         assert is_a_test or Path(script).name in corpus, (
             f"{block.where}: {script} is run by no test in {block.argument}"
         )
+
+
+@pytest.mark.parametrize("block", of_kind("autopilot-config"), ids=lambda b: b.id)
+def test_frame_configs_are_accepted_by_the_autopilot_modes(
+    block: Block, sitl_binary: Path, tmp_path: Path
+):
+    config = tmp_path / "vehicle.toml"
+    config.write_text(block.text)
+    result = subprocess.run(
+        [str(sitl_binary), "--config", str(config), "--print-autopilot-params", "px4"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert result.returncode == 0, f"{block.where}: {result.stderr}"
+    rotors = block.text.count("[[frame.rotor]]")
+    assert f"CA_ROTOR_COUNT {rotors}\n" in result.stdout, result.stdout
 
 
 @pytest.mark.parametrize("block", of_kind("sitl-config"), ids=lambda b: b.id)

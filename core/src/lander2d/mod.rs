@@ -9,6 +9,7 @@
 pub mod contact;
 pub mod drone;
 pub(crate) mod free_body;
+mod kinematics;
 pub mod model;
 pub mod params;
 pub(crate) mod scene;

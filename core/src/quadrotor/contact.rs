@@ -28,19 +28,17 @@
 //! (2 ms: ω·h = 0.22): 5 substeps for a 10 ms control step, 2 for PX4's 4 ms step. A step in
 //! which no foot can reach the ground keeps `max_substep` and never evaluates the contact.
 
-use super::params::{QuadrotorParams, ROTOR_POSITION};
+use super::dynamics::BRISTLES;
+use super::params::QuadrotorParams;
 use super::state::BodyState;
 
-/// Index of the first bristle value in the contact integrator's flat state (after the 17
-/// values of the rigid body and motors).
-pub(crate) const STRETCH: usize = 17;
+/// Signs (forward, left) of the four feet: front-right, rear-left, front-left, rear-right
+/// (the quad X's rotor order, whatever the frame).
+const FOOT_SIGNS: [(f64, f64); 4] = [(1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (-1.0, -1.0)];
 
-/// Length of the contact integrator's flat state.
-pub(crate) const CONTACT_LEN: usize = STRETCH + 8;
-
-/// The four feet in body FLU, m, in rotor order.
+/// The four feet in body FLU, m.
 pub fn feet(p: &QuadrotorParams) -> [[f64; 3]; 4] {
-    ROTOR_POSITION.map(|(fwd, left)| [fwd * p.gear_x, left * p.gear_y, p.gear_z])
+    FOOT_SIGNS.map(|(fwd, left)| [fwd * p.gear_x, left * p.gear_y, p.gear_z])
 }
 
 /// Distance of every foot from the centre of mass, m: while z exceeds it no foot can be on
@@ -113,10 +111,12 @@ impl Gear {
     }
 
     /// Adds the contact's accelerations to the body rates in `d` and writes the bristle rates
-    /// into `d[STRETCH..]`, for the flat state `x` (layout of the integrator, module docs).
+    /// into its last 8 values, for the flat state `x` (layout of the integrator: the rigid
+    /// body first, the bristles last; `dynamics`).
     #[inline(always)]
-    pub(crate) fn add_rates(&self, x: &[f64; CONTACT_LEN], d: &mut [f64; CONTACT_LEN]) {
-        for i in STRETCH..CONTACT_LEN {
+    pub(crate) fn add_rates<const C: usize>(&self, x: &[f64; C], d: &mut [f64; C]) {
+        let stretch = C - BRISTLES;
+        for i in stretch..C {
             d[i] = self.relax * x[i];
         }
         let z = x[2];
@@ -141,19 +141,19 @@ impl Gear {
                 v[2] + dot(&r[2], &spin),
             ];
             let normal = (k * -height - c * vf[2]).max(0.0);
-            let (sx, sy) = (x[STRETCH + 2 * i], x[STRETCH + 2 * i + 1]);
+            let (sx, sy) = (x[stretch + 2 * i], x[stretch + 2 * i + 1]);
             let (tx, ty) = (-(k * sx + c * vf[0]), -(k * sy + c * vf[1]));
             let limit = self.friction * normal;
             let magnitude2 = tx * tx + ty * ty;
             let (fx, fy) = if magnitude2 <= limit * limit {
-                d[STRETCH + 2 * i] = vf[0];
-                d[STRETCH + 2 * i + 1] = vf[1];
+                d[stretch + 2 * i] = vf[0];
+                d[stretch + 2 * i + 1] = vf[1];
                 (tx, ty)
             } else {
                 let scale = limit / magnitude2.sqrt();
                 let (fx, fy) = (tx * scale, ty * scale);
-                d[STRETCH + 2 * i] = (-fx - k * sx) / c;
-                d[STRETCH + 2 * i + 1] = (-fy - k * sy) / c;
+                d[stretch + 2 * i] = (-fx - k * sx) / c;
+                d[stretch + 2 * i + 1] = (-fy - k * sy) / c;
                 (fx, fy)
             };
             let f = [fx, fy, normal];
@@ -176,14 +176,16 @@ impl Gear {
         }
     }
 
-    /// Sets the bristle of every foot above the ground to zero (lift-off).
+    /// Sets the bristle of every foot above the ground to zero (lift-off), in a state whose
+    /// last 8 values are the bristles.
     #[inline(always)]
-    pub(crate) fn release_lifted_feet(&self, x: &mut [f64; CONTACT_LEN]) {
+    pub(crate) fn release_lifted_feet(&self, x: &mut [f64]) {
         let r = rotation(x[6], x[7], x[8], x[9]);
+        let stretch = x.len() - BRISTLES;
         for (i, foot) in self.feet.iter().enumerate() {
             if x[2] + dot(&r[2], foot) > 0.0 {
-                x[STRETCH + 2 * i] = 0.0;
-                x[STRETCH + 2 * i + 1] = 0.0;
+                x[stretch + 2 * i] = 0.0;
+                x[stretch + 2 * i + 1] = 0.0;
             }
         }
     }
@@ -228,6 +230,10 @@ fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The quad's contact state: 13 body values, 4 motors, 8 bristles.
+    const CONTACT_LEN: usize = 25;
+    const STRETCH: usize = 17;
     use nalgebra::{UnitQuaternion, Vector3};
 
     /// The foot heights against nalgebra's rotation of each foot, tilted and turned.

@@ -10,10 +10,10 @@
 //!   random stream in the same order as the stepper draws it, so both see the same weather.
 
 use super::contact::Gear;
-use super::dynamics::{self, STATE_LEN};
+use super::dynamics;
 use super::model::Quadrotor;
 use super::wind;
-use crate::error::{InputError, check_finite};
+use crate::error::{CommandError, check_finite};
 
 /// Number of event indicators: one foot height per landing-gear foot.
 pub const EVENT_INDICATORS: usize = 4;
@@ -78,22 +78,36 @@ pub const BODY_STATE_OUTPUTS: [&str; 17] = [
 ];
 
 impl Quadrotor {
+    /// Number of continuous states: 13 rigid-body values, one per motor, 8 bristles.
+    pub fn state_len(&self) -> usize {
+        dynamics::state_len(self.frame().rotor_count())
+    }
+
     /// The continuous state (layout of [`dynamics::state_vector`]).
-    pub fn continuous_state(&self) -> [f64; STATE_LEN] {
+    pub fn continuous_state(&self) -> Vec<f64> {
         dynamics::state_vector(&self.body)
     }
 
-    /// Sets the continuous state; every value must be finite (nothing changes otherwise).
-    pub fn set_continuous_state(&mut self, x: &[f64; STATE_LEN]) -> Result<(), InputError> {
+    /// Sets the continuous state; it must have [`Quadrotor::state_len`] values, every one
+    /// finite (nothing changes otherwise).
+    pub fn set_continuous_state(&mut self, x: &[f64]) -> Result<(), CommandError> {
+        if x.len() != self.state_len() {
+            return Err(CommandError::WrongLength {
+                what: "continuous state",
+                expected: self.state_len(),
+                got: x.len(),
+            });
+        }
         check_finite("continuous state", x)?;
         dynamics::set_state_vector(x, &mut self.body);
         Ok(())
     }
 
     /// The derivative of [`Quadrotor::continuous_state`] under the current command and wind.
-    pub fn state_derivative(&self) -> [f64; STATE_LEN] {
+    pub fn state_derivative(&self) -> Vec<f64> {
         dynamics::derivative_vector(
             &self.params,
+            self.frame(),
             &self.body,
             &self.command(),
             &self.wind_velocity(),
@@ -170,6 +184,7 @@ mod tests {
         let d = quad.state_derivative();
         let core = dynamics::derivatives(
             &quad.params,
+            quad.frame(),
             &quad.body,
             &quad.command(),
             &quad.wind_velocity(),
@@ -177,13 +192,20 @@ mod tests {
         assert_eq!(d[..3], [0.3, 0.1, -0.4]);
         assert_eq!(d[3..6], *core.acceleration.as_slice());
         assert_eq!(d[13], (0.6 - 0.5) / 0.08);
-        let mut y = x;
+        let mut y = x.clone();
         y[2] = 1.0;
         quad.set_continuous_state(&y).unwrap();
         assert_eq!(quad.continuous_state(), y);
         y[5] = f64::NAN;
-        let e = quad.set_continuous_state(&y).unwrap_err();
+        let Err(CommandError::NotFinite(e)) = quad.set_continuous_state(&y) else {
+            panic!("a NaN state was taken");
+        };
         assert_eq!((e.index, quad.continuous_state()[5]), (5, x[5]));
+        let e = quad.set_continuous_state(&y[..20]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "continuous state has 20 values, the vehicle takes 25"
+        );
     }
 
     /// Events on the turbulence grid draw the same samples as the stepper does.

@@ -1,15 +1,28 @@
 //! Equations of motion and their integration.
 //!
-//! World ENU, body FLU. Rotor i of PX4's quad-X sits at (±L/√2, ±L/√2): 0 front-right CCW,
-//! 1 rear-left CCW, 2 front-left CW, 3 rear-right CW. Thrust T_i = k m_i² along body +z;
-//! torques are r_i × F_i plus the spin reaction (a CCW rotor pushes the body toward −z).
+//! World ENU, body FLU. The rotors are the frame's table ([`super::frame`]): rotor i at
+//! L·(xᵢ, yᵢ) pushes T_i = kᵢ mᵢ² along body +z; torques are r_i × F_i plus the spin
+//! reaction (a CCW rotor pushes the body toward −z), summed as [`super::mixing`] groups them.
 //! Body rates are integrated as body rates: q̇ = ½ q ⊗ (0, ω), I ω̇ = τ − ω × I ω.
 //! The ground pushes on four landing-gear feet ([`super::contact`]).
+//!
+//! The integrator works on flat arrays of a length fixed at compile time: 13 rigid-body
+//! values, then the motors (4 for a quad; a frame of n rotors runs in the next size up of 4,
+//! 6, 8 or 12, its unused motors held at zero), then the 8 bristles when a foot may touch. The
+//! quad X runs exactly the operations it ran before frames existed.
 
-use super::contact::{CONTACT_LEN, Gear, STRETCH, gear_reach};
+use super::contact::{Gear, gear_reach};
+use super::frame::{Frame, MAX_ROTORS};
+use super::mixing::Mixing;
 use super::params::QuadrotorParams;
-use super::state::BodyState;
+use super::state::{BodyState, Motors};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+
+/// Rigid-body values at the head of every flat state: position 0..3, velocity 3..6,
+/// quaternion w, x, y, z 6..10, body rates 10..13.
+pub(crate) const BODY: usize = 13;
+/// Bristle values at the end of a contact state: x, y per foot.
+pub(crate) const BRISTLES: usize = 8;
 
 /// Time derivative of a [`BodyState`] (same shape: velocity, acceleration, q̇, ω̇, ṁ, ṡ).
 #[derive(Debug, Clone, Copy)]
@@ -18,195 +31,335 @@ pub struct Derivative {
     pub acceleration: Vector3<f64>,
     pub attitude_rate: Quaternion<f64>,
     pub angular_acceleration: Vector3<f64>,
-    pub motor_rates: [f64; 4],
+    pub motor_rates: Motors,
     pub gear_stretch_rates: [[f64; 2]; 4],
 }
 
-/// Constants of the equations that depend only on the parameters, computed once per step.
+/// Constants of the equations that depend only on the parameters and the frame, computed
+/// once per step.
 #[derive(Debug, Clone, Copy)]
-struct Coefficients {
-    /// k·L/√2: roll/pitch torque per unit of squared motor state, N·m.
-    roll_pitch: f64,
-    /// k·c_yaw: yaw reaction torque per unit of squared motor state, N·m.
-    yaw: f64,
-    /// k/m: acceleration per unit of squared motor state, m/s².
-    thrust_per_mass: f64,
+struct Coefficients<'f> {
+    mixing: &'f Mixing,
+    /// Per thrust term: kᵢ/m, m/s² per unit of squared motor state.
+    thrust: [f64; MAX_ROTORS],
+    /// Per roll term: kᵢ·L·|yᵢ|, N·m.
+    roll: [f64; MAX_ROTORS],
+    /// Per pitch term: kᵢ·L·|xᵢ|, N·m.
+    pitch: [f64; MAX_ROTORS],
+    /// Per yaw term: kᵢ·cᵢ, N·m.
+    yaw: [f64; MAX_ROTORS],
+    /// Σ kᵢ/m: the acceleration of every motor at full state, m/s².
+    full_thrust_per_mass: f64,
     /// ½ρC_dA/m, 1/m.
     drag_per_mass: f64,
     gravity: f64,
     inertia: Vector3<f64>,
     inv_inertia: Vector3<f64>,
-    inv_tau: f64,
+    /// 1/τᵢ per motor, 1/s (zero for an unused slot).
+    inv_tau: [f64; MAX_ROTORS],
 }
 
-impl Coefficients {
-    fn new(p: &QuadrotorParams) -> Self {
-        let lever = p.arm_length * std::f64::consts::FRAC_1_SQRT_2;
-        Coefficients {
-            roll_pitch: p.thrust_coefficient * lever,
-            yaw: p.thrust_coefficient * p.yaw_torque_coefficient,
-            thrust_per_mass: p.thrust_coefficient / p.mass,
+impl<'f> Coefficients<'f> {
+    fn new(p: &QuadrotorParams, frame: &'f Frame) -> Self {
+        let rotors = frame.rotors();
+        let mixing = frame.mixing();
+        let k = |i: u8| {
+            rotors[i as usize]
+                .thrust_coefficient
+                .unwrap_or(p.thrust_coefficient)
+        };
+        let mut c = Coefficients {
+            mixing,
+            thrust: [0.0; MAX_ROTORS],
+            roll: [0.0; MAX_ROTORS],
+            pitch: [0.0; MAX_ROTORS],
+            yaw: [0.0; MAX_ROTORS],
+            full_thrust_per_mass: 0.0,
             drag_per_mass: 0.5 * p.air_density * p.drag_area / p.mass,
             gravity: p.gravity,
             inertia: Vector3::new(p.inertia_xx, p.inertia_yy, p.inertia_zz),
             inv_inertia: Vector3::new(1.0 / p.inertia_xx, 1.0 / p.inertia_yy, 1.0 / p.inertia_zz),
-            inv_tau: 1.0 / p.motor_time_constant,
+            inv_tau: [0.0; MAX_ROTORS],
+        };
+        for (t, term) in mixing.thrust.terms().iter().enumerate() {
+            c.thrust[t] = k(term.representative) / p.mass;
+            c.full_thrust_per_mass += term.len() as f64 * c.thrust[t];
         }
+        for (t, term) in mixing.roll.terms().iter().enumerate() {
+            let r = &rotors[term.representative as usize];
+            c.roll[t] = k(term.representative) * (p.arm_length * r.y.abs());
+        }
+        for (t, term) in mixing.pitch.terms().iter().enumerate() {
+            let r = &rotors[term.representative as usize];
+            c.pitch[t] = k(term.representative) * (p.arm_length * r.x.abs());
+        }
+        for (t, term) in mixing.yaw.terms().iter().enumerate() {
+            let r = &rotors[term.representative as usize];
+            c.yaw[t] =
+                k(term.representative) * r.torque_coefficient.unwrap_or(p.yaw_torque_coefficient);
+        }
+        for (i, r) in rotors.iter().enumerate() {
+            c.inv_tau[i] = 1.0 / r.time_constant.unwrap_or(p.motor_time_constant);
+        }
+        c
     }
+}
+
+/// Calls `$f::<L, C>(args)` with the flat lengths of a frame of `$rotors` rotors: L = 13 +
+/// motor slots (4, 6, 8 or 12), C = L + 8 bristles.
+macro_rules! by_size {
+    ($rotors:expr, $f:ident($($arg:expr),*)) => {
+        match $rotors {
+            ..=4 => $f::<17, 25>($($arg),*),
+            5..=6 => $f::<19, 27>($($arg),*),
+            7..=8 => $f::<21, 29>($($arg),*),
+            _ => $f::<25, 33>($($arg),*),
+        }
+    };
 }
 
 /// The state derivative for motor commands `command` (in [0, 1]) and air velocity `wind`,
 /// ground contact included: a pure function of the state.
 pub fn derivatives(
     params: &QuadrotorParams,
+    frame: &Frame,
     state: &BodyState,
-    command: &[f64; 4],
+    command: &Motors,
     wind: &Vector3<f64>,
 ) -> Derivative {
-    let d = derivative_vector(params, state, command, wind);
-    let s = &d[STRETCH..];
+    by_size!(
+        frame.rotor_count(),
+        derivatives_sized(params, frame, state, command, wind)
+    )
+}
+
+fn derivatives_sized<const L: usize, const C: usize>(
+    params: &QuadrotorParams,
+    frame: &Frame,
+    state: &BodyState,
+    command: &Motors,
+    wind: &Vector3<f64>,
+) -> Derivative {
+    let d = derivative_sized::<L, C>(params, frame, state, command, wind);
+    let n = frame.rotor_count();
+    let s = &d[L..];
+    let mut motor_rates = Motors::zeros(n);
+    motor_rates.copy_from_slice(&d[BODY..BODY + n]);
     Derivative {
         velocity: Vector3::new(d[0], d[1], d[2]),
         acceleration: Vector3::new(d[3], d[4], d[5]),
         attitude_rate: Quaternion::new(d[6], d[7], d[8], d[9]),
         angular_acceleration: Vector3::new(d[10], d[11], d[12]),
-        motor_rates: [d[13], d[14], d[15], d[16]],
+        motor_rates,
         gear_stretch_rates: [[s[0], s[1]], [s[2], s[3]], [s[4], s[5]], [s[6], s[7]]],
     }
 }
 
-/// Length of the continuous state vector: 17 rigid-body and motor values, 8 bristles.
-pub const STATE_LEN: usize = CONTACT_LEN;
-
-/// The continuous state as one vector: position 0..3, velocity 3..6, quaternion w, x, y, z
-/// 6..10, body rates 10..13, motors 13..17, bristles (x, y per foot) 17..25 — the vector the
-/// stepper integrates while a foot may touch, and a Model-Exchange solver always.
-pub fn state_vector(state: &BodyState) -> [f64; STATE_LEN] {
-    flatten_contact(state)
+/// Length of the continuous state vector of a frame of `rotors` rotors: 13 rigid-body
+/// values, one per motor, 8 bristles (25 for a quad).
+pub fn state_len(rotors: usize) -> usize {
+    BODY + rotors + BRISTLES
 }
 
-/// Writes a [`state_vector`] back into `state`.
-pub fn set_state_vector(x: &[f64; STATE_LEN], state: &mut BodyState) {
-    unflatten_contact(x, state);
+/// The continuous state as one vector: position 0..3, velocity 3..6, quaternion w, x, y, z
+/// 6..10, body rates 10..13, the n motors 13..13+n, bristles (x, y per foot) after them — the
+/// vector the stepper integrates while a foot may touch, and a Model-Exchange solver always.
+pub fn state_vector(state: &BodyState) -> Vec<f64> {
+    let mut x = Vec::with_capacity(state_len(state.motors.len()));
+    x.extend_from_slice(&body_values(state));
+    x.extend_from_slice(&state.motors);
+    x.extend(state.gear_stretch.iter().flatten());
+    x
+}
+
+/// Writes a [`state_vector`] (of the state's own length) back into `state`.
+pub fn set_state_vector(x: &[f64], state: &mut BodyState) {
+    let n = state.motors.len();
+    debug_assert_eq!(x.len(), state_len(n));
+    set_body_values(&x[..BODY], state);
+    state.motors.copy_from_slice(&x[BODY..BODY + n]);
+    for (i, stretch) in state.gear_stretch.iter_mut().enumerate() {
+        *stretch = [x[BODY + n + 2 * i], x[BODY + n + 2 * i + 1]];
+    }
 }
 
 /// The time derivative of [`state_vector`]: the right-hand side RK4 integrates (with the
 /// contact when the ground is on; the bristles do not move without it).
 pub fn derivative_vector(
     params: &QuadrotorParams,
+    frame: &Frame,
     state: &BodyState,
-    command: &[f64; 4],
+    command: &Motors,
     wind: &Vector3<f64>,
-) -> [f64; STATE_LEN] {
-    let c = Coefficients::new(params);
+) -> Vec<f64> {
+    by_size!(
+        frame.rotor_count(),
+        derivative_compact(params, frame, state, command, wind)
+    )
+}
+
+/// The sized derivative without its unused motor slots.
+fn derivative_compact<const L: usize, const C: usize>(
+    params: &QuadrotorParams,
+    frame: &Frame,
+    state: &BodyState,
+    command: &Motors,
+    wind: &Vector3<f64>,
+) -> Vec<f64> {
+    let d = derivative_sized::<L, C>(params, frame, state, command, wind);
+    let rotors = frame.rotor_count();
+    let mut out = Vec::with_capacity(state_len(rotors));
+    out.extend_from_slice(&d[..BODY + rotors]);
+    out.extend_from_slice(&d[L..]);
+    out
+}
+
+fn derivative_sized<const L: usize, const C: usize>(
+    params: &QuadrotorParams,
+    frame: &Frame,
+    state: &BodyState,
+    command: &Motors,
+    wind: &Vector3<f64>,
+) -> [f64; C] {
+    let c = Coefficients::new(params, frame);
+    let command = command.padded();
     if params.ground_enabled {
-        contact_rates(
+        contact_rates::<L, C>(
             params,
             &c,
             &Gear::new(params),
-            &flatten_contact(state),
+            &flatten_contact::<L, C>(state),
             command,
             wind,
         )
     } else {
-        let mut d = [0.0; CONTACT_LEN];
-        d[..STRETCH].copy_from_slice(&rates(params, &c, &flatten(state), command, wind));
+        let mut d = [0.0; C];
+        d[..L].copy_from_slice(&rates::<L>(params, &c, &flatten::<L>(state), command, wind));
         d
     }
 }
 
-/// A [`BodyState`] as one flat vector for the integrator (position 0..3, velocity 3..6,
-/// quaternion w, x, y, z 6..10, body rates 10..13, motors 13..17): RK4's stage sums become
-/// plain loops the compiler vectorises.
-type Flat = [f64; 17];
-
+/// The 13 rigid-body values of a state, in flat order.
 #[inline(always)]
-fn flatten(s: &BodyState) -> Flat {
-    let (p, v, q, w, m) = (s.position, s.velocity, s.attitude, s.body_rates, s.motors);
+fn body_values(s: &BodyState) -> [f64; BODY] {
+    let (p, v, q, w) = (s.position, s.velocity, s.attitude, s.body_rates);
     [
-        p.x, p.y, p.z, v.x, v.y, v.z, q.w, q.i, q.j, q.k, w.x, w.y, w.z, m[0], m[1], m[2], m[3],
+        p.x, p.y, p.z, v.x, v.y, v.z, q.w, q.i, q.j, q.k, w.x, w.y, w.z,
     ]
 }
 
-/// Writes a flat state back into `s` (the bristles are left alone).
 #[inline(always)]
-fn unflatten_into(x: &Flat, s: &mut BodyState) {
+fn set_body_values(x: &[f64], s: &mut BodyState) {
     s.position = Vector3::new(x[0], x[1], x[2]);
     s.velocity = Vector3::new(x[3], x[4], x[5]);
     s.attitude = Quaternion::new(x[6], x[7], x[8], x[9]);
     s.body_rates = Vector3::new(x[10], x[11], x[12]);
-    s.motors = [x[13], x[14], x[15], x[16]];
 }
 
-/// The state of a step that may touch the ground: [`Flat`] followed by the four bristles
-/// (x, y each).
-type ContactFlat = [f64; CONTACT_LEN];
-
+/// A [`BodyState`] as one flat vector of length `L` for the integrator (the rigid body, then
+/// L − 13 motor slots): RK4's stage sums become plain loops the compiler vectorises.
 #[inline(always)]
-fn flatten_contact(s: &BodyState) -> ContactFlat {
-    let mut x = [0.0; CONTACT_LEN];
-    x[..STRETCH].copy_from_slice(&flatten(s));
+fn flatten<const L: usize>(s: &BodyState) -> [f64; L] {
+    let mut x = [0.0; L];
+    x[..BODY].copy_from_slice(&body_values(s));
+    x[BODY..].copy_from_slice(&s.motors.padded()[..L - BODY]);
+    x
+}
+
+/// Writes a flat state back into `s` (the bristles are left alone).
+#[inline(always)]
+fn unflatten_into<const L: usize>(x: &[f64; L], s: &mut BodyState) {
+    set_body_values(&x[..BODY], s);
+    s.motors.padded_mut()[..L - BODY].copy_from_slice(&x[BODY..]);
+}
+
+/// The state of a step that may touch the ground: the flat state (L values) followed by the
+/// four bristles (x, y each): C = L + 8.
+#[inline(always)]
+fn flatten_contact<const L: usize, const C: usize>(s: &BodyState) -> [f64; C] {
+    let mut x = [0.0; C];
+    x[..L].copy_from_slice(&flatten::<L>(s));
     for (i, stretch) in s.gear_stretch.iter().enumerate() {
-        x[STRETCH + 2 * i] = stretch[0];
-        x[STRETCH + 2 * i + 1] = stretch[1];
+        x[L + 2 * i] = stretch[0];
+        x[L + 2 * i + 1] = stretch[1];
     }
     x
 }
 
 #[inline(always)]
-fn unflatten_contact(x: &ContactFlat, s: &mut BodyState) {
-    let mut body = [0.0; STRETCH];
-    body.copy_from_slice(&x[..STRETCH]);
+fn unflatten_contact<const L: usize, const C: usize>(x: &[f64; C], s: &mut BodyState) {
+    let mut body = [0.0; L];
+    body.copy_from_slice(&x[..L]);
     unflatten_into(&body, s);
     for (i, stretch) in s.gear_stretch.iter_mut().enumerate() {
-        *stretch = [x[STRETCH + 2 * i], x[STRETCH + 2 * i + 1]];
+        *stretch = [x[L + 2 * i], x[L + 2 * i + 1]];
     }
 }
 
 /// The equations of motion on a flat state (module docs).
 #[inline(always)]
-fn rates(
+fn rates<const L: usize>(
     p: &QuadrotorParams,
     c: &Coefficients,
-    x: &Flat,
-    command: &[f64; 4],
+    x: &[f64; L],
+    command: &[f64; MAX_ROTORS],
     wind: &Vector3<f64>,
-) -> Flat {
-    let (m0, m1, m2, m3) = (x[13], x[14], x[15], x[16]);
-    // T_i = k m_i².
-    let squares = [m0 * m0, m1 * m1, m2 * m2, m3 * m3];
-    let [ax, ay, az] = acceleration(c, x, &squares, wind);
-    let [alpha_x, alpha_y, alpha_z] = angular_acceleration(p, c, x, &squares);
+) -> [f64; L] {
+    let (thrust, torque) = if L == BODY + 4 && c.mixing.quad_x_terms {
+        quad_x_sums(c, x)
+    } else {
+        rotor_sums(c, x)
+    };
+    let [ax, ay, az] = acceleration(c, x, thrust, wind);
+    let [alpha_x, alpha_y, alpha_z] = angular_acceleration(p, c, x, torque);
     let [dqw, dqx, dqy, dqz] = attitude_rate(x);
-    [
-        x[3],
-        x[4],
-        x[5],
-        ax,
-        ay,
-        az,
-        dqw,
-        dqx,
-        dqy,
-        dqz,
-        alpha_x,
-        alpha_y,
-        alpha_z,
-        (command[0] - m0) * c.inv_tau,
-        (command[1] - m1) * c.inv_tau,
-        (command[2] - m2) * c.inv_tau,
-        (command[3] - m3) * c.inv_tau,
-    ]
+    let mut d = [0.0; L];
+    d[..BODY].copy_from_slice(&[
+        x[3], x[4], x[5], ax, ay, az, dqw, dqx, dqy, dqz, alpha_x, alpha_y, alpha_z,
+    ]);
+    for i in 0..L - BODY {
+        d[BODY + i] = (command[i] - x[BODY + i]) * c.inv_tau[i];
+    }
+    d
 }
 
-/// Acceleration (world) of a flat state with squared motor states `squares`: thrust along
-/// body z, gravity, quadratic drag on the air-relative velocity.
+/// The thrust (acceleration along body z) and the rotors' torque (body) of a flat state: the
+/// frame's grouped sums of T_i = k m_i² ([`super::mixing`]).
 #[inline(always)]
-fn acceleration(c: &Coefficients, x: &Flat, squares: &[f64; 4], wind: &Vector3<f64>) -> [f64; 3] {
+fn rotor_sums<const L: usize>(c: &Coefficients, x: &[f64; L]) -> (f64, [f64; 3]) {
+    let mut squares = [0.0; MAX_ROTORS];
+    for i in 0..L - BODY {
+        squares[i] = x[BODY + i] * x[BODY + i];
+    }
+    let m = c.mixing;
+    let torque = [
+        m.roll.sum(&c.roll, &squares),
+        m.pitch.sum(&c.pitch, &squares),
+        m.yaw.sum(&c.yaw, &squares),
+    ];
+    (m.thrust.sum(&c.thrust, &squares), torque)
+}
+
+/// [`rotor_sums`] of a frame with the quad X's terms, written out: the same operations in
+/// the same order, kept in registers.
+#[inline(always)]
+fn quad_x_sums<const L: usize>(c: &Coefficients, x: &[f64; L]) -> (f64, [f64; 3]) {
+    let (m0, m1, m2, m3) = (x[BODY], x[BODY + 1], x[BODY + 2], x[BODY + 3]);
+    let (s0, s1, s2, s3) = (m0 * m0, m1 * m1, m2 * m2, m3 * m3);
+    let torque = [
+        c.roll[0] * ((s1 + s2) - (s0 + s3)),
+        c.pitch[0] * ((s1 + s3) - (s0 + s2)),
+        c.yaw[0] * ((s2 + s3) - (s0 + s1)),
+    ];
+    (c.thrust[0] * ((s0 + s1) + (s2 + s3)), torque)
+}
+
+/// Acceleration (world) of a flat state with `thrust` (the thrust sum: acceleration along
+/// body z): thrust, gravity, quadratic drag on the air-relative velocity.
+#[inline(always)]
+fn acceleration(c: &Coefficients, x: &[f64], thrust: f64, wind: &Vector3<f64>) -> [f64; 3] {
     let (vx, vy, vz) = (x[3], x[4], x[5]);
     let (qw, qx, qy, qz) = (x[6], x[7], x[8], x[9]);
-    let [s0, s1, s2, s3] = *squares;
-    let thrust = c.thrust_per_mass * ((s0 + s1) + (s2 + s3));
     let (bx, by, bz) = (
         2.0 * (qx * qz + qw * qy),
         2.0 * (qy * qz - qw * qx),
@@ -221,24 +374,21 @@ fn acceleration(c: &Coefficients, x: &Flat, squares: &[f64; 4], wind: &Vector3<f
     ]
 }
 
-/// Angular acceleration (body) of a flat state with squared motor states `squares`: rotors,
-/// damping, optional pendulum; Euler's equation with the gyroscopic term ω × Iω.
+/// Angular acceleration (body) of a flat state with the rotors' `torque` (body, N·m):
+/// rotors, damping, optional pendulum; Euler's equation with the gyroscopic term ω × Iω.
 #[inline(always)]
 fn angular_acceleration(
     p: &QuadrotorParams,
     c: &Coefficients,
-    x: &Flat,
-    squares: &[f64; 4],
+    x: &[f64],
+    torque: [f64; 3],
 ) -> [f64; 3] {
     let (wx, wy, wz) = (x[10], x[11], x[12]);
-    // The rotor sums are r × F and the spin reaction written out for the quad-X signs of
-    // ROTOR_POSITION and ROTOR_SPIN (a test checks them against the tables).
-    let [s0, s1, s2, s3] = *squares;
     let damping = p.angular_damping_linear
         + p.angular_damping_quadratic * (wx * wx + wy * wy + wz * wz).sqrt();
-    let mut tx = c.roll_pitch * ((s1 + s2) - (s0 + s3)) - damping * wx;
-    let mut ty = c.roll_pitch * ((s1 + s3) - (s0 + s2)) - damping * wy;
-    let tz = c.yaw * ((s2 + s3) - (s0 + s1)) - damping * wz;
+    let mut tx = torque[0] - damping * wx;
+    let mut ty = torque[1] - damping * wy;
+    let tz = torque[2] - damping * wz;
     if p.pendulum_coefficient != 0.0 {
         let attitude = UnitQuaternion::new_unchecked(Quaternion::new(x[6], x[7], x[8], x[9]));
         let (roll, pitch, _) = attitude.euler_angles();
@@ -256,7 +406,7 @@ fn angular_acceleration(
 
 /// q̇ = ½ q ⊗ (0, ω) of a flat state.
 #[inline(always)]
-fn attitude_rate(x: &Flat) -> [f64; 4] {
+fn attitude_rate(x: &[f64]) -> [f64; 4] {
     let (qw, qx, qy, qz) = (x[6], x[7], x[8], x[9]);
     let (hx, hy, hz) = (0.5 * x[10], 0.5 * x[11], 0.5 * x[12]);
     [
@@ -269,18 +419,18 @@ fn attitude_rate(x: &Flat) -> [f64; 4] {
 
 /// The equations of motion with the ground contact ([`super::contact`]).
 #[inline(always)]
-fn contact_rates(
+fn contact_rates<const L: usize, const C: usize>(
     p: &QuadrotorParams,
     c: &Coefficients,
     gear: &Gear,
-    x: &ContactFlat,
-    command: &[f64; 4],
+    x: &[f64; C],
+    command: &[f64; MAX_ROTORS],
     wind: &Vector3<f64>,
-) -> ContactFlat {
-    let mut body = [0.0; STRETCH];
-    body.copy_from_slice(&x[..STRETCH]);
-    let mut d = [0.0; CONTACT_LEN];
-    d[..STRETCH].copy_from_slice(&rates(p, c, &body, command, wind));
+) -> [f64; C] {
+    let mut body = [0.0; L];
+    body.copy_from_slice(&x[..L]);
+    let mut d = [0.0; C];
+    d[..L].copy_from_slice(&rates::<L>(p, c, &body, command, wind));
     gear.add_rates(x, &mut d);
     d
 }
@@ -328,17 +478,33 @@ fn rk4<const N: usize>(x: &[f64; N], h: f64, f: impl Fn(&[f64; N]) -> [f64; N]) 
 /// the ground during the step.
 pub fn integrate(
     params: &QuadrotorParams,
+    frame: &Frame,
     state: &mut BodyState,
-    command: &[f64; 4],
+    command: &Motors,
+    wind: &Vector3<f64>,
+    dt: f64,
+) {
+    by_size!(
+        frame.rotor_count(),
+        integrate_sized(params, frame, state, command, wind, dt)
+    )
+}
+
+#[inline(always)]
+fn integrate_sized<const L: usize, const C: usize>(
+    params: &QuadrotorParams,
+    frame: &Frame,
+    state: &mut BodyState,
+    command: &Motors,
     wind: &Vector3<f64>,
     dt: f64,
 ) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx") {
         // SAFETY: the CPU supports AVX, checked just above.
-        return unsafe { integrate_avx(params, state, command, wind, dt) };
+        return unsafe { integrate_avx::<L, C>(params, frame, state, command, wind, dt) };
     }
-    integrate_portable(params, state, command, wind, dt)
+    integrate_portable::<L, C>(params, frame, state, command, wind, dt)
 }
 
 /// [`integrate`] compiled with AVX's three-operand instructions: a third fewer instructions
@@ -346,14 +512,15 @@ pub fn integrate(
 /// multiply-add, no reassociation — so both paths give the same bits (a test checks).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
-fn integrate_avx(
+fn integrate_avx<const L: usize, const C: usize>(
     params: &QuadrotorParams,
+    frame: &Frame,
     state: &mut BodyState,
-    command: &[f64; 4],
+    command: &Motors,
     wind: &Vector3<f64>,
     dt: f64,
 ) {
-    integrate_portable(params, state, command, wind, dt)
+    integrate_portable::<L, C>(params, frame, state, command, wind, dt)
 }
 
 /// ceil(dt / max_substep), at least 1. A ratio within 1e-9 (relative) above a whole number
@@ -380,7 +547,7 @@ fn may_touch(
     dt: f64,
 ) -> bool {
     let v = &s.velocity;
-    let thrust_and_gravity = c.gravity + 4.0 * c.thrust_per_mass;
+    let thrust_and_gravity = c.gravity + c.full_thrust_per_mass;
     let speed = v.x.abs() + v.y.abs() + v.z.abs() + thrust_and_gravity * dt;
     let air = speed + wind.x.abs() + wind.y.abs() + wind.z.abs();
     let acceleration = thrust_and_gravity + c.drag_per_mass * air * air;
@@ -388,33 +555,35 @@ fn may_touch(
 }
 
 #[inline(always)]
-fn integrate_portable(
+fn integrate_portable<const L: usize, const C: usize>(
     params: &QuadrotorParams,
+    frame: &Frame,
     state: &mut BodyState,
-    command: &[f64; 4],
+    command: &Motors,
     wind: &Vector3<f64>,
     dt: f64,
 ) {
-    let c = Coefficients::new(params);
+    let c = Coefficients::new(params, frame);
+    let command = command.padded();
     if params.ground_enabled && may_touch(params, &c, state, wind, dt) {
         let gear = Gear::new(params);
         let substeps = substep_count(dt, params.max_substep.min(params.contact_substep));
         let h = if substeps == 1.0 { dt } else { dt / substeps };
-        let mut x = flatten_contact(state);
+        let mut x = flatten_contact::<L, C>(state);
         for _ in 0..substeps as u64 {
             x = rk4(&x, h, |y| {
-                contact_rates(params, &c, &gear, y, command, wind)
+                contact_rates::<L, C>(params, &c, &gear, y, command, wind)
             });
             gear.release_lifted_feet(&mut x);
         }
-        unflatten_contact(&x, state);
+        unflatten_contact::<L, C>(&x, state);
         return;
     }
     let substeps = substep_count(dt, params.max_substep);
     let h = if substeps == 1.0 { dt } else { dt / substeps };
-    let mut x = flatten(state);
+    let mut x = flatten::<L>(state);
     for _ in 0..substeps as u64 {
-        x = rk4(&x, h, |y| rates(params, &c, y, command, wind));
+        x = rk4(&x, h, |y| rates::<L>(params, &c, y, command, wind));
     }
     unflatten_into(&x, state);
     // No foot reached the ground: every bristle is released.
@@ -425,45 +594,87 @@ fn integrate_portable(
 /// hover or at rest on the ground) and angular (body, rad/s²), ground contact included.
 pub fn accelerations(
     params: &QuadrotorParams,
+    frame: &Frame,
     state: &BodyState,
-    command: &[f64; 4],
+    command: &Motors,
     wind: &Vector3<f64>,
 ) -> (Vector3<f64>, Vector3<f64>) {
-    let d = derivatives(params, state, command, wind);
+    let d = derivatives(params, frame, state, command, wind);
     (d.acceleration, d.angular_acceleration)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::quadrotor::params::{ROTOR_POSITION, ROTOR_SPIN};
 
-    /// The written-out torque sums in `rates` against r × F and the spin reaction summed
-    /// over the rotor tables, for unequal motor states.
+    /// The grouped sums against r × F and the spin reaction summed rotor by rotor over the
+    /// table, for unequal motor states, for every shipped frame and one with its own
+    /// coefficients per rotor.
     #[test]
-    fn torque_sums_match_the_rotor_tables() {
-        let p = QuadrotorParams::default();
-        let c = Coefficients::new(&p);
-        let motors = [0.3, 0.55, 0.7, 0.45];
-        let mut state = BodyState::at_rest(Vector3::zeros(), 0.0, 0.0, 0.0, 0.0);
-        state.motors = motors;
-        let d = rates(&p, &c, &flatten(&state), &motors, &Vector3::zeros());
-        let lever = p.arm_length * std::f64::consts::FRAC_1_SQRT_2;
-        let mut expected = Vector3::zeros();
-        for i in 0..4 {
-            let thrust = p.thrust_coefficient * motors[i] * motors[i];
-            let (fwd, left) = ROTOR_POSITION[i];
-            let r = Vector3::new(fwd * lever, left * lever, 0.0);
-            expected += r.cross(&Vector3::new(0.0, 0.0, thrust));
-            expected.z += ROTOR_SPIN[i] * p.yaw_torque_coefficient * thrust;
+    fn torque_and_thrust_sums_match_the_rotor_tables() {
+        let p = QuadrotorParams {
+            ground_enabled: false,
+            ..QuadrotorParams::default()
+        };
+        let mut custom = Frame::named("hexa_x").unwrap().table().clone();
+        custom.rotors[1].thrust_coefficient = Some(12.0);
+        custom.rotors[4].torque_coefficient = Some(0.03);
+        custom.rotors[5].time_constant = Some(0.05);
+        let frames = crate::quadrotor::frame::shipped_names()
+            .map(|n| Frame::named(n).unwrap())
+            .chain([Frame::new(custom).unwrap()]);
+        for frame in frames {
+            let n = frame.rotor_count();
+            let motors: Vec<f64> = (0..n).map(|i| 0.3 + 0.07 * i as f64).collect();
+            let command = Motors::from_slice(&vec![0.5; n]).unwrap();
+            let state = BodyState {
+                motors: Motors::from_slice(&motors).unwrap(),
+                ..BodyState::at_rest(Vector3::new(0.0, 0.0, 5.0), 0.0, 0.0, 0.0, 0.0)
+            };
+            let d = derivatives(&p, &frame, &state, &command, &Vector3::zeros());
+            let mut torque = Vector3::zeros();
+            let mut thrust = 0.0;
+            for (r, m) in frame.rotors().iter().zip(&motors) {
+                let t = r.thrust_coefficient.unwrap_or(p.thrust_coefficient) * m * m;
+                let arm = Vector3::new(r.x, r.y, 0.0) * p.arm_length;
+                torque += arm.cross(&Vector3::new(0.0, 0.0, t));
+                let c = r.torque_coefficient.unwrap_or(p.yaw_torque_coefficient);
+                torque.z += r.spin.sign() * c * t;
+                thrust += t;
+            }
+            let name = frame.name();
+            let got = d.angular_acceleration.component_mul(&Vector3::new(
+                p.inertia_xx,
+                p.inertia_yy,
+                p.inertia_zz,
+            ));
+            assert!((got - torque).norm() < 1e-12, "{name}: {got} vs {torque}");
+            let az = (d.acceleration.z + p.gravity) * p.mass;
+            assert!((az - thrust).abs() < 1e-12, "{name}: {az} vs {thrust}");
+            for (i, rate) in d.motor_rates.iter().enumerate() {
+                let tau = frame.rotors()[i]
+                    .time_constant
+                    .unwrap_or(p.motor_time_constant);
+                assert!((rate - (0.5 - motors[i]) / tau).abs() < 1e-12, "{name} {i}");
+            }
         }
-        let torque = Vector3::new(
-            d[10] * p.inertia_xx,
-            d[11] * p.inertia_yy,
-            d[12] * p.inertia_zz,
-        );
-        assert!((torque - expected).norm() < 1e-12, "{torque} vs {expected}");
-        assert!(expected.x.abs() > 1e-3 && expected.y.abs() > 1e-3 && expected.z.abs() > 1e-4);
+    }
+
+    /// The written-out quad X sums and the grouped ones give the same bits.
+    #[test]
+    fn quad_x_sums_are_the_grouped_sums() {
+        let p = QuadrotorParams::default();
+        let f = Frame::quad_x();
+        let c = Coefficients::new(&p, &f);
+        let mut x = [0.0; 17];
+        for k in 0..1000 {
+            for (i, m) in x[BODY..].iter_mut().enumerate() {
+                *m = ((k * 7 + i * 13) % 101) as f64 / 100.0 + 1e-3 * i as f64;
+            }
+            let (a, b) = (quad_x_sums(&c, &x), rotor_sums(&c, &x));
+            assert_eq!(a.0.to_bits(), b.0.to_bits());
+            assert_eq!(a.1.map(f64::to_bits), b.1.map(f64::to_bits));
+        }
     }
 
     /// The AVX build of the integrator and the portable one give the same bits: same IEEE
@@ -483,17 +694,18 @@ mod tests {
             body_rates: Vector3::new(2.0, -1.0, 3.0),
             ..BodyState::at_rest(Vector3::new(0.3, 0.2, 2.0), 0.3, -0.2, 1.0, 0.4)
         };
+        let f = Frame::quad_x();
         let (mut a, mut b) = (start, start);
         let wind = Vector3::new(3.0, -1.0, 0.2);
         for i in 0..500 {
             let m = 0.3 + 0.4 * ((i % 7) as f64 / 7.0);
-            let command = [m, 0.9 - m, 0.5, 0.45];
+            let command = Motors::from([m, 0.9 - m, 0.5, 0.45]);
             let dt = if i % 3 == 0 { 0.025 } else { 0.01 };
-            integrate_portable(&p, &mut a, &command, &wind, dt);
+            integrate_portable::<17, 25>(&p, &f, &mut a, &command, &wind, dt);
             // SAFETY: AVX support was checked at the top of the test.
-            unsafe { integrate_avx(&p, &mut b, &command, &wind, dt) };
+            unsafe { integrate_avx::<17, 25>(&p, &f, &mut b, &command, &wind, dt) };
         }
-        let bits = |s: &BodyState| flatten_contact(s).map(f64::to_bits);
+        let bits = |s: &BodyState| flatten_contact::<17, 25>(s).map(f64::to_bits);
         assert_eq!(bits(&a), bits(&b));
         assert_ne!(bits(&a), bits(&start));
         // The contact path too: a tilted, sliding touchdown that bounces and settles.
@@ -503,10 +715,11 @@ mod tests {
             ..BodyState::at_rest(Vector3::new(0.0, 0.0, 0.3), 0.4, -0.2, 0.5, 0.0)
         };
         let (mut a, mut b) = (touchdown, touchdown);
+        let low = Motors::from([0.1; 4]);
         for _ in 0..200 {
-            integrate_portable(&p, &mut a, &[0.1; 4], &wind, 0.01);
+            integrate_portable::<17, 25>(&p, &f, &mut a, &low, &wind, 0.01);
             // SAFETY: AVX support was checked at the top of the test.
-            unsafe { integrate_avx(&p, &mut b, &[0.1; 4], &wind, 0.01) };
+            unsafe { integrate_avx::<17, 25>(&p, &f, &mut b, &low, &wind, 0.01) };
         }
         assert_eq!(bits(&a), bits(&b));
         assert!(a.position.z < 0.1, "{}", a.position.z);
@@ -534,8 +747,10 @@ mod tests {
         };
         let mut s = BodyState::at_rest(Vector3::new(0.0, 0.0, 100.0), 0.2, 0.1, 0.3, 0.5);
         s.body_rates = Vector3::new(3.0, -2.0, 5.0);
+        let f = Frame::quad_x();
+        let command = Motors::from([0.5, 0.45, 0.55, 0.5]);
         for _ in 0..100_000 {
-            integrate(&p, &mut s, &[0.5, 0.45, 0.55, 0.5], &Vector3::zeros(), 0.01);
+            integrate(&p, &f, &mut s, &command, &Vector3::zeros(), 0.01);
         }
         assert!(
             (s.attitude.norm() - 1.0).abs() < 1e-14,
@@ -543,7 +758,14 @@ mod tests {
             s.attitude.norm()
         );
         s.attitude *= 3.0;
-        integrate(&p, &mut s, &[0.5; 4], &Vector3::zeros(), 0.01);
+        integrate(
+            &p,
+            &f,
+            &mut s,
+            &Motors::from([0.5; 4]),
+            &Vector3::zeros(),
+            0.01,
+        );
         assert!(
             (s.attitude.norm() - 1.0).abs() < 1e-14,
             "{}",

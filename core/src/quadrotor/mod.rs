@@ -7,12 +7,16 @@
 pub mod contact;
 pub mod continuous;
 pub mod dynamics;
+pub mod frame;
+mod mixing;
 pub mod model;
 pub mod params;
+mod seam;
 pub mod state;
 pub mod variables;
 pub mod wind;
 
+pub use frame::{Frame, FrameError, FrameTable, Rotor, Spin};
 pub use model::Quadrotor;
 pub use params::{QuadrotorInitial, QuadrotorParams};
-pub use state::{BodyState, WindState};
+pub use state::{BodyState, Motors, WindState};

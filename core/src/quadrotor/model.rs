@@ -3,26 +3,30 @@
 
 use super::contact::{foot_heights, rest_height};
 use super::dynamics::{accelerations, integrate};
+use super::frame::Frame;
 use super::params::{QuadrotorInitial, QuadrotorParams};
-use super::state::{BodyState, WindState};
+use super::state::{BodyState, Motors, WindState};
 use super::wind::{GRID_SLACK, OuCache, apply_transition, reset_wind};
-use crate::error::{InputError, ParamError, check_finite};
+use crate::error::{CommandError, ParamError, check_finite};
 use crate::params::Parameters;
 use crate::rng::SimRng;
 use crate::snapshot::{self, SnapshotError};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
-/// One simulated quadrotor. Plain data: clone it to save it, serde it to store it.
+/// One simulated multirotor: its frame (the rotor table, [`Frame`]), parameters, state,
+/// command, wind and random generator. Plain data: clone it to save it, serde it to store it.
+/// Built as the quad X ([`Frame::quad_x`]); [`Quadrotor::with_frame`] gives it another.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Quadrotor {
     pub params: QuadrotorParams,
+    frame: Frame,
     pub body: BodyState,
     pub wind: WindState,
     /// Wind added from outside (the FMU's wind input), world ENU, m/s.
     pub external_wind: Vector3<f64>,
-    /// Motor commands in [0, 1], held until changed.
-    command: [f64; 4],
+    /// Motor commands in [0, 1], one per rotor, held until changed.
+    command: Motors,
     /// Time since the last point of the physics grid, s, in [0, max_substep): 0 after any
     /// step that ends on the grid (see [`Quadrotor::step`]).
     grid_phase: f64,
@@ -40,16 +44,45 @@ impl Quadrotor {
     ) -> Result<Self, ParamError> {
         params.validate()?;
         let wind = reset_wind(&params, &mut rng);
+        let body = body.with_motor_count(4).unwrap_or(body);
         Ok(Quadrotor {
             params,
+            frame: Frame::quad_x(),
             body,
             wind,
             external_wind: Vector3::zeros(),
-            command: [0.0; 4],
+            command: Motors::from([0.0; 4]),
             grid_phase: 0.0,
             rng,
             ou_cache: OuCache::default(),
         })
+    }
+
+    /// This vehicle with `frame`'s rotors: as many motors as it has rotors, each at the state
+    /// and command of the first one (nothing else changes).
+    pub fn with_frame(mut self, frame: Frame) -> Self {
+        let n = frame.rotor_count();
+        self.body = self.body.with_motor_count(n).unwrap_or(self.body);
+        self.command = Motors::uniform(n, self.command[0]).unwrap_or(self.command);
+        self.frame = frame;
+        self
+    }
+
+    /// The rotor table.
+    pub fn frame(&self) -> &Frame {
+        &self.frame
+    }
+
+    /// Motor state at which every rotor at the same state carries the weight: √(m g / Σ kᵢ)
+    /// (the quad X's is [`QuadrotorParams::hover_motor_state`]). `None` when no motor state
+    /// in [0, 1] can hover.
+    pub fn hover_motor_state(&self) -> Option<f64> {
+        let p = &self.params;
+        let total: f64 = (self.frame.rotors().iter())
+            .map(|r| r.thrust_coefficient.unwrap_or(p.thrust_coefficient))
+            .sum();
+        let m = (p.mass * p.gravity / total).sqrt();
+        (m.is_finite() && m <= 1.0).then_some(m)
     }
 
     /// The vehicle standing level on its landing gear at the origin, facing north, with the
@@ -68,7 +101,9 @@ impl Quadrotor {
     /// is the vehicle `new(params, body, rng)` with that command.
     pub fn restart(&mut self, body: BodyState, mut rng: SimRng) {
         self.wind = reset_wind(&self.params, &mut rng);
-        self.command = [body.motors[0].clamp(0.0, 1.0); 4];
+        let n = self.frame.rotor_count();
+        let body = body.with_motor_count(n).unwrap_or(body);
+        self.command = Motors::uniform(n, body.motors[0].clamp(0.0, 1.0)).unwrap_or(self.command);
         self.body = body;
         self.external_wind = Vector3::zeros();
         self.grid_phase = 0.0;
@@ -93,19 +128,39 @@ impl Quadrotor {
         body.velocity = Vector3::new(i.initial_vx, i.initial_vy, i.initial_vz);
         body.body_rates = Vector3::new(i.initial_wx, i.initial_wy, i.initial_wz);
         let mut quad = Quadrotor::new(params, body, SimRng::new(u64::from(i.seed)))?;
-        quad.command = [i.initial_motor; 4];
+        quad.command = Motors::from([i.initial_motor; 4]);
         Ok(quad)
     }
 
-    /// Sets the motor commands. Each must be finite; values are clamped into [0, 1].
-    pub fn set_command(&mut self, command: [f64; 4]) -> Result<(), InputError> {
-        check_finite("motor command", &command)?;
-        self.command = command.map(|c| c.clamp(0.0, 1.0));
+    /// Sets the motor commands, one per rotor in the frame's motor order. Each must be
+    /// finite; values are clamped into [0, 1]. Nothing changes on an error.
+    pub fn set_command(&mut self, command: impl AsRef<[f64]>) -> Result<(), CommandError> {
+        let command = command.as_ref();
+        let expected = self.frame.rotor_count();
+        if command.len() != expected {
+            return Err(CommandError::WrongLength {
+                what: "motor command",
+                expected,
+                got: command.len(),
+            });
+        }
+        check_finite("motor command", command)?;
+        for (slot, c) in self.command.iter_mut().zip(command) {
+            *slot = c.clamp(0.0, 1.0);
+        }
         Ok(())
     }
 
-    /// The motor commands in effect, each in [0, 1].
-    pub fn command(&self) -> [f64; 4] {
+    /// Sets motor `index`'s command to finite `value`, clamped into [0, 1]; the variable
+    /// tables call it for the rotors their frame has (an index past them changes nothing).
+    pub(crate) fn set_motor_command(&mut self, index: usize, value: f64) {
+        if let Some(slot) = self.command.get_mut(index) {
+            *slot = value.clamp(0.0, 1.0);
+        }
+    }
+
+    /// The motor commands in effect, each in [0, 1], one per rotor.
+    pub fn command(&self) -> Motors {
         self.command
     }
 
@@ -147,7 +202,14 @@ impl Quadrotor {
                 }
             }
             let wind = self.wind_velocity();
-            integrate(&self.params, &mut self.body, &self.command, &wind, piece);
+            integrate(
+                &self.params,
+                &self.frame,
+                &mut self.body,
+                &self.command,
+                &wind,
+                piece,
+            );
             self.grid_phase = if at_grid {
                 0.0
             } else {
@@ -199,6 +261,7 @@ impl Quadrotor {
     pub fn accelerations(&self) -> (Vector3<f64>, Vector3<f64>) {
         accelerations(
             &self.params,
+            &self.frame,
             &self.body,
             &self.command,
             &self.wind_velocity(),
@@ -220,7 +283,7 @@ impl Quadrotor {
         &mut self.rng
     }
 
-    /// The whole state as bytes (parameters, body, wind, command, RNG); every f64 is kept
+    /// The whole state as bytes (frame, parameters, body, wind, command, RNG); every f64 is kept
     /// bit for bit, so a restored instance continues exactly as this one would.
     pub fn save(&self) -> Result<Vec<u8>, SnapshotError> {
         snapshot::encode(SNAPSHOT_TAG, self)
@@ -239,13 +302,18 @@ impl Quadrotor {
             && b.body_rates.iter().all(|v| v.is_finite())
             && b.attitude.coords.iter().all(|v| v.is_finite())
             && b.attitude.norm() > 0.0
-            && b.motors.iter().chain(&quad.command).all(|v| v.is_finite())
+            && b.motors.len() == quad.frame.rotor_count()
+            && quad.command.len() == quad.frame.rotor_count()
+            && b.motors
+                .iter()
+                .chain(quad.command.iter())
+                .all(|v| v.is_finite())
             && b.gear_stretch.iter().flatten().all(|v| v.is_finite())
             && (0.0..quad.params.turbulence_dt).contains(&quad.wind.since_sample)
             && (0.0..quad.params.max_substep).contains(&quad.grid_phase);
         if !finite {
             return Err(SnapshotError::Invalid(
-                "state holds a non-finite value, a zero quaternion, or a wind sample or physics grid time off its grid"
+                "state holds a non-finite value, a zero quaternion, a motor count unlike its frame's, or a wind sample or physics grid time off its grid"
                     .into(),
             ));
         }
@@ -254,5 +322,6 @@ impl Quadrotor {
 }
 
 /// Format tag of a Quadrotor snapshot (name and version; 02 added the gear's bristles, 03 the
-/// time since the last turbulence sample, 04 the time since the last physics grid point).
-const SNAPSHOT_TAG: &[u8; 8] = b"FLYQUA04";
+/// time since the last turbulence sample, 04 the time since the last physics grid point, 05
+/// the frame and one motor per rotor).
+const SNAPSHOT_TAG: &[u8; 8] = b"FLYQUA05";

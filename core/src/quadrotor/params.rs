@@ -6,12 +6,6 @@ use crate::param;
 use crate::params::{ParamSpec, Parameters};
 use serde::{Deserialize, Serialize};
 
-// The quad-X frame, motors in the order front-right, rear-left, front-left, rear-right.
-/// Spin of each rotor seen from above: −1 for CCW (reaction torque toward −z), +1 for CW.
-pub const ROTOR_SPIN: [f64; 4] = [-1.0, -1.0, 1.0, 1.0];
-/// Rotor position signs (forward, left), multiplied by L/√2.
-pub const ROTOR_POSITION: [(f64, f64); 4] = [(1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (-1.0, -1.0)];
-
 /// Physical parameters. Defaults are the reference vehicle of seed 001 (1 kg, 10 cm arms;
 /// docs/reference/quadrotor.md).
 ///
@@ -184,7 +178,8 @@ impl Parameters for QuadrotorParams {
 }
 
 impl QuadrotorParams {
-    /// Motor state at which the four rotors together carry the weight: √(m g / 4k).
+    /// Motor state at which the four rotors of a quad together carry the weight: √(m g / 4k)
+    /// (any frame: `Quadrotor::hover_motor_state`).
     /// Returns `None` when no motor state in [0, 1] can hover.
     pub fn hover_motor_state(&self) -> Option<f64> {
         let m = (self.mass * self.gravity / (4.0 * self.thrust_coefficient)).sqrt();

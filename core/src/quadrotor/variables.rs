@@ -157,9 +157,9 @@ const fn wind<const I: usize>(name: &'static str, text: &'static str) -> InputRo
 }
 
 fn set_motor<const I: usize>(quad: &mut Quadrotor, value: f64) -> Result<(), InputError> {
-    let mut command = quad.command();
-    command[I] = value;
-    quad.set_command(command)
+    check_finite("motor command", &[value]).map_err(|e| InputError { index: I, ..e })?;
+    quad.set_motor_command(I, value);
+    Ok(())
 }
 
 fn set_wind<const I: usize>(quad: &mut Quadrotor, value: f64) -> Result<(), InputError> {

@@ -2,7 +2,7 @@
 //! (flat-earth projection, exact to millimetres over kilometres), NED velocity, course, a
 //! 3D fix, noise, a fixed rate and an optional delivery delay (a delay line of fixes).
 
-use super::frames::enu_to_ned;
+use crate::frames::enu_to_ned;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;

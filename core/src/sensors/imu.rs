@@ -6,7 +6,7 @@
 //! biases b that wander as first-order Gauss–Markov processes (random walk with a long
 //! correlation time, as an IMU datasheet's bias instability describes).
 
-use super::frames::flu_to_frd;
+use crate::frames::flu_to_frd;
 use crate::rng::SimRng;
 use nalgebra::{UnitQuaternion, Vector3};
 

@@ -1,7 +1,7 @@
 //! Magnetometer: the Earth's field at home, from declination, inclination and strength, turned
 //! into the body frame, plus white noise. The field is taken as uniform over the flying area.
 
-use super::frames::{flu_to_frd, ned_to_enu};
+use crate::frames::{flu_to_frd, ned_to_enu};
 use nalgebra::{UnitQuaternion, Vector3};
 
 /// The Earth field in world NED, gauss: horizontal part F·cos I pointing D east of north,

@@ -11,10 +11,10 @@
 //! Everything is pure and seeded: a [`Sensors`] holds its parameters, its random generator,
 //! the IMU biases and the GPS delay line, all plain data saved by [`Sensors::save`], so the
 //! same seed and the same flight give the same sensor stream bit for bit. The core's frames
-//! are world ENU / body FLU; [`frames`] turns them into the NED / FRD sensors speak.
+//! are world ENU / body FLU; [`crate::frames`] turns them into the NED / FRD sensors speak.
+//! The sensors read a vehicle's [`Kinematics`] (the vehicle seam), not a model.
 
 pub mod baro;
-pub mod frames;
 pub mod gps;
 pub mod imu;
 pub mod mag;
@@ -29,10 +29,11 @@ pub use imu::ImuReading;
 pub use params::SensorParams;
 
 use crate::error::ParamError;
+use crate::frames;
 use crate::params::Parameters;
-use crate::quadrotor::Quadrotor;
 use crate::rng::SimRng;
 use crate::snapshot::{self, SnapshotError};
+use crate::vehicle::Kinematics;
 use gps::GpsTiming;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -98,28 +99,25 @@ impl Sensors {
         (self.gyro_bias, self.accel_bias)
     }
 
-    /// Reads IMU, magnetometer and barometer for `quad` as it is now; `dt` (s) is the time
+    /// Reads IMU, magnetometer and barometer of a vehicle in state `k`; `dt` (s) is the time
     /// since the previous sample: it sets the white noise per sample and moves the biases.
-    pub fn sample(&mut self, quad: &Quadrotor, dt: f64) -> SensorReading {
-        let imu = self.sample_imu(quad, dt);
+    pub fn sample(&mut self, k: &Kinematics, dt: f64) -> SensorReading {
+        let imu = self.sample_imu(k, dt);
         let p = &self.params;
         let rng = &mut self.rng;
         let mag = imu::with_noise(
-            mag::body_field_frd(&quad.attitude(), &self.field_ned),
+            mag::body_field_frd(&k.attitude, &self.field_ned),
             p.mag_noise,
             rng,
         );
-        let baro = baro::reading(
-            p.home_altitude + quad.body.position.z,
-            p.baro_noise * rng.normal(),
-        );
+        let baro = baro::reading(p.home_altitude + k.position.z, p.baro_noise * rng.normal());
         SensorReading { imu, mag, baro }
     }
 
     /// Reads the IMU alone (for an autopilot that models its other sensors itself, as
     /// ArduPilot does): the same biases, noise and random stream as the IMU part of
     /// [`Sensors::sample`].
-    pub fn sample_imu(&mut self, quad: &Quadrotor, dt: f64) -> ImuReading {
+    pub fn sample_imu(&mut self, k: &Kinematics, dt: f64) -> ImuReading {
         let p = &self.params;
         let rng = &mut self.rng;
         imu::step_bias(
@@ -136,9 +134,8 @@ impl Sensors {
             dt,
             rng,
         );
-        let (acceleration, _) = quad.accelerations();
-        let accel = imu::specific_force_frd(&quad.attitude(), &acceleration, quad.params.gravity);
-        let gyro = frames::flu_to_frd(&quad.body.body_rates);
+        let accel = imu::specific_force_frd(&k.attitude, &k.acceleration, k.gravity);
+        let gyro = frames::flu_to_frd(&k.body_rates);
         ImuReading {
             accel: imu::with_noise(
                 accel + self.accel_bias,
@@ -153,25 +150,24 @@ impl Sensors {
         }
     }
 
-    /// The GPS at simulation time `time` (s): takes a fix of `quad` when one is due (at
+    /// The GPS at simulation time `time` (s): takes a fix of a vehicle in state `k` when one is due (at
     /// `gps_rate`, the first at the first call) and returns the fix that has become
     /// `gps_delay` old, if any.
-    pub fn gps(&mut self, quad: &Quadrotor, time: f64) -> Option<GpsFix> {
+    pub fn gps(&mut self, k: &Kinematics, time: f64) -> Option<GpsFix> {
         let p = &self.params;
         if self.gps.take_due(time, p.gps_rate) {
             let rng = &mut self.rng;
-            let b = &quad.body;
             let h = p.gps_horizontal_noise;
             let noise = Vector3::new(
                 h * rng.normal(),
                 h * rng.normal(),
                 p.gps_vertical_noise * rng.normal(),
             );
-            let velocity = imu::with_noise(b.velocity, p.gps_velocity_noise, rng);
+            let velocity = imu::with_noise(k.velocity, p.gps_velocity_noise, rng);
             let fix = gps::fix(
                 &self.home(),
                 time,
-                &(b.position + noise),
+                &(k.position + noise),
                 &velocity,
                 (p.gps_eph, p.gps_epv),
                 p.gps_satellites,

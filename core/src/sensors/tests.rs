@@ -3,7 +3,8 @@
 
 use super::*;
 use crate::quadrotor::contact::rest_height;
-use crate::quadrotor::{BodyState, QuadrotorParams};
+use crate::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
+use crate::vehicle::Vehicle;
 use std::f64::consts::FRAC_PI_2;
 
 const DT: f64 = 0.004;
@@ -46,7 +47,9 @@ fn at_rest_on_the_ground_the_imu_reads_minus_g_and_no_rotation() {
     let mut quad = quad_at(Vector3::new(0.0, 0.0, rest_height(&still_air())), 0.7);
     quad.step(DT);
     assert!(quad.is_grounded());
-    let r = Sensors::new(ideal(), 0).unwrap().sample(&quad, DT);
+    let r = Sensors::new(ideal(), 0)
+        .unwrap()
+        .sample(&quad.kinematics(), DT);
     assert!(
         close(&r.imu.accel, &Vector3::new(0.0, 0.0, -9.81), 1e-12),
         "{}",
@@ -59,7 +62,9 @@ fn at_rest_on_the_ground_the_imu_reads_minus_g_and_no_rotation() {
 fn in_free_fall_the_accelerometer_reads_zero_and_the_gyro_reads_frd_rates() {
     let mut quad = quad_at(Vector3::new(0.0, 0.0, 50.0), 0.0);
     quad.body.body_rates = Vector3::new(0.1, 0.2, 0.3); // FLU
-    let r = Sensors::new(ideal(), 0).unwrap().sample(&quad, DT);
+    let r = Sensors::new(ideal(), 0)
+        .unwrap()
+        .sample(&quad.kinematics(), DT);
     assert!(
         close(&r.imu.accel, &Vector3::zeros(), 1e-12),
         "{}",
@@ -88,7 +93,10 @@ fn a_tilted_vehicle_sees_gravity_on_its_tilted_axes() {
 #[test]
 fn the_barometer_at_100_m_above_home_reads_the_isa() {
     let quad = quad_at(Vector3::new(0.0, 0.0, 100.0), 0.0);
-    let b = Sensors::new(ideal(), 0).unwrap().sample(&quad, DT).baro;
+    let b = Sensors::new(ideal(), 0)
+        .unwrap()
+        .sample(&quad.kinematics(), DT)
+        .baro;
     // ISA at 588 m MSL: 101325·(1 − 0.0065·588/288.15)^5.255877 Pa (tables: ~944.6 hPa),
     // 15 − 0.0065·588 °C.
     assert!(
@@ -108,7 +116,7 @@ fn the_magnetometer_at_home_reads_the_declared_field() {
     // Facing north (ENU yaw 90°), level: FRD is NED.
     let north = Sensors::new(ideal(), 0)
         .unwrap()
-        .sample(&quad_at(Vector3::zeros(), FRAC_PI_2), DT);
+        .sample(&quad_at(Vector3::zeros(), FRAC_PI_2).kinematics(), DT);
     assert!(
         close(&north.mag, &Vector3::new(n, e, d), 1e-9),
         "{}",
@@ -117,7 +125,7 @@ fn the_magnetometer_at_home_reads_the_declared_field() {
     // Facing east: forward is east, right is south.
     let east = Sensors::new(ideal(), 0)
         .unwrap()
-        .sample(&quad_at(Vector3::zeros(), 0.0), DT);
+        .sample(&quad_at(Vector3::zeros(), 0.0).kinematics(), DT);
     assert!(
         close(&east.mag, &Vector3::new(e, -n, d), 1e-9),
         "{}",
@@ -132,7 +140,7 @@ fn gps_reports_the_state_around_home_at_its_rate_and_delay() {
     quad.body.velocity = Vector3::new(1.0, 2.0, -0.5);
     let mut s = Sensors::new(ideal(), 0).unwrap();
     let f = s
-        .gps(&quad, 0.0)
+        .gps(&quad.kinematics(), 0.0)
         .expect("the first fix comes at once without delay");
     assert!((f.position.latitude_deg - 47.397_921_663_06).abs() < 1e-10);
     assert!((f.position.longitude_deg - 8.545_726_709_215).abs() < 1e-10);
@@ -143,7 +151,7 @@ fn gps_reports_the_state_around_home_at_its_rate_and_delay() {
     assert_eq!((f.eph, f.epv, f.satellites), (0.3, 0.4, 12));
     // 10 Hz at 4 ms steps over one second: fixes at 0.0, 0.1, …, 0.9 (and 1.0 is the next).
     let fixes = (1..250)
-        .filter(|k| s.gps(&quad, f64::from(*k) * DT).is_some())
+        .filter(|k| s.gps(&quad.kinematics(), f64::from(*k) * DT).is_some())
         .count();
     assert_eq!(fixes, 9);
     // With 0.2 s delay the first fix, taken at 0, arrives at 0.2 s.
@@ -156,7 +164,10 @@ fn gps_reports_the_state_around_home_at_its_rate_and_delay() {
     )
     .unwrap();
     let first = (0..100)
-        .find_map(|k| late.gps(&quad, f64::from(k) * DT).map(|f| (k, f)))
+        .find_map(|k| {
+            late.gps(&quad.kinematics(), f64::from(k) * DT)
+                .map(|f| (k, f))
+        })
         .unwrap();
     assert_eq!(first.0, 50);
     assert_eq!(first.1.measured_at, 0.0);
@@ -165,7 +176,7 @@ fn gps_reports_the_state_around_home_at_its_rate_and_delay() {
     assert_eq!(
         Sensors::new(ideal(), 0)
             .unwrap()
-            .gps(&quad, 0.0)
+            .gps(&quad.kinematics(), 0.0)
             .unwrap()
             .course_deg,
         None
@@ -190,12 +201,12 @@ fn white_noise_has_the_standard_deviation_of_its_parameters() {
     let n = 20_000;
     let (mut ax, mut gz, mut my, mut p, mut gps_n) = (vec![], vec![], vec![], vec![], vec![]);
     for k in 0..n {
-        let r = s.sample(&quad, DT);
+        let r = s.sample(&quad.kinematics(), DT);
         ax.push(r.imu.accel.x);
         gz.push(r.imu.gyro.z);
         my.push(r.mag.y);
         p.push(r.baro.pressure_hpa * 100.0);
-        if let Some(f) = s.gps(&quad, f64::from(k) * 0.1) {
+        if let Some(f) = s.gps(&quad.kinematics(), f64::from(k) * 0.1) {
             gps_n.push(f.position.latitude_deg.to_radians() * gps::EARTH_RADIUS);
         }
     }
@@ -230,7 +241,7 @@ fn biases_wander_as_their_gauss_markov_process_says() {
     for seed in 0..2000 {
         let mut s = Sensors::new(params.clone(), seed).unwrap();
         for _ in 0..steps {
-            s.sample(&quad, DT);
+            s.sample(&quad.kinematics(), DT);
         }
         biases.push(s.biases().0.x);
     }
@@ -243,14 +254,14 @@ fn biases_wander_as_their_gauss_markov_process_says() {
 fn stream(s: &mut Sensors, quad: &Quadrotor, steps: u32) -> Vec<u64> {
     let mut bits = Vec::new();
     for k in 0..steps {
-        let r = s.sample(quad, DT);
+        let r = s.sample(&quad.kinematics(), DT);
         bits.extend(
             [r.imu.accel, r.imu.gyro, r.mag]
                 .iter()
                 .flat_map(|v| v.iter().map(|x| x.to_bits())),
         );
         bits.push(r.baro.pressure_hpa.to_bits());
-        if let Some(f) = s.gps(quad, f64::from(k) * DT) {
+        if let Some(f) = s.gps(&quad.kinematics(), f64::from(k) * DT) {
             bits.push(f.position.latitude_deg.to_bits());
             bits.push(f.velocity_ned.z.to_bits());
         }

@@ -22,11 +22,11 @@
 use super::flight::{BASE_OBSERVATION, BASE_OBSERVATION_SIZE, base_bounds, write_base_observation};
 use super::randomization::{Randomization, VehicleParams};
 use crate::error::ParamError;
+use crate::frames::{attitude_ned, enu_to_ned, flu_to_frd};
 use crate::params::Parameters;
 use crate::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
 use crate::rate_loop::{RateLoop, RatesSetpoint};
 use crate::rng::SimRng;
-use crate::sensors::frames::{attitude_ned, enu_to_ned, flu_to_frd};
 use crate::tasks::{ActionError, InfoRef, InfoVisitor, check_action};
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};

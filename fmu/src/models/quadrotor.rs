@@ -12,9 +12,10 @@
 use crate::error::FmuError;
 use crate::model::{Access, FmuModel, Hybrid, Table};
 use crate::table::{Array, ModelExchangeTable, ModelInfo, local};
+use flyloop_core::CommandError;
 use flyloop_core::number::Compact;
 use flyloop_core::quadrotor::continuous::{BODY_STATE_OUTPUTS, BRISTLES, EVENT_INDICATORS};
-use flyloop_core::quadrotor::dynamics::STATE_LEN;
+use flyloop_core::quadrotor::dynamics::state_len;
 use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial, wind};
 use flyloop_core::variables::{self, Variable};
 use flyloop_core::{ParamError, SnapshotError};
@@ -119,7 +120,7 @@ fn table() -> Table<Quadrotor> {
     });
     let me = ModelExchangeTable {
         states: states.iter().map(|v| v.value_reference).collect(),
-        derivatives: (DERIVATIVE_VR..).take(STATE_LEN).collect(),
+        derivatives: (DERIVATIVE_VR..).take(state_len(4)).collect(),
         event_indicators: EVENT_INDICATORS,
     };
     // Each reads its value at its position in the state vector.
@@ -187,15 +188,16 @@ impl Hybrid for Quadrotor {
     }
 
     fn set_states(&mut self, x: &[f64]) -> Result<(), FmuError> {
-        let mut state = [0.0; STATE_LEN];
-        state.copy_from_slice(x);
-        self.set_continuous_state(&state).map_err(|e| {
-            let name = state_names().nth(e.index).unwrap_or_default();
-            FmuError::InvalidArgument(format!(
-                "x[{}] (state `{name}`) is {}, not a finite number; nothing was set",
-                e.index,
-                Compact(e.value)
-            ))
+        self.set_continuous_state(x).map_err(|e| match e {
+            CommandError::NotFinite(e) => {
+                let name = state_names().nth(e.index).unwrap_or_default();
+                FmuError::InvalidArgument(format!(
+                    "x[{}] (state `{name}`) is {}, not a finite number; nothing was set",
+                    e.index,
+                    Compact(e.value)
+                ))
+            }
+            e => FmuError::InvalidArgument(format!("{e}; nothing was set")),
         })
     }
 

@@ -24,8 +24,9 @@ pub struct ServoFrame {
     pub frame_rate: u16,
     /// ArduPilot's frame counter (from 0 at its start).
     pub frame_count: u32,
-    /// Servo outputs 1–4 (the motors), µs.
-    pub motors: [u16; 4],
+    /// Servo outputs 1–16, µs: output n + 1 drives rotor n (ArduPilot's motor order for the
+    /// shipped frames is the frame table's; `autopilot_params`).
+    pub motors: [u16; 16],
 }
 
 /// Why a datagram is not a servo frame.
@@ -77,7 +78,7 @@ pub fn parse(bytes: &[u8]) -> Result<ServoFrame, PacketError> {
         return Err(PacketError::FrameRate);
     }
     let frame_count = u32::from_le_bytes([bytes[4], bytes[5], bytes[6], bytes[7]]);
-    let motors = [0, 1, 2, 3].map(|i| u16_at(bytes, 8 + 2 * i));
+    let motors = std::array::from_fn(|i| u16_at(bytes, 8 + 2 * i));
     Ok(ServoFrame {
         frame_rate,
         frame_count,
@@ -113,7 +114,7 @@ mod tests {
     #[test]
     fn packets_decode_and_bad_ones_say_why() {
         let mut pwm = [0u16; 16];
-        pwm[..4].copy_from_slice(&[1100, 1200, 1300, 1400]);
+        pwm[..6].copy_from_slice(&[1100, 1200, 1300, 1400, 1500, 1600]);
         let p = encode_16(1200, 77, &pwm);
         assert_eq!(p.len(), 40);
         assert_eq!(
@@ -121,14 +122,14 @@ mod tests {
             Ok(ServoFrame {
                 frame_rate: 1200,
                 frame_count: 77,
-                motors: [1100, 1200, 1300, 1400]
+                motors: pwm
             })
         );
         // 32 channels: the same head, 72 bytes.
         let mut p32 = p.clone();
         p32[..2].copy_from_slice(&MAGIC_32.to_le_bytes());
         p32.extend_from_slice(&[0u8; 32]);
-        assert_eq!(parse(&p32).map(|f| f.motors), Ok([1100, 1200, 1300, 1400]));
+        assert_eq!(parse(&p32).map(|f| f.motors), Ok(pwm));
         // A 32-channel magic in 40 bytes, a short packet, frame rate 0.
         let mut wrong = p.clone();
         wrong[..2].copy_from_slice(&MAGIC_32.to_le_bytes());

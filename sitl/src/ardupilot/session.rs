@@ -11,6 +11,7 @@ use crate::track::SessionTrack;
 use flyloop_core::ParamError;
 use flyloop_core::quadrotor::Quadrotor;
 use flyloop_core::sensors::Sensors;
+use flyloop_core::vehicle::Vehicle;
 use nalgebra::Vector3;
 use std::fmt;
 use std::net::SocketAddr;
@@ -138,7 +139,8 @@ impl Session {
     /// The vehicle at rest on its landing gear at home, facing north.
     pub fn new(options: &SessionOptions) -> Result<Self, ParamError> {
         let c = &options.vehicle;
-        let quad = Quadrotor::standing(c.quadrotor.clone(), options.seed)?;
+        let quad =
+            Quadrotor::standing(c.quadrotor.clone(), options.seed)?.with_frame(c.frame.clone());
         let sensors = Sensors::new(c.sensors.clone(), options.seed)?;
         Ok(Session {
             start: (quad.clone(), sensors.clone()),
@@ -277,10 +279,11 @@ impl Session {
         self.last = None;
     }
 
-    /// Motor commands from the frame's servo outputs; absurd ones are refused (counted) and
-    /// the previous command holds.
+    /// Motor commands from the first servo outputs, one per rotor; absurd ones are refused
+    /// (counted) and the previous command holds.
     fn apply_motors(&mut self, frame: &ServoFrame) {
-        if let Some(&pwm) = frame.motors.iter().find(|&&p| p > MAX_PWM) {
+        let outputs = &frame.motors[..self.quad.frame().rotor_count()];
+        if let Some(&pwm) = outputs.iter().find(|&&p| p > MAX_PWM) {
             self.stats.absurd_pwm += 1;
             self.log_once(
                 Kind::Pwm,
@@ -291,8 +294,8 @@ impl Session {
             );
             return;
         }
-        let command = frame.motors.map(packet::motor_command);
-        if let Err(e) = self.quad.set_command(command) {
+        let command: Vec<f64> = outputs.iter().map(|&p| packet::motor_command(p)).collect();
+        if let Err(e) = self.quad.set_command(&command) {
             // Commands in [0, 1] are always accepted; kept for a future bound.
             self.stats.absurd_pwm += 1;
             self.log_once(Kind::Pwm, format_args!("motor command refused: {e}"));
@@ -308,7 +311,7 @@ impl Session {
         self.time_us += step_us;
         let dt = step_us as f64 * 1e-6;
         self.quad.step(dt);
-        let imu = self.sensors.sample_imu(&self.quad, dt);
+        let imu = self.sensors.sample_imu(&self.quad.kinematics(), dt);
         self.stats.steps += 1;
         self.stats.physics += start.elapsed();
         self.speed.observe(self.time_us);

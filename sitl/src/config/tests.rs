@@ -141,3 +141,57 @@ fn the_autopilot_vehicle_reads_both_sets_and_names_mistakes() {
         .to_string();
     assert!(e.contains("without randomisation"), "{e}");
 }
+
+#[test]
+fn the_frame_presets_parse_and_hover_on_their_rotors() {
+    for (file, text, rotors) in [
+        (
+            "px4_hexa_x",
+            include_str!("../../presets/px4_hexa_x.toml"),
+            6,
+        ),
+        (
+            "ardupilot_hexa_x",
+            include_str!("../../presets/ardupilot_hexa_x.toml"),
+            6,
+        ),
+        (
+            "ardupilot_octo_x",
+            include_str!("../../presets/ardupilot_octo_x.toml"),
+            8,
+        ),
+    ] {
+        let v = AutopilotVehicle::parse(text).unwrap();
+        assert_eq!(v.frame.rotor_count(), rotors, "{file}");
+        let quad = flyloop_core::quadrotor::Quadrotor::standing(v.quadrotor, 0)
+            .unwrap()
+            .with_frame(v.frame);
+        let hover = quad.hover_motor_state().unwrap();
+        assert!((0.5..0.65).contains(&hover), "{file}: hover at {hover}");
+    }
+    assert_eq!(AutopilotVehicle::iris().frame.name(), "quad_x");
+}
+
+/// Regression (issue 33): a frame the core refuses is a config error naming the rotor and
+/// the field, never a panic or a silent quad.
+#[test]
+fn a_bad_frame_table_names_the_rotor_and_field() {
+    let bad = "mass = 2\n[frame]\nname = \"tri\"\n[[frame.rotor]]\nx = 1\ny = 0\nspin = \"cw\"";
+    let e = AutopilotVehicle::parse(bad).unwrap_err().to_string();
+    assert_eq!(e, "frame `tri` has 1 rotors: a frame needs 4 to 12");
+    let e = AutopilotVehicle::parse("[frame]\nname = \"dodeca\"").unwrap_err();
+    assert!(e.to_string().starts_with("unknown frame `dodeca`"), "{e}");
+    let e = AutopilotVehicle::parse("frame = 6").unwrap_err();
+    assert!(e.to_string().contains("`frame` must be a table"), "{e}");
+    let mut text = String::from("[frame]\nname = \"flat\"\n");
+    for (x, y, spin) in [(1, 1, "cw"), (-1, -1, "cw"), (1, -1, "ccw"), (-1, 1, "ccw")] {
+        text += &format!(
+            "[[frame.rotor]]\nx = {x}\ny = {y}\nspin = \"{spin}\"\nthrust_coefficient = -1\n"
+        );
+    }
+    let e = AutopilotVehicle::parse(&text).unwrap_err().to_string();
+    assert!(
+        e.contains("rotor 0: `thrust_coefficient` = -1 is out of range"),
+        "{e}"
+    );
+}

@@ -3,7 +3,7 @@
 
 use super::messages;
 use crate::config::AutopilotVehicle;
-use crate::kinematics::{Home, Kinematics};
+use crate::kinematics::Home;
 use crate::speed::SpeedLog;
 use crate::stats::Stats;
 use crate::telemetry;
@@ -12,6 +12,7 @@ use crate::wire::{Encoder, StreamDecoder};
 use flyloop_core::ParamError;
 use flyloop_core::quadrotor::Quadrotor;
 use flyloop_core::sensors::Sensors;
+use flyloop_core::vehicle::Vehicle;
 use mavlink::dialects::common::{COMMAND_LONG_DATA, MavCmd, MavMessage};
 use std::time::Instant;
 
@@ -58,7 +59,8 @@ impl Session {
     /// The vehicle at rest on its landing gear at the origin, facing north.
     pub fn new(options: &SessionOptions) -> Result<Self, ParamError> {
         let c = &options.vehicle;
-        let mut quad = Quadrotor::standing(c.quadrotor.clone(), options.seed)?;
+        let mut quad =
+            Quadrotor::standing(c.quadrotor.clone(), options.seed)?.with_frame(c.frame.clone());
         // One step with the motors off: the state PX4's first controls meet.
         quad.step(options.step_us.max(1) as f64 * 1e-6);
         let sensors = Sensors::new(c.sensors.clone(), options.seed)?;
@@ -166,11 +168,12 @@ impl Session {
         steps
     }
 
-    /// Motor commands from controls[0..4]; a non-finite one refuses the whole set (counted),
-    /// and the previous command holds.
+    /// Motor commands from controls[0..n], one per rotor (PX4's motor n is the frame's rotor
+    /// n); a non-finite one refuses the whole set (counted), and the previous command holds.
     fn apply_controls(&mut self, controls: &[f32; 16]) {
-        let command = [0, 1, 2, 3].map(|i| f64::from(controls[i]));
-        if let Err(e) = self.quad.set_command(command) {
+        let n = self.quad.frame().rotor_count();
+        let command: Vec<f64> = controls[..n].iter().map(|&c| f64::from(c)).collect();
+        if let Err(e) = self.quad.set_command(&command) {
             self.stats.refused_controls += 1;
             tracing::warn!(
                 refused = self.stats.refused_controls,
@@ -208,18 +211,18 @@ impl Session {
     /// HIL_SENSOR now, HIL_GPS when a fix is delivered, HIL_STATE_QUATERNION when due.
     fn emit(&mut self, out: &mut Vec<u8>) {
         let dt = self.step_us as f64 * 1e-6;
-        let reading = self.sensors.sample(&self.quad, dt);
+        let k = self.quad.kinematics();
+        let reading = self.sensors.sample(&k, dt);
         let sensor = messages::hil_sensor(&reading, self.time_us);
         self.encoder.push(out, SIMULATOR_SYSTEM, &sensor);
         self.track.record(self.time_us, &self.quad);
-        if let Some(fix) = self.sensors.gps(&self.quad, self.time_us as f64 * 1e-6) {
+        if let Some(fix) = self.sensors.gps(&k, self.time_us as f64 * 1e-6) {
             let stamp = self.gps_epoch_us + (fix.measured_at * 1e6).round() as u64;
             self.encoder
                 .push(out, SIMULATOR_SYSTEM, &messages::hil_gps(&fix, stamp));
         }
         if let Some(interval) = self.state_interval_us {
             if self.time_us >= self.next_state_us {
-                let k = Kinematics::of_quadrotor(&self.quad);
                 let state = telemetry::hil_state_quaternion_of(&k, &self.home, self.time_us);
                 self.encoder.push(out, SIMULATOR_SYSTEM, &state);
                 self.next_state_us += interval;

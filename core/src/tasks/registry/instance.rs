@@ -6,6 +6,7 @@ use crate::tasks::hover::Hover;
 use crate::tasks::landing::Landing;
 use crate::tasks::waypoints::Waypoints;
 use crate::tasks::{ActionError, Info, InfoVisitor, StepOutcome, Task};
+use crate::vehicle::{Kinematics, Vehicle};
 
 /// A task instance of one of the three kinds.
 #[derive(Debug)]
@@ -48,6 +49,15 @@ impl TaskInstance {
             TaskInstance::Hover(t) => t.as_mut(),
             TaskInstance::Waypoints(t) => t.as_mut(),
             TaskInstance::Landing(t) => t.as_mut(),
+        }
+    }
+
+    /// The state of the task's vehicle (the vehicle seam's kinematics).
+    pub fn kinematics(&self) -> Kinematics {
+        match self {
+            TaskInstance::Hover(t) => t.quadrotor().kinematics(),
+            TaskInstance::Waypoints(t) => t.quadrotor().kinematics(),
+            TaskInstance::Landing(t) => t.lander().kinematics(),
         }
     }
 

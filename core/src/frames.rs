@@ -1,5 +1,5 @@
-//! Frame changes the sensors need: the core's world ENU / body FLU into the NED / FRD that
-//! sensors (and PX4) report in. Each is a proper rotation: 180° about (1, 1, 0)/√2 for
+//! The one frames module: the core's world ENU / body FLU into the NED / FRD that sensors,
+//! PX4, ArduPilot and MAVLink speak. Each is a proper rotation: 180° about (1, 1, 0)/√2 for
 //! ENU → NED, 180° about x for FLU → FRD.
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};

@@ -1,0 +1,81 @@
+//! The vehicle seam: what every front end (the FMU, the tasks and gym envs, the MAVLink
+//! SITL, the PX4 and ArduPilot sessions, the sensors, the telemetry) needs of a vehicle, in one
+//! trait, so none of them reaches into a model's own type.
+//!
+//! A vehicle takes as many actuator commands as it has actuators (a multirotor: one per
+//! rotor of its frame), advances on its own physics grid, and reports its [`Kinematics`] in the
+//! core's frames (world ENU, body FLU); [`crate::frames`] turns those into NED / FRD. The
+//! sensors read the kinematics, so a sensor model never depends on which model flies.
+
+use crate::error::CommandError;
+use crate::frames::{enu_to_ned, flu_to_frd};
+use crate::snapshot::SnapshotError;
+use nalgebra::{UnitQuaternion, Vector3};
+
+/// A vehicle's state as the sensors, the autopilot links and the telemetry read it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Kinematics {
+    /// Position, world ENU, m.
+    pub position: Vector3<f64>,
+    /// Velocity, world ENU, m/s.
+    pub velocity: Vector3<f64>,
+    /// Attitude, body FLU → world ENU.
+    pub attitude: UnitQuaternion<f64>,
+    /// Angular velocity in the body frame FLU, rad/s.
+    pub body_rates: Vector3<f64>,
+    /// Kinematic acceleration (total force / mass, gravity included), world ENU, m/s².
+    pub acceleration: Vector3<f64>,
+    /// Gravitational acceleration of the model, m/s² (positive).
+    pub gravity: f64,
+    /// Velocity relative to the air, world ENU, m/s.
+    pub air_velocity: Vector3<f64>,
+}
+
+impl Kinematics {
+    /// Position north, east, down from the local origin, m.
+    pub fn position_ned(&self) -> Vector3<f64> {
+        enu_to_ned(&self.position)
+    }
+
+    /// Velocity north, east, down, m/s.
+    pub fn velocity_ned(&self) -> Vector3<f64> {
+        enu_to_ned(&self.velocity)
+    }
+
+    /// Body rates about FRD x, y, z (roll, pitch, yaw rate), rad/s.
+    pub fn body_rates_frd(&self) -> Vector3<f64> {
+        flu_to_frd(&self.body_rates)
+    }
+
+    /// What an accelerometer measures (acceleration minus gravity) in body FRD, m/s²: about
+    /// (0, 0, −g) in a level hover.
+    pub fn specific_force_frd(&self) -> Vector3<f64> {
+        crate::sensors::imu::specific_force_frd(&self.attitude, &self.acceleration, self.gravity)
+    }
+
+    /// Speed relative to the air, m/s.
+    pub fn airspeed(&self) -> f64 {
+        self.air_velocity.norm()
+    }
+}
+
+/// A simulated vehicle, as every front end drives it.
+pub trait Vehicle {
+    /// Number of actuator commands the vehicle takes (a multirotor: its rotors).
+    fn actuator_count(&self) -> usize;
+    /// Sets the actuator commands, one per actuator in the model's order; a vector of the
+    /// wrong length or with a non-finite value is refused whole (nothing changes).
+    fn set_actuators(&mut self, commands: &[f64]) -> Result<(), CommandError>;
+    /// The actuator commands in effect.
+    fn actuators(&self) -> Vec<f64>;
+    /// Advances the vehicle by `dt` seconds on its physics grid.
+    fn advance(&mut self, dt: f64);
+    /// The state in the core's frames.
+    fn kinematics(&self) -> Kinematics;
+    /// Whether it touches the ground.
+    fn is_grounded(&self) -> bool;
+    /// Whether every state value is a finite number.
+    fn is_finite(&self) -> bool;
+    /// The whole state as bytes; a restored vehicle continues bit for bit.
+    fn save(&self) -> Result<Vec<u8>, SnapshotError>;
+}
