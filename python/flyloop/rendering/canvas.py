@@ -58,8 +58,26 @@ def _open_window(pg: Any, size: tuple[int, int]) -> Any:
     driver = pg.display.get_driver()
     if driver in _HEADLESS_DRIVERS and driver != asked:
         pg.display.quit()
-        raise RuntimeError(NO_DISPLAY.format(why=f"SDL fell back to its {driver!r} driver"))
+        why = f"SDL fell back to its {driver!r} driver"
+        if not asked and os.environ.get("DISPLAY"):
+            # SDL tried X11 and moved on without a word: ask for X11 itself once, which either
+            # opens the window or says why it cannot.
+            return _open_x11(pg, size, why)
+        raise RuntimeError(NO_DISPLAY.format(why=why))
     return surface
+
+
+def _open_x11(pg: Any, size: tuple[int, int], why: str) -> Any:
+    """The window on DISPLAY through SDL's X11 driver, or RuntimeError with SDL's reason."""
+    os.environ["SDL_VIDEODRIVER"] = "x11"
+    try:
+        pg.display.init()
+        return pg.display.set_mode(size)
+    except pg.error as exc:
+        display = os.environ.get("DISPLAY")
+        raise RuntimeError(NO_DISPLAY.format(why=f"{why}; X11 on {display}: {exc}")) from exc
+    finally:
+        del os.environ["SDL_VIDEODRIVER"]
 
 
 def _px(point: Point) -> tuple[int, int]:
