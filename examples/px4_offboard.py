@@ -18,7 +18,8 @@ the end, on Ctrl-C or on any error, control goes back to PX4: position hold
 
 Prints `waypoint i: hold error mean X m, max Y m` per waypoint (distance of PX4's position
 estimate from the waypoint during its hold), then `mean hold error M m` and, last,
-`max hold error Z m` (the largest distance of all holds).
+`max hold error Z m` (the largest distance of all holds). On stderr it says each phase as
+it starts: waiting for PX4, arming, the takeoff, the switch to OFFBOARD, each waypoint.
 Exit codes: 0 flown, 2 PX4 not reachable or not ready, 3 offboard refused or lost, 4
 telemetry stopped, 130 interrupted.
 
@@ -301,6 +302,12 @@ def parse_waypoints(text: str) -> list[tuple[float, float, float]]:
     return points
 
 
+def phase(text: str) -> None:
+    """Says what the script does now (on stderr, beside its other messages; stdout keeps the
+    results): a person waits through each of these phases for seconds."""
+    print(f"px4_offboard: {text}", file=sys.stderr, flush=True)
+
+
 def fresh(link: Px4Link, stale_s: float) -> None:
     if time.monotonic() - link.state.wall > stale_s:
         raise FlightError(f"telemetry stopped: no estimate from PX4 for {stale_s:.1f} s", 4)
@@ -310,6 +317,7 @@ def take_off(link: Px4Link, args: argparse.Namespace) -> np.ndarray:
     """Asks PX4 for the estimate's streams, arms and takes off; returns home (NED, m) once
     the drone is in the air, still (< 0.3 m/s) and over 1 m above it."""
     s = link.state
+    phase(f"waiting for PX4's heartbeat at {args.connect} (up to {args.timeout:.0f} s)")
     try:
         link.wait("PX4's heartbeat", lambda st: st.heartbeat, args.timeout)
     except FlightError as exc:
@@ -320,13 +328,17 @@ def take_off(link: Px4Link, args: argparse.Namespace) -> np.ndarray:
         (MAV.MAVLINK_MSG_ID_EXTENDED_SYS_STATE, 5),
     ):
         link.interval(message, hz)
+    phase("PX4 is there; waiting for its position and attitude estimate")
     link.wait("an estimate", lambda st: st.position is not None and st.q is not None, args.timeout)
+    phase("arming (retried every second until PX4's estimator is ready)")
     link.accepted("arming", MAV.MAV_CMD_COMPONENT_ARM_DISARM, (1,), args.timeout, 2)
+    phase("armed; taking off with PX4's takeoff")
     nan = float("nan")
     link.accepted("takeoff", MAV.MAV_CMD_NAV_TAKEOFF, (-1, 0, 0, nan, nan, nan, nan), 30, 2)
     link.command(MAV.MAV_CMD_REQUEST_MESSAGE, MAV.MAVLINK_MSG_ID_HOME_POSITION)
     home_msg = link.mav.recv_match(type="HOME_POSITION", blocking=True, timeout=5)
     home = np.array([home_msg.x, home_msg.y, home_msg.z]) if home_msg else s.position.copy()
+    phase("climbing: waiting until in the air, 1 m above home and still")
     link.wait(
         "the takeoff",
         lambda st: (
@@ -385,6 +397,8 @@ def fly(link: Px4Link, policy: Policy | None, args: argparse.Namespace) -> list[
     setpoints = Setpoints(link, policy, args.hover_thrust)
 
     # Stream setpoints for a second of PX4 time before asking for OFFBOARD.
+    who = "the policy's" if policy is not None else "position"
+    phase(f"in the air; streaming {who} setpoints for 1 s before OFFBOARD")
     start = s.time_ms
     next_ms = s.time_ms
     while s.time_ms - start < 1000:
@@ -393,6 +407,7 @@ def fly(link: Px4Link, policy: Policy | None, args: argparse.Namespace) -> list[
         if s.time_ms >= next_ms:
             setpoints.send()
             next_ms = s.time_ms + setpoints.dt_ms
+    phase("switching to OFFBOARD")
     link.set_mode(PX4_OFFBOARD, "the switch to OFFBOARD", 3)
     # The heartbeat that shows the new mode may come up to a second later.
     switched_ms, offboard = s.time_ms, False
@@ -402,6 +417,11 @@ def fly(link: Px4Link, policy: Policy | None, args: argparse.Namespace) -> list[
         origin = setpoints.target.copy()
         leg = np.linalg.norm(point - origin)
         leg_ms = 1000 * leg / args.speed
+        north, east, up = (point - home) * np.array([1, 1, -1])
+        phase(
+            f"waypoint {i}: flying to {north:.1f} N, {east:.1f} E, {up:.1f} m up, then "
+            f"settling {args.settle:g} s and holding {args.hold:g} s"
+        )
         t0 = s.time_ms
         errors: list[float] = []
         hold_start = t0 + leg_ms + 1000 * args.settle

@@ -5,12 +5,14 @@
     .venv/bin/python examples/px4_track_plot.py track.csv mission.png ArduPilot
 
 Left: the path seen from above (north up). Right: height above home and motor states over
-simulation time. One line per PX4 connection.
+simulation time. One line per PX4 connection. A track the SITL is still writing can be
+plotted: its complete rows are.
 """
 
 from __future__ import annotations
 
 import csv
+import io
 import sys
 from pathlib import Path
 
@@ -19,10 +21,19 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+# The columns the plot draws (flyloop-sitl --track writes them, among others).
+COLUMNS = {"connection", "time_us", "north", "east", "down", "m0"}
 
-def read(path: Path) -> list[dict[str, float]]:
-    with open(path) as f:
-        return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+
+def read(path: Path) -> tuple[list[dict[str, float]], bool]:
+    """The track's complete rows, and whether a partial last row was left out: the SITL may
+    still be writing the file (it writes whole buffers, which end anywhere in a row)."""
+    text = path.read_text()
+    partial = not text.endswith("\n")
+    if partial:
+        text = text[: text.rfind("\n") + 1]
+    rows = [{k: float(v) for k, v in row.items()} for row in csv.DictReader(io.StringIO(text))]
+    return rows, partial and bool(rows)
 
 
 def plot(rows: list[dict[str, float]], out: Path, autopilot: str = "PX4") -> None:
@@ -48,7 +59,19 @@ def plot(rows: list[dict[str, float]], out: Path, autopilot: str = "PX4") -> Non
 def main() -> None:
     if len(sys.argv) not in (3, 4):
         sys.exit("usage: px4_track_plot.py TRACK.csv OUT.png [AUTOPILOT (default PX4)]")
-    plot(read(Path(sys.argv[1])), Path(sys.argv[2]), *sys.argv[3:])
+    track, out = Path(sys.argv[1]), Path(sys.argv[2])
+    try:
+        rows, partial = read(track)
+    except (OSError, ValueError) as exc:
+        sys.exit(f"px4_track_plot.py: cannot read {track}: {exc}")
+    if not rows:
+        sys.exit(f"px4_track_plot.py: {track} has no complete row yet")
+    missing = sorted(COLUMNS - set(rows[0]))
+    if missing:
+        sys.exit(f"px4_track_plot.py: {track} is not a flyloop-sitl --track file: no {missing}")
+    plot(rows, out, *sys.argv[3:])
+    note = " (its last row, still being written, left out)" if partial else ""
+    print(f"plotted {len(rows)} rows of {track}{note} to {out}")
 
 
 if __name__ == "__main__":

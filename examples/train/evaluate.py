@@ -255,7 +255,7 @@ def main(argv: list[str] | None = None) -> int:
         args.json.write_text(json.dumps(result, indent=2) + "\n")
     if args.gif is not None:
         shot = record(None if args.random else args.run, args.gif, args.seed, env=args.env)
-        ending = "landed" if shot["success"] else "did not succeed"
+        ending = shot["outcome"]
         print(f"  recorded seed {args.seed} ({shot['steps']} steps, {ending}) to {args.gif}")
     return 0
 
@@ -303,11 +303,9 @@ def record(
     finally:
         e.close()
     save_video(frames, path, fps=fps)
+    success = bool(p.success(terminated, truncated, info))
     return dict(
-        path=path,
-        frames=len(frames),
-        steps=steps,
-        success=bool(p.success(terminated, truncated, info)),
+        path=path, frames=len(frames), steps=steps, success=success, outcome=p.outcome(success)
     )
 
 

@@ -31,20 +31,24 @@ run folder (policy.pt with summary.json) as it loads a stable-baselines3 one.
 
 from __future__ import annotations
 
-import argparse
-import csv
-import json
 import sys
-import time
-from dataclasses import asdict, dataclass, field, replace
-from pathlib import Path
 
-import flyloop  # noqa: F401  (registers the envs)
-import gymnasium as gym
-import numpy as np
-import torch
-from torch import nn
-from training_envs import HOVER_SUCCESS_DISTANCE_M, preset
+if __name__ == "__main__":  # torch and the envs take seconds to load: say so first
+    print("fast_ppo: loading torch and the envs", file=sys.stderr, flush=True)
+
+import argparse  # noqa: E402
+import csv  # noqa: E402
+import json  # noqa: E402
+import time  # noqa: E402
+from dataclasses import asdict, dataclass, field, replace  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import flyloop  # noqa: F401, E402  (registers the envs)
+import gymnasium as gym  # noqa: E402
+import numpy as np  # noqa: E402
+import torch  # noqa: E402
+from torch import nn  # noqa: E402
+from training_envs import HOVER_SUCCESS_DISTANCE_M, preset  # noqa: E402
 
 EVAL_SEED = 1_000_000
 # The validation episodes that choose the policy a run keeps (Config.select_every): disjoint
@@ -501,6 +505,11 @@ def progress_row(
     return row
 
 
+def say(text: str) -> None:
+    """A phase that takes seconds, said as it starts (on stderr, as the progress bar)."""
+    print(f"fast_ppo: {text}", file=sys.stderr, flush=True)
+
+
 def progress_bar(total: int, off: bool):
     """A tqdm bar over the env steps, or None with --no-progress-bar."""
     if off:
@@ -542,6 +551,10 @@ def train(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
     steps, start = 0, time.perf_counter()
     per_update = cfg.num_envs * cfg.rollout_steps
     updates = -(-args.timesteps // per_update)
+    say(
+        f"training {args.env} on the {backend} backend: {updates} updates of {cfg.num_envs} "
+        f"envs x {cfg.rollout_steps} steps ({updates * per_update:,} env steps)"
+    )
     bar = progress_bar(updates * per_update, args.no_progress_bar)
     selection = Selection(cfg, args.env, backend, updates)
     try:
@@ -736,6 +749,7 @@ def run_one(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
     cpu_start = time.process_time()
     run = train(args, backend, cfg)
     cpu = time.process_time() - cpu_start
+    say(f"evaluating the policy on {args.eval_episodes} held-out episodes ({backend})")
     result = evaluate(run["model"], run["norm"], args.env, backend, args.eval_episodes)
     if run["selected"] is not None:
         # What keeping the best policy gained: the last policy on the same held-out episodes.
@@ -810,6 +824,7 @@ def main(argv: list[str] | None = None) -> int:
     title = f"{task.title}, {cfg.num_envs} envs, seed {args.seed}"
     for path in (args.out / "learning_curve.png", args.curve):
         if path is not None:
+            say(f"drawing the learning curve to {path}")
             path.parent.mkdir(parents=True, exist_ok=True)
             plot({b: s["rows"] for b, s in runs.items()}, path, title)
     return 0

@@ -8,12 +8,19 @@ import time
 from pathlib import Path
 from typing import Any
 
+import flyloop.sb3
 import numpy as np
 import torch
 from learning_curve import EpisodeLog, plot_learning_curve
 from stable_baselines3 import PPO, SAC
 from stable_baselines3.common.callbacks import BaseCallback
-from stable_baselines3.common.vec_env import DummyVecEnv, VecMonitor, VecNormalize
+from stable_baselines3.common.vec_env import (
+    DummyVecEnv,
+    VecEnv,
+    VecEnvWrapper,
+    VecMonitor,
+    VecNormalize,
+)
 from training_envs import check_action, make_success_env, preset, random_policy_baseline
 
 ALGORITHMS = {"ppo": PPO, "sac": SAC}
@@ -68,6 +75,42 @@ class EpisodeRecorder(BaseCallback):
         return True
 
 
+class SuccessInfos(VecEnvWrapper):
+    """Sets info['is_success'] where an episode ended (SuccessInfo for a VecEnv): SB3's
+    `TimeLimit.truncated` is truncated and not terminated, all the preset's test needs."""
+
+    def __init__(self, venv: VecEnv, success) -> None:
+        super().__init__(venv)
+        self._success = success
+
+    def reset(self):
+        return self.venv.reset()
+
+    def step_wait(self):
+        obs, rewards, dones, infos = self.venv.step_wait()
+        for i in np.flatnonzero(dones):
+            info = infos[i]
+            truncated = bool(info["TimeLimit.truncated"])
+            info["is_success"] = bool(self._success(not truncated, truncated, info))
+        return obs, rewards, dones, infos
+
+
+def make_base_vec_env(env: str, action: str | None, n_envs: int, backend: str) -> VecEnv:
+    """The preset's n_envs envs with info['is_success'] at episode ends. Native backend with
+    the preset's default action interface: one flyloop.sb3 VecEnv over the native batch
+    (the same episodes as single envs, several times faster); otherwise single envs (a SITL
+    each with backend="sitl"; the other action interfaces are single-env wrappers) in a
+    DummyVecEnv."""
+    p = preset(env)
+    action = check_action(p, action)
+    if backend == "native" and action == p.default_action:
+        venv = flyloop.sb3.make_vec_env(
+            p.env_id, n_envs, unit_actions=action is not None, **p.env_kwargs
+        )
+        return SuccessInfos(venv, p.success)
+    return DummyVecEnv([lambda: make_success_env(env, action=action, backend=backend)] * n_envs)
+
+
 def make_vec_env(
     env: str,
     action: str | None,
@@ -77,10 +120,10 @@ def make_vec_env(
     backend: str = "native",
     statistics: Path | None = None,
 ) -> VecNormalize:
-    """n_envs preset envs (one SITL each, or in-process with backend="native"), monitored
-    and normalised (starting from the normalisation `statistics` of an earlier run, if
-    given); env i's first episode has seed `seed + i`."""
-    venv = DummyVecEnv([lambda: make_success_env(env, action=action, backend=backend)] * n_envs)
+    """n_envs preset envs (make_base_vec_env), monitored and normalised (starting from the
+    normalisation `statistics` of an earlier run, if given); env i's first episode has seed
+    `seed + i`."""
+    venv = make_base_vec_env(env, action, n_envs, backend)
     venv.seed(seed)
     if statistics is not None:
         return VecNormalize.load(str(statistics), VecMonitor(venv))

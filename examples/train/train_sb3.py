@@ -10,10 +10,12 @@ rollout/ep_rew_mean, rollout/success_rate, losses), episodes.csv (every training
 learning_curve.png and summary.json (wall time, env steps/s, the random policy's mean
 return). Prints a progress bar while it trains, then the wall time and env steps/s.
 
-The --n-envs envs run the core in this process (--backend native, the default) or each its
-own flyloop-sitl process (--backend sitl; found through FLYLOOP_SITL, PATH or the workspace
-build; see the flyloop package's README): the same episodes bit for bit. Torch runs on one
-CPU thread: the policy is small and the envs need the other core.
+The --n-envs envs run the core in this process (--backend native, the default: one
+flyloop.sb3 VecEnv over the native batch, all envs stepped in one call; with --action
+primitives or rates single envs in a DummyVecEnv) or each its own flyloop-sitl process
+(--backend sitl; found through FLYLOOP_SITL, PATH or the workspace build; see the flyloop
+package's README): the same episodes bit for bit. Torch runs on one CPU thread: the policy
+is small and the envs need the other core.
 """
 
 from __future__ import annotations
@@ -46,7 +48,7 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", type=Path, default=Path("runs/train"), help="output folder")
     parser.add_argument(
-        "--n-envs", type=int, default=None, help="envs (SITL processes) in parallel"
+        "--n-envs", type=int, default=None, help="envs stepped together (SITL processes)"
     )
     parser.add_argument(
         "--baseline-episodes", type=int, default=20, help="episodes of the random policy's bar"

@@ -87,10 +87,15 @@ class Preset:
     actions: Mapping[str, Callable[[gym.Env], gym.Env]] | None
     success: Callable[[bool, bool, Mapping[str, Any]], bool]
     success_text: str
+    # How an episode ended, in the task's own words: (a success, anything else).
+    outcomes: tuple[str, str] = ("landed", "did not land")
 
     @property
     def default_action(self) -> str | None:
         return next(iter(self.actions)) if self.actions else None
+
+    def outcome(self, success: bool) -> str:
+        return self.outcomes[0] if success else self.outcomes[1]
 
 
 # The vehicles of flyloop-sitl --px4 (sitl/presets/). Read when a preset needs them: RLlib's
@@ -131,6 +136,10 @@ PRESETS: dict[str, Preset] = {
         success_text=(
             f"reached the time limit (no crash, not out of bounds) within "
             f"{HOVER_SUCCESS_DISTANCE_M} m of the target"
+        ),
+        outcomes=(
+            f"held the target (within {HOVER_SUCCESS_DISTANCE_M} m at the time limit)",
+            "did not hold the target",
         ),
     ),
     # Lander2D-v1 (the landing reward; v0's seed reward pays for hovering, see its docstring).
@@ -191,6 +200,10 @@ def offboard_preset() -> Preset:
         success_text=(
             f"reached the time limit (no crash, not out of bounds) within "
             f"{HOVER_SUCCESS_DISTANCE_M} m of the target"
+        ),
+        outcomes=(
+            f"held the target (within {HOVER_SUCCESS_DISTANCE_M} m at the time limit)",
+            "did not hold the target",
         ),
     )
 

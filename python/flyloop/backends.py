@@ -8,7 +8,9 @@ A backend runs `num_envs` instances of one task built from a config (core name -
 - `run(actions, resetting, seeds, out)`: every instance at once, rows in `resetting` reset
   with their `seeds` (their action ignored, reward and flags 0), the rest stepped; results go
   into the arrays of `out` (an `Outputs`);
-- `close()` (idempotent), `sitl_process` (None in-process).
+- `close()` (idempotent), `sitl_process` (None in-process);
+- native only: `reset_rows(resetting, seeds, out)`, the rows in `resetting` reset alone
+  (stable-baselines3's autoreset within the step, flyloop.sb3).
 
 `NativeBackend` runs the core in this process (flyloop._native.Batch); `SitlBackend`
 (flyloop.sitl_backend) runs it in a flyloop-sitl process, one datagram per exchange.
@@ -97,6 +99,13 @@ class NativeBackend:
             actions, resetting, seeds, out.obs, out.info, out.rewards, out.terminated,
             out.truncated,
         )  # fmt: skip
+
+    def reset_rows(self, resetting: np.ndarray, seeds: np.ndarray, out: Outputs):
+        """Only the rows in `resetting` start a new episode (the others are untouched)."""
+        self._open().reset_rows(resetting, seeds, out.obs, out.info)
+        out.rewards[resetting] = 0.0
+        out.terminated[resetting] = False
+        out.truncated[resetting] = False
 
     def close(self) -> None:
         batch, self._batch = self._batch, None

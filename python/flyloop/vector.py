@@ -172,6 +172,18 @@ class FlyloopVectorEnv(VectorEnv):
         return self._give(self._out.obs), self._columns.infos(self._out.info)
 
     def step(self, actions):
+        out = self.step_arrays(actions)
+        return (
+            self._give(out.obs),
+            self._give(out.rewards),
+            self._give(out.terminated),
+            self._give(out.truncated),
+            self._columns.infos(out.info),
+        )
+
+    def step_arrays(self, actions) -> Outputs:
+        """`step` without building the infos: the arrays it wrote (overwritten by the next
+        call), for wrappers that build their own (flyloop.sb3)."""
         a = as_actions(actions, self.action_space.shape, "actions")
         out, resetting = self._out, self._resetting
         np.logical_or(out.terminated, out.truncated, out=resetting)
@@ -181,13 +193,26 @@ class FlyloopVectorEnv(VectorEnv):
         for i in np.flatnonzero(resetting):
             self._seeds[i] = self._draw(int(i))
         self._backend.run(a, resetting, self._seeds, out)
-        return (
-            self._give(out.obs),
-            self._give(out.rewards),
-            self._give(out.terminated),
-            self._give(out.truncated),
-            self._columns.infos(out.info),
-        )
+        return out
+
+    def reset_ended(self) -> tuple[np.ndarray, np.ndarray, list[dict[str, Any]]]:
+        """Autoreset within the step, for APIs that want it (flyloop.sb3): every sub-env the
+        last step ended starts its next episode now, with the seed the next step would have
+        drawn, so the next step steps it with its action. Returns the indices of those
+        sub-envs, their first observations and their info dicts. Native backend only."""
+        if not hasattr(self._backend, "reset_rows"):
+            raise ValueError("reset_ended needs backend='native'")
+        out = self._out
+        ended = out.terminated | out.truncated
+        rows = np.flatnonzero(ended)
+        for i in rows:
+            self._seeds[i] = self._draw(int(i))
+        self._backend.reset_rows(ended, self._seeds, out)
+        return rows, out.obs[rows], self._columns.dicts(out.info[rows])
+
+    def info_dicts(self) -> list[dict[str, Any]]:
+        """The last step's or reset's info as one dict per sub-env."""
+        return self._columns.dicts(self._out.info)
 
     def _give(self, array: np.ndarray) -> np.ndarray:
         return array.copy() if self._copy else array

@@ -52,3 +52,22 @@ class InfoColumns:
                 infos[name] = values[:, a:b].astype(np.float64)
         infos.update(self.masks)
         return infos
+
+    def dicts(self, values: np.ndarray) -> list[dict[str, Any]]:
+        """One info dict per row, as the single env's info: reals float, integers int, flags
+        bool, vectors float64 arrays (stable-baselines3's per-env infos)."""
+        columns: list[list[Any]] = []
+        every = values.T.tolist()  # one pass from float32 to Python floats
+        for _, kind, a, b in self.fields:
+            if kind == REAL:
+                columns.append(every[a])
+            elif kind == FLAG:
+                columns.append([v != 0.0 for v in every[a]])
+            elif kind == INTEGER:
+                columns.append([int(v) for v in every[a]])
+            else:
+                columns.append(list(values[:, a:b].astype(np.float64)))
+        names = [name for name, _, _, _ in self.fields]
+        if not names:
+            return [{} for _ in range(len(values))]
+        return [dict(zip(names, row, strict=True)) for row in zip(*columns, strict=True)]

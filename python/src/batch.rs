@@ -425,6 +425,39 @@ impl Batch {
             .map_err(|e| PyRuntimeError::new_err(format!("step failed: {e}")))
     }
 
+    /// Starts a new episode, with its entry of `seeds`, in every env where `reset` is set and
+    /// leaves the others untouched; writes the new episodes' observations and info values
+    /// into their rows of `obs` and `info`. `step` resets only alongside a step of the rest;
+    /// this is the reset of an autoreset in the same step (stable-baselines3's VecEnv). In
+    /// the calling thread: only the few envs whose episode just ended are reset.
+    fn reset_rows(
+        &mut self,
+        reset: PyReadonlyArray1<'_, bool>,
+        seeds: PyReadonlyArray1<'_, u64>,
+        mut obs: PyReadwriteArray2<'_, f32>,
+        mut info: PyReadwriteArray2<'_, f32>,
+    ) -> PyResult<()> {
+        self.open()?;
+        let n = self.envs.len();
+        let reset = slice_of1("reset", &reset, n)?;
+        let seeds = slice_of1("seeds", &seeds, n)?;
+        let obs = mut_of("obs", &mut obs, [n, self.n_obs])?;
+        let info = mut_of("info", &mut info, [n, self.n_info])?;
+        let (n_obs, n_info) = (self.n_obs, self.n_info);
+        let mut values = Vec::with_capacity(n_info);
+        for (i, env) in self.envs.iter_mut().enumerate() {
+            if !reset[i] {
+                continue;
+            }
+            env.reset(seeds[i]);
+            env.write_observation(&mut obs[i * n_obs..(i + 1) * n_obs]);
+            values.clear();
+            push_infos(env, &mut values);
+            info[i * n_info..(i + 1) * n_info].copy_from_slice(&values);
+        }
+        Ok(())
+    }
+
     /// Single env: starts a new episode of env 0 with `seed`; returns (observation, info).
     fn reset_one<'py>(
         &mut self,

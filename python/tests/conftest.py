@@ -10,6 +10,16 @@ import pytest
 
 from flyloop import find_sitl_binary
 
+# torch's optimizers import triton (through torch._dynamo) when first made; in a process where
+# pygame has opened an X11 window (test_render_human.py) that import segfaults (the window's
+# graphics libraries and triton's own LLVM clash). Loaded first, before any window, it loads
+# cleanly: the tests that train in-process (tests/training) may share a pytest-xdist worker
+# with the window tests. Measured: window then Adam -> SIGSEGV; this import, window, Adam -> ok.
+try:
+    import torch._dynamo  # noqa: F401
+except ImportError:  # torch is a test peer of the training tests only
+    pass
+
 
 @pytest.fixture(scope="session")
 def sitl_binary() -> Path:

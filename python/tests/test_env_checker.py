@@ -64,7 +64,13 @@ def test_stable_baselines3_check_env_passes_without_a_warning(built, name):
 @pytest.mark.parametrize(
     "env_id", ["flyloop/QuadHover-v0", "flyloop/Lander2D-v0", "flyloop/Lander2D-v1"]
 )
-def test_the_made_env_passes_with_its_passive_checker_and_rendering(sitl_binary, env_id):
+def test_the_made_env_passes_with_its_passive_checker_and_rendering(
+    sitl_binary, env_id, monkeypatch
+):
+    # The checker also makes the env in each declared render mode, "human" too: with no
+    # display here, SDL's off-screen driver is asked for (human mode refuses to fall back to
+    # it unasked).
+    monkeypatch.setenv("SDL_VIDEODRIVER", "offscreen")
     env = gym.make(env_id, render_mode="rgb_array")
     try:
         with warnings.catch_warnings():

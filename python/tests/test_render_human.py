@@ -7,6 +7,7 @@ import select
 import shutil
 import struct
 import subprocess
+import sys
 import time
 
 import numpy as np
@@ -222,3 +223,51 @@ def test_human_mode_without_a_display_is_a_clear_error(monkeypatch):
     monkeypatch.setenv("SDL_VIDEODRIVER", "x11")
     with pytest.raises(RuntimeError, match="needs a display"):
         QuadrotorView("human", width=200, height=200)
+
+
+NO_DISPLAY_SCRIPT = """
+import gymnasium as gym, flyloop
+env = gym.make("flyloop/QuadHover-v0", backend="native", render_mode="human")
+env.reset(seed=0)
+print("no error: a window opened?")
+"""
+
+
+def run_headless(**env_vars: str) -> subprocess.CompletedProcess:
+    """The script in a fresh interpreter with no display at all (as on a server or in CI),
+    plus `env_vars`: what a user without a desktop gets."""
+    env = {
+        k: v
+        for k, v in os.environ.items()
+        if k not in ("DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER", "XDG_RUNTIME_DIR")
+    }
+    return subprocess.run(
+        [sys.executable, "-c", NO_DISPLAY_SCRIPT],
+        env={**env, **env_vars},
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+
+
+@pytest.mark.parametrize(
+    "env_vars,why",
+    [
+        ({}, "DISPLAY and WAYLAND_DISPLAY are not set"),
+        # A display that is not there: SDL falls back to its off-screen driver by itself.
+        ({"DISPLAY": ":97"}, "SDL fell back to its 'offscreen' driver"),
+    ],
+)
+def test_human_mode_with_no_display_says_what_is_wrong_and_what_to_do(env_vars, why):
+    done = run_headless(**env_vars)
+    assert done.returncode == 1, done.stdout + done.stderr
+    last = done.stderr.strip().splitlines()[-1]
+    assert last.startswith("RuntimeError: render_mode='human' needs a display"), done.stderr
+    for advice in (why, "desktop", "xvfb-run", "render_mode='rgb_array'"):
+        assert advice in last, (advice, last)
+    assert "no error" not in done.stdout
+
+
+def test_an_off_screen_driver_the_user_asked_for_is_kept():
+    done = run_headless(SDL_VIDEODRIVER="offscreen")
+    assert done.returncode == 0 and "no error" in done.stdout, done.stderr

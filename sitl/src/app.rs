@@ -149,9 +149,8 @@ fn start_px4(args: Args) -> Result<(), StartError> {
         |shutdown| {
             let listener = tokio::net::TcpListener::from_std(listener)?;
             Ok(async move {
-                Ok(px4::server::run(session, listener, pacing, shutdown)
-                    .await?
-                    .stats)
+                let s = px4::server::run(session, listener, pacing, shutdown).await?;
+                Ok(format!("{} {}", s.speed.summary(), s.stats))
             })
         },
         || {
@@ -265,7 +264,10 @@ fn start_ardupilot(args: Args) -> Result<(), StartError> {
     serve_until_signal(
         |shutdown| {
             let serving = ardupilot::server::run(session, socket, pacing, shutdown);
-            Ok(async move { Ok(serving.await?.stats) })
+            Ok(async move {
+                let s = serving.await?;
+                Ok(format!("{} {}", s.speed.summary(), s.stats))
+            })
         },
         || {
             println!("{ready}");

@@ -13,7 +13,8 @@
 //! - [`px4`]: PX4 mode, flyloop as PX4's simulator over TCP,
 //! - [`ardupilot`]: ArduPilot mode, flyloop as ArduPilot's JSON physics backend over UDP,
 //! - [`pacer`]: the wall-clock pacer of both autopilot modes,
-//! - [`track`]: their ground-truth track file (`--track`).
+//! - [`track`]: their ground-truth track file (`--track`),
+//! - [`speed`]: their simulated time and real-time factor in the log.
 
 pub mod app;
 pub mod ardupilot;
@@ -31,6 +32,7 @@ pub mod px4;
 pub mod record;
 pub mod server;
 pub mod sim;
+pub mod speed;
 pub mod starter_config;
 pub mod stats;
 pub mod task_frame;

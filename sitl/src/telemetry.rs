@@ -27,8 +27,9 @@ pub mod id {
 /// What a ground station needs to draw a vehicle's status.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Status {
-    /// Waiting for its first command (real time) or stepped by a controller (lockstep).
+    /// No controller flies it: waiting for its first command or step, or its episode ended.
     Standby,
+    /// A controller flies it (HEARTBEAT: armed).
     Active,
     /// Failsafe: the controller went silent and the motors are off.
     Failsafe,

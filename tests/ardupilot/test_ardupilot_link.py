@@ -140,5 +140,12 @@ def test_lockstep_repeats_bad_input_restart_and_silence(simulator):
         "1",
     )
     assert counters["absurd_pwm"] == "1", counters
+    # How fast it ran: the simulated time (read every 64 frames: the last few may be left
+    # out) against the wall time it took, and their ratio.
+    simulated, wall = float(counters["simulated_s"]), float(counters["wall_s"])
+    assert 1.0013 - 64 * 0.000833 <= simulated <= 1.0013 + 1e-6, counters
+    assert 0 < wall < 60 and float(counters["real_time_factor"]) == pytest.approx(
+        simulated / wall, rel=1e-3, abs=0.01
+    )
     # Each kind of bad input logged once.
     assert logged().count("skipped: ") == 3, logged()

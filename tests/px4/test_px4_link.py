@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import socket
 import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -127,3 +128,70 @@ def test_lockstep_bad_input_second_connection_and_reconnect(simulator):
     counts = dict(kv.split("=") for kv in stats.split())
     assert int(counts["garbage"]) >= 1
     assert int(counts["refused_controls"]) == 1
+
+
+def test_speed_is_logged_and_a_track_still_being_written_plots(sitl_binary, tmp_path):
+    """flyloop-sitl says how fast it runs (every 5 s of wall time and in its stop line), and
+    examples/px4_track_plot.py plots the track it is still writing (a partial last row)."""
+    track, log = tmp_path / "track.csv", tmp_path / "sitl.log"
+    with open(log, "w") as err:
+        proc = subprocess.Popen(
+            [str(sitl_binary), "--px4", "--px4-listen", "127.0.0.1:0", "--speed-factor", "0"]
+            + ["--track", str(track)],
+            stdout=subprocess.PIPE,
+            stderr=err,
+            text=True,
+        )
+    try:
+        ready = dict(kv.split("=", 1) for kv in proc.stdout.readline().split()[2:])
+        host, port = ready["px4"].rsplit(":", 1)
+        peer = Peer((host, int(port)))
+        first = peer.messages(1)[0].time_usec
+        start = time.monotonic()
+        while time.monotonic() - start < 6.0:  # past the first 5 s line
+            peer.sock.sendall(peer.controls(0.0) * 50)
+            last = peer.messages(50)[-1].time_usec
+        wall = time.monotonic() - start
+
+        # The track mid-flight: the SITL writes whole buffers, so its last row is usually
+        # cut; a copy cut inside a number makes sure of it.
+        script = Path(__file__).resolve().parents[2] / "examples" / "px4_track_plot.py"
+        text = track.read_text()
+        complete = text[: text.rfind("\n") + 1]
+        rows = complete.count("\n") - 1  # the header
+        cut = tmp_path / "cut.csv"
+        cut.write_text(complete + text[len(complete) :] + "12.3")
+        assert rows > 100 and not cut.read_text().endswith("\n")
+        png = tmp_path / "cut.png"
+        done = subprocess.run(
+            [sys.executable, str(script), str(cut), str(png)], capture_output=True, text=True
+        )
+        assert done.returncode == 0, done.stderr
+        assert f"plotted {rows} rows" in done.stdout and "left out" in done.stdout
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        # Not a track, or no file: one line naming it, no traceback.
+        other = tmp_path / "other.csv"
+        other.write_text("a,b\n1,2\n")
+        bad = ((other, "is not a flyloop-sitl --track file"), (tmp_path, "cannot read"))
+        for path, said in bad:
+            done = subprocess.run(
+                [sys.executable, str(script), str(path), str(png)], capture_output=True, text=True
+            )
+            assert done.returncode == 1 and said in done.stderr, done.stderr
+            assert "Traceback" not in done.stderr
+    finally:
+        stop(proc)
+    logged = log.read_text()
+    # The 5-second line: simulated time, the window's and the overall real-time factor.
+    line = next(x for x in logged.splitlines() if "x real time over the last" in x)
+    assert " INFO " in line, line
+    simulated = float(line.split("simulated ", 1)[1].split(" s,", 1)[0])
+    factor = float(line.split(" s, ", 1)[1].split("x real time", 1)[0])
+    assert 0 < simulated <= (last - first) * 1e-6 + 0.3 and factor > 1, line
+    # The stop line: totals over the whole run, the factor = simulated / wall.
+    stats = dict(kv.split("=") for kv in logged.split("stopped: ", 1)[1].split())
+    sim_s, wall_s = float(stats["simulated_s"]), float(stats["wall_s"])
+    assert abs(sim_s - (last - first) * 1e-6) <= 64 * 0.004 + 1e-6, (sim_s, first, last)
+    assert 5.0 < wall_s <= wall + 0.5
+    assert float(stats["real_time_factor"]) == pytest.approx(sim_s / wall_s, rel=1e-3, abs=0.01)
+    assert int(stats["steps"]) >= (last - first) // 4000

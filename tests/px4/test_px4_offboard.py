@@ -55,6 +55,13 @@ def check_flight(result, bound: float) -> list[tuple[float, float]]:
         assert worst < 2 * bound + 0.3, result.stdout
     lines = result.stdout.strip().splitlines()
     assert lines[-1].startswith("max hold error"), lines[-1]
+    # Each phase a person waits through is said as it starts, in order.
+    said = [line for line in result.stderr.splitlines() if line.startswith("px4_offboard: ")]
+    order = ["waiting for PX4's heartbeat", "waiting for its position", "arming", "taking off"]
+    order += ["climbing", "streaming the policy's setpoints", "switching to OFFBOARD"]
+    order += [f"waypoint {i}: flying to" for i in range(3)] + ["PX4 holds position"]
+    at = [next(k for k, line in enumerate(said) if phase in line) for phase in order]
+    assert at == sorted(at), said
     assert "PX4 holds position" in result.stderr and "PX4 lands" in result.stderr
     return errors
 
@@ -83,7 +90,11 @@ def test_no_px4_is_said_in_one_line_without_a_traceback(tmp_path):
         timeout=60,
     )
     assert result.returncode == 2, result.stderr
-    assert "PX4 not reachable at udpout:127.0.0.1:9" in result.stderr
+    # The wait is said before it starts, then its end in one line.
+    lines = result.stderr.strip().splitlines()
+    waiting = "px4_offboard: waiting for PX4's heartbeat at udpout:127.0.0.1:9 (up to 3 s)"
+    assert waiting in lines, lines
+    assert "PX4 not reachable at udpout:127.0.0.1:9" in lines[-1], lines
     assert "Traceback" not in result.stderr
     assert time.monotonic() - start < 30
 

@@ -18,7 +18,8 @@ A fenced block is checked when the line before it is a marker comment:
   ArduPilot modes (vehicle parameters and a ``[frame]``) that flyloop-sitl accepts.
 - ``<!-- check: ci -->``: the README's two top commands; ``.ci/run`` runs each line as written.
 
-Every fenced block carries a marker: a block without one fails. Beyond the blocks: the README
+Python blocks must run without a warning. Every fenced block carries a marker: a block
+without one fails. Beyond the blocks: the README
 starts with its two commands and stays under 200 lines; every link and every repository path
 a page names exists; no page names a path outside the repository.
 """
@@ -28,9 +29,13 @@ from __future__ import annotations
 import os
 import re
 import shlex
+import shutil
 import signal
+import socket
 import subprocess
 import sys
+import threading
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -41,6 +46,7 @@ REPO = Path(__file__).resolve().parents[2]
 README = REPO / "README.md"
 PAGES = [README, *sorted((REPO / "docs").rglob("*.md"))]
 MARKER = re.compile(r"<!-- check: ([\w-]+)(?: (\S+))? -->")
+WARNING = re.compile(r"^.*\b\w*Warning: .*$", re.M)
 
 
 @dataclass
@@ -241,6 +247,11 @@ def run_python(code: str, sitl: Path) -> None:
         timeout=300,
     )
     assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-4000:]
+    # A snippet a reader copies runs clean: no warning (fmpy's "Warning: missing input ...",
+    # Python's UserWarning, ...) that would leave the reader wondering what is wrong.
+    warned = WARNING.findall(result.stdout + result.stderr)
+    output = result.stdout[-2000:] + result.stderr[-2000:]
+    assert not warned, f"the snippet warns: {warned}\n{output}"
 
 
 def start_sitl(binary: Path, args: list[str]) -> tuple[subprocess.Popen, str]:
@@ -371,3 +382,88 @@ def test_config_files_are_accepted_by_the_sitl(block: Block, sitl_binary: Path, 
     # The top-level values come back as the parameters' values.
     for name, value in re.findall(r"^(\w+) = ([\d.]+)$", block.text.split("\n[")[0], re.M):
         assert re.search(rf"^{name} = {re.escape(value)}\b", result.stdout, re.M), name
+
+
+def shell_blocks() -> list[Block]:
+    return [b for b in ALL if b.language == "sh"]
+
+
+def test_commands_name_the_venvs_programs_by_their_path():
+    """A program setup.sh installs into .venv (mavproxy.py, pytest, tensorboard, ...) is
+    named .venv/bin/NAME, as every other command names it: a bare name runs whatever PATH
+    finds, or nothing. The RLlib cluster block is the exception: it runs on other machines,
+    in their own environment."""
+    venv = REPO / ".venv" / "bin"
+    elsewhere = os.pathsep.join(p for p in os.environ["PATH"].split(os.pathsep) if p != str(venv))
+    # Programs only the venv has (cargo, bash, ... are found on PATH anyway).
+    programs = {p.name for p in venv.iterdir() if not shutil.which(p.name, path=elsewhere)}
+    assert "mavproxy.py" in programs and "pytest" in programs
+    bare = [
+        f"{block.where}: {command}"
+        for block in shell_blocks()
+        if "ray start" not in block.text
+        for command in commands(block)
+        if set(programs_run(command)) & programs
+    ]
+    assert not bare, bare
+
+
+def programs_run(command: str) -> list[str]:
+    """The programs a command line runs: its first word and the first after each ;, &&, ||
+    or |, past VAR=value assignments."""
+    out, first = [], True
+    for word in shlex.split(command):
+        if word in (";", "&&", "||", "|"):
+            first = True
+        elif first and not re.match(r"^\w+=", word):
+            out.append(word)
+            first = False
+    return out
+
+
+def test_mavproxy_as_the_docs_run_it_leaves_the_checkout_clean(tmp_path: Path):
+    """Every MAVProxy command of the docs, run from the repository root as they say, keeps
+    its log (mav.tlog, mav.tlog.raw) and parameter file out of the checkout's tracked tree.
+    The link is a local UDP port here (the docs' PX4 or ArduPilot is not needed for where
+    MAVProxy writes its state)."""
+    lines = [c for b in shell_blocks() for c in commands(b) if "mavproxy.py" in c]
+    assert len(lines) >= 2, lines  # PX4's and ArduPilot's
+    status = ["git", "status", "--porcelain", "--untracked-files=all"]
+    for line in lines:
+        words = [w for w in shlex.split(line) if not w.startswith("--master=")]
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+            s.bind(("127.0.0.1", 0))
+            port = s.getsockname()[1]
+        before = subprocess.run(status, cwd=REPO, capture_output=True, text=True).stdout
+        proc = subprocess.Popen(
+            [*words, f"--master=udpin:127.0.0.1:{port}"],
+            cwd=REPO,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            start_new_session=True,  # MAVProxy forks helpers: stopped with its group
+        )
+        # A MAVProxy that never says where it logs is stopped after 60 s (the test fails).
+        guard = threading.Timer(60, os.killpg, (proc.pid, signal.SIGKILL))
+        guard.start()
+        try:
+            seen = ""
+            for out in proc.stdout:
+                seen += out
+                if out.startswith("Telemetry log: "):  # its log files are open now
+                    break
+            time.sleep(1.0)
+        finally:
+            guard.cancel()
+            try:
+                os.killpg(proc.pid, signal.SIGKILL)
+            except ProcessLookupError:  # the guard stopped it
+                pass
+            proc.wait()
+        after = subprocess.run(status, cwd=REPO, capture_output=True, text=True).stdout
+        new = sorted(set(after.splitlines()) - set(before.splitlines()))
+        assert not new, f"{line} left {new} in the checkout"
+        logged = re.search(r"Telemetry log: (\S+)", seen)
+        assert logged, seen
+        assert (REPO / logged.group(1)).resolve().is_relative_to(REPO / "runs"), logged.group(1)

@@ -1,5 +1,6 @@
-"""The ground-station link as its own peer: telemetry streams, requests, and a real MAVProxy
-that detects the vehicle and shows its attitude."""
+"""The ground-station link as its own peer: telemetry streams, requests, honest HEARTBEAT
+flags, and a real MAVProxy that detects the vehicle, shows its attitude and says ARMED only
+while a controller flies it."""
 
 from __future__ import annotations
 
@@ -124,3 +125,54 @@ def test_mavproxy_detects_the_vehicle_and_shows_its_attitude(start_sitl, client_
     yaw_enu = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
     assert abs(float(fields["yaw"]) - (math.pi / 2 - yaw_enu)) < 1e-5, fields
     assert abs(float(fields["roll"])) < 0.11 and abs(float(fields["pitch"])) < 0.11
+
+
+def armed_and_state(gcs: GroundStation, seconds: float = 1.3) -> tuple[bool, int]:
+    """The last HEARTBEAT's armed flag and system status (HEARTBEAT comes at 1 Hz)."""
+    beat = of_type(gcs.listen(seconds), "HEARTBEAT")[-1]
+    assert beat.base_mode & ~mavlink2.MAV_MODE_FLAG_SAFETY_ARMED == 0, beat  # no other flag
+    return bool(beat.base_mode & mavlink2.MAV_MODE_FLAG_SAFETY_ARMED), beat.system_status
+
+
+def test_heartbeat_says_armed_only_while_a_controller_flies(start_sitl, client_for, tmp_path):
+    # Regression: a lockstep SITL nobody stepped said SAFETY_ARMED and MAV_STATE_ACTIVE.
+    config = tmp_path / "short.toml"
+    config.write_text("max_steps = 20\n")
+    gcs = GroundStation()
+    sitl = start_sitl("--config", str(config), gcs=f"127.0.0.1:{gcs.port}")
+    standby, active = mavlink2.MAV_STATE_STANDBY, mavlink2.MAV_STATE_ACTIVE
+    assert armed_and_state(gcs) == (False, standby)  # nothing flies it
+    client = client_for(sitl)
+    for _ in range(5):
+        client.step([0.5] * 4)
+    assert armed_and_state(gcs) == (True, active)  # a controller flies it
+    for _ in range(15):
+        frame = decode_frame(client.step([0.5] * 4), 1)
+    assert frame.truncated  # the episode's time limit
+    assert armed_and_state(gcs) == (False, standby)
+    client.reset(3)
+    client.step([0.5] * 4)
+    assert armed_and_state(gcs) == (True, active)
+    client.reset(4)  # a new episode no controller has stepped yet
+    assert armed_and_state(gcs) == (False, standby)
+
+
+def test_mavproxy_says_armed_only_while_a_controller_flies(start_sitl, client_for, tmp_path):
+    port = free_udp_port()
+    mavproxy = MavProxy(tmp_path, f"--master=udpin:127.0.0.1:{port}", "--nowait")
+    try:
+        mavproxy.wait_for("Connect udpin", timeout=30)
+        sitl = start_sitl(gcs=f"127.0.0.1:{port}")
+        mavproxy.wait_for("online system 1", timeout=30)
+        # No flight modes, nothing armed: base_mode 0, which MAVProxy prints in hex.
+        mavproxy.wait_for("Mode(0x00000000)", timeout=10)
+        time.sleep(2.5)  # more heartbeats
+        assert "ARMED" not in mavproxy.console()
+        client = client_for(sitl)
+        client.reset(1)
+        client.step([0.5] * 4)
+        mavproxy.wait_for("ARMED", timeout=10)
+        client.reset(2)
+        mavproxy.wait_for("DISARMED", timeout=10)
+    finally:
+        mavproxy.kill()

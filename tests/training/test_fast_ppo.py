@@ -5,9 +5,12 @@ vector env learns exactly the same thing."""
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
+import time
 
 import pytest
-from training_support import TRAIN, run_script
+from training_support import REPO, TRAIN, run_script
 
 # The lander's short run: 20 updates of 128 envs x 128 steps (~23 CPU seconds). Measured
 # (seed 0, held-out seeds 1,000,000..1,000,019): mean return 2.6 against -302.6 for random
@@ -37,6 +40,19 @@ def test_fast_ppo_learns_quadhover_on_the_native_vector_env(tmp_path):
     assert s["first_update_at_90_percent"] is not None
     assert (tmp_path / "learning_curve.png").is_file()
     assert (tmp_path / "native" / "progress.csv").is_file()
+
+    # evaluate.py records a hover episode and names its outcome in hover's words (it called
+    # a held target "landed").
+    gif, figures = tmp_path / "hover.gif", tmp_path / "eval.json"
+    done = run_script(
+        TRAIN / "evaluate.py", str(tmp_path / "native"), "--episodes", "1",
+        "--json", str(figures), "--gif", str(gif),
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr[-3000:]
+    held = json.loads(figures.read_text())["success_rate"] == 1.0
+    words = "held the target" if held else "did not hold the target"
+    assert f"steps, {words}" in done.stdout and "landed" not in done.stdout, done.stdout
+    assert gif.read_bytes()[:6] == b"GIF89a"
 
 
 @pytest.mark.training
@@ -151,3 +167,29 @@ def test_training_table_reads_one_row_per_task_with_one_figure_per_seed(tmp_path
         s = summary(tmp_path / f"hover_s{seed}", "native")
         assert s["seed"] == seed and s["env_steps"] == 8192
         assert f"{100 * s['evaluation']['success_rate']:.1f} %" in cells[3]
+
+
+def test_fast_ppo_says_each_phase_from_its_first_second(tmp_path):
+    """Regression: nothing showed for the first seconds (torch and the envs loading) nor
+    while it evaluated and drew. Now each phase is one stderr line as it starts."""
+    start = time.monotonic()
+    proc = subprocess.Popen(
+        [sys.executable, str(TRAIN / "fast_ppo.py"), "--timesteps", "4096", "--num-envs", "16"]
+        + ["--eval-episodes", "2", "--out", str(tmp_path), "--no-progress-bar"],
+        cwd=REPO,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    first = proc.stderr.readline()
+    waited = time.monotonic() - start
+    out, err = proc.communicate(timeout=300)
+    assert proc.returncode == 0, err[-3000:]
+    # Before torch is imported (seconds): only the interpreter's start-up before it.
+    assert first == "fast_ppo: loading torch and the envs\n", first
+    assert waited < 3.0, waited
+    said = [line.split(": ", 1)[1] for line in err.splitlines() if line.startswith("fast_ppo: ")]
+    assert [s.split()[0] for s in said] == ["training", "evaluating", "drawing"], said
+    assert said[0] == (
+        "training hover on the native backend: 2 updates of 16 envs x 128 steps (4,096 env steps)"
+    )

@@ -167,3 +167,24 @@ def test_evaluate_loads_a_fast_ppo_run(tmp_path):
     assert result["env_id"] == "flyloop/Lander2D-v1" and result["first_seed"] == own["seed"]
     assert result["success_rate"] == own["success_rate"]
     assert result["mean_return"] == pytest.approx(own["mean_return"], abs=1.0)
+
+
+def test_each_task_names_its_outcome_in_its_own_words(tmp_path):
+    """Regression: evaluate.py called a successful hover episode "landed"."""
+    import training_envs
+
+    hover = training_envs.preset("hover")
+    assert hover.outcome(True).startswith("held the target") and "land" not in hover.outcome(True)
+    assert hover.outcome(False) == "did not hold the target"
+    assert training_envs.preset("offboard").outcomes == hover.outcomes
+    for name in ("lander", "lander_moving", "lander_v0"):
+        p = training_envs.preset(name)
+        assert (p.outcome(True), p.outcome(False)) == ("landed", "did not land"), name
+    # The recorded episode's line, for random actions (which fail both tasks).
+    for env, words in (("hover", "did not hold the target"), ("lander", "did not land")):
+        gif = tmp_path / f"{env}.gif"
+        done = run_script(
+            TRAIN / "evaluate.py", "--random", "--env", env, "--episodes", "1", "--gif", str(gif)
+        )
+        assert done.returncode == 0, done.stderr[-2000:]
+        assert f"steps, {words}) to {gif}" in done.stdout, done.stdout

@@ -22,6 +22,62 @@ _DEJAVU_SCALE = 0.68
 _font_files: dict[bool, str | None] = {}
 # pygame drives one window per process; a second human view would silently steal it.
 _window_owner: View | None = None
+# SDL_VIDEODRIVER=dummy set by an rgb_array view (not by the user): a human view drops it.
+_dummy_driver_ours = False
+# SDL's drivers that draw nowhere: pygame falls back to them when there is no display.
+_HEADLESS_DRIVERS = ("offscreen", "dummy")
+NO_DISPLAY = (
+    "render_mode='human' needs a display to open its window, and this process has none "
+    "({why}). Run it on a desktop, under a virtual display (`xvfb-run -a python ...`), or "
+    "use render_mode='rgb_array' to get the frames as arrays (e.g. to save a video with "
+    "flyloop.rendering.record_episode)."
+)
+
+
+def _has_display() -> bool:
+    return sys.platform in ("win32", "darwin") or bool(
+        os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+    )
+
+
+def _open_window(pg: Any, size: tuple[int, int]) -> Any:
+    """The window's surface, or RuntimeError saying what to do: pygame itself opens an
+    invisible off-screen window when there is no display, and raises nothing."""
+    global _dummy_driver_ours
+    if _dummy_driver_ours and os.environ.get("SDL_VIDEODRIVER") == "dummy":
+        del os.environ["SDL_VIDEODRIVER"]
+        _dummy_driver_ours = False
+    asked = os.environ.get("SDL_VIDEODRIVER")  # the user's choice of driver stands
+    if not asked and not _has_display():
+        raise RuntimeError(NO_DISPLAY.format(why="DISPLAY and WAYLAND_DISPLAY are not set"))
+    try:
+        pg.display.init()
+        surface = pg.display.set_mode(size)
+    except pg.error as exc:
+        raise RuntimeError(NO_DISPLAY.format(why=f"SDL: {exc}")) from exc
+    driver = pg.display.get_driver()
+    if driver in _HEADLESS_DRIVERS and driver != asked:
+        pg.display.quit()
+        why = f"SDL fell back to its {driver!r} driver"
+        if not asked and os.environ.get("DISPLAY"):
+            # SDL tried X11 and moved on without a word: ask for X11 itself once, which either
+            # opens the window or says why it cannot.
+            return _open_x11(pg, size, why)
+        raise RuntimeError(NO_DISPLAY.format(why=why))
+    return surface
+
+
+def _open_x11(pg: Any, size: tuple[int, int], why: str) -> Any:
+    """The window on DISPLAY through SDL's X11 driver, or RuntimeError with SDL's reason."""
+    os.environ["SDL_VIDEODRIVER"] = "x11"
+    try:
+        pg.display.init()
+        return pg.display.set_mode(size)
+    except pg.error as exc:
+        display = os.environ.get("DISPLAY")
+        raise RuntimeError(NO_DISPLAY.format(why=f"{why}; X11 on {display}: {exc}")) from exc
+    finally:
+        del os.environ["SDL_VIDEODRIVER"]
 
 
 def _px(point: Point) -> tuple[int, int]:
@@ -167,17 +223,16 @@ class View:
     def __init__(
         self, render_mode: str, size: tuple[int, int], caption: str, fps: float, path_steps: int
     ) -> None:
-        global _window_owner
+        global _window_owner, _dummy_driver_ours
         self.path: deque[np.ndarray] = deque(maxlen=path_steps)
         self._last_step: int | None = None
         if render_mode not in RENDER_MODES:
             raise ValueError(f"render_mode must be one of {RENDER_MODES}, got {render_mode!r}")
         self.render_mode, self.size, self.fps = render_mode, (int(size[0]), int(size[1])), fps
-        has_display = sys.platform in ("win32", "darwin") or bool(
-            os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
-        )
-        if render_mode == "rgb_array" and not has_display:  # SDL draws off-screen
-            os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+        if render_mode == "rgb_array" and not _has_display():  # SDL draws off-screen
+            if "SDL_VIDEODRIVER" not in os.environ:
+                os.environ["SDL_VIDEODRIVER"] = "dummy"
+                _dummy_driver_ours = True
         os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
         import pygame as pg
 
@@ -189,14 +244,7 @@ class View:
                     "another human-mode view already owns the pygame window of this process; "
                     "close it first (pygame shows one window per process)"
                 )
-            try:
-                pg.display.init()
-                self._surface = pg.display.set_mode(self.size)
-            except pg.error as exc:
-                raise RuntimeError(
-                    f"render_mode='human' needs a display ({exc}); run under a desktop or "
-                    "xvfb-run, or use render_mode='rgb_array' headless"
-                ) from exc
+            self._surface = _open_window(pg, self.size)
             pg.display.set_caption(caption)
             self._clock = pg.time.Clock()
             _window_owner = self

@@ -5,6 +5,7 @@ use super::packet::{self, MAX_PWM, PacketError, ServoFrame};
 use super::reply::{self, State};
 use crate::config::AutopilotVehicle;
 use crate::kinematics::{attitude_ned, enu_to_ned, flu_to_frd};
+use crate::speed::SpeedLog;
 use crate::stats::us_per;
 use crate::track::SessionTrack;
 use flyloop_core::ParamError;
@@ -119,6 +120,8 @@ pub struct Session {
     /// Ground-truth CSV (`--track`), if any.
     pub track: SessionTrack,
     pub stats: Counters,
+    /// Simulated time against wall time, logged while ArduPilot steps.
+    pub speed: SpeedLog,
 }
 
 /// What to do with a datagram.
@@ -149,6 +152,7 @@ impl Session {
             logged: 0,
             track: SessionTrack::default(),
             stats: Counters::default(),
+            speed: SpeedLog::default(),
         })
     }
 
@@ -310,6 +314,7 @@ impl Session {
         let imu = self.sensors.sample_imu(&self.quad.kinematics(), dt);
         self.stats.steps += 1;
         self.stats.physics += start.elapsed();
+        self.speed.observe(self.time_us);
         let b = &self.quad.body;
         let q = attitude_ned(&self.quad.attitude());
         let state = State {

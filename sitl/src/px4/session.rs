@@ -4,6 +4,7 @@
 use super::messages;
 use crate::config::AutopilotVehicle;
 use crate::kinematics::Home;
+use crate::speed::SpeedLog;
 use crate::stats::Stats;
 use crate::telemetry;
 use crate::track::SessionTrack;
@@ -50,6 +51,8 @@ pub struct Session {
     /// Ground-truth CSV (`--track`), if any.
     pub track: SessionTrack,
     pub stats: Stats,
+    /// Simulated time against wall time, logged while PX4 steps.
+    pub speed: SpeedLog,
 }
 
 impl Session {
@@ -81,6 +84,7 @@ impl Session {
             encoder: Encoder::default(),
             track: SessionTrack::default(),
             stats: Stats::default(),
+            speed: SpeedLog::default(),
         })
     }
 
@@ -201,6 +205,7 @@ impl Session {
         self.stats.steps += 1;
         self.emit(out);
         self.stats.physics += start.elapsed();
+        self.speed.observe(self.time_us);
     }
 
     /// HIL_SENSOR now, HIL_GPS when a fix is delivered, HIL_STATE_QUATERNION when due.

@@ -246,7 +246,16 @@ impl Sim {
     pub(super) fn status(&self, i: usize) -> Status {
         let rt = &self.runtime[i];
         match self.options.mode {
-            Mode::Lockstep => Status::Active,
+            // Armed only while a controller flies it: from its first step after a reset
+            // until its episode ends (a SITL nobody steps is not armed).
+            Mode::Lockstep => {
+                let last = &self.vehicles[i].last;
+                if last.step > 0 && !last.terminated && !last.truncated {
+                    Status::Active
+                } else {
+                    Status::Standby
+                }
+            }
             Mode::Realtime if rt.failsafe => Status::Failsafe,
             Mode::Realtime if rt.running => Status::Active,
             Mode::Realtime => Status::Standby,
