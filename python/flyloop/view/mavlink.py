@@ -70,6 +70,7 @@ class _Autopilot:
     # Its local origin in the truth's frame (NED from the truth's home, m): from its
     # GPS_GLOBAL_ORIGIN; zero until it says.
     origin: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    origin_known: bool = False
 
 
 class MavlinkScene:
@@ -197,8 +198,15 @@ class MavlinkScene:
         north = math.radians(m.latitude / 1e7 - lat0) * EARTH_RADIUS
         east = math.radians(m.longitude / 1e7 - lon0) * EARTH_RADIUS * math.cos(math.radians(lat0))
         origin = [north, east, -(m.altitude / 1e3 - alt0)]
+        autopilot = self.autopilots.setdefault(key, _Autopilot())
+        autopilot.origin_known = True
         if math.hypot(*origin) < 1000.0:
-            self.autopilots.setdefault(key, _Autopilot()).origin = origin
+            autopilot.origin = origin
+
+    def origin_known(self, source) -> bool:
+        """Whether the autopilot at `source` has told its local origin (an estimate before
+        it is drawn as if its origin were home)."""
+        return any(a.origin_known for (s, _), a in self.autopilots.items() if s == source)
 
     def _on_local_position_ned(self, key: tuple, m) -> None:
         if self.is_autopilot(key):
@@ -330,8 +338,13 @@ class Listener:
             self.last_beat = now
             gcs, invalid = mavlink2.MAV_TYPE_GCS, mavlink2.MAV_AUTOPILOT_INVALID
             hb = self.mav.heartbeat_encode(gcs, invalid, 0, 0, 0).pack(self.mav)
+            origin = mavlink2.MAVLINK_MSG_ID_GPS_GLOBAL_ORIGIN
             for peer in self.autopilots:
                 self.sock.sendto(hb, peer)
+                # An autopilot sets its origin at its first GPS fusion, after the view
+                # greeted it: ask again each second until it has answered.
+                if not self.view.origin_known(peer):
+                    self._commands(peer, [(mavlink2.MAV_CMD_REQUEST_MESSAGE, origin, 0)])
 
     def close(self) -> None:
         for peer in self.asked:
