@@ -8,27 +8,13 @@
 
 // Test code: a failed unwrap is a failed test.
 
+use crate::trace_hash::Hash;
 use flyloop_core::lander2d::{DroneState, Lander2d, Lander2dParams};
 use flyloop_core::rng::SimRng;
 use flyloop_core::tasks::Task;
 use flyloop_core::tasks::landing::{Landing, LandingParams};
 
-/// FNV-1a over 64-bit words: one number for a whole trace of bits.
-#[derive(Default)]
-struct Hash(u64);
-
 impl Hash {
-    fn new() -> Self {
-        Hash(0xcbf2_9ce4_8422_2325)
-    }
-
-    fn add(&mut self, word: u64) {
-        for byte in word.to_le_bytes() {
-            self.0 ^= u64::from(byte);
-            self.0 = self.0.wrapping_mul(0x0100_0000_01b3);
-        }
-    }
-
     fn add_state(&mut self, l: &Lander2d) {
         let d = l.drone();
         let c = l.contact();

@@ -16,3 +16,4 @@ mod quadrotor_physics;
 mod quadrotor_rates;
 mod quadrotor_tasks;
 mod quadrotor_wind_grid;
+mod trace_hash;

@@ -5,6 +5,7 @@
 
 // Test code: a failed unwrap is a failed test.
 
+use crate::trace_hash::Hash;
 use flyloop_core::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
 use flyloop_core::rng::SimRng;
 use flyloop_core::tasks::InfoRef;
@@ -12,21 +13,7 @@ use flyloop_core::tasks::randomization::{ParamRange, Randomization};
 use flyloop_core::tasks::registry::{TaskConfig, TaskInstance, TaskKind};
 use nalgebra::Vector3;
 
-/// FNV-1a over 64-bit words: one number for a whole trace of bits.
-struct Hash(u64);
-
 impl Hash {
-    fn new() -> Self {
-        Hash(0xcbf2_9ce4_8422_2325)
-    }
-
-    fn add(&mut self, word: u64) {
-        for byte in word.to_le_bytes() {
-            self.0 ^= u64::from(byte);
-            self.0 = self.0.wrapping_mul(0x0100_0000_01b3);
-        }
-    }
-
     fn add_body(&mut self, b: &BodyState) {
         let reals = b
             .position

@@ -33,6 +33,20 @@ pub struct Derivative {
     pub gear_stretch_rates: [[f64; 2]; 4],
 }
 
+impl Derivative {
+    /// In the layout of [`state_vector`]: the derivative of each continuous state.
+    pub fn to_vec(&self) -> Vec<f64> {
+        let mut d = Vec::with_capacity(state_len(self.motor_rates.len()));
+        d.extend(self.velocity.iter().chain(self.acceleration.iter()));
+        let q = &self.attitude_rate;
+        d.extend([q.w, q.i, q.j, q.k]);
+        d.extend(self.angular_acceleration.iter());
+        d.extend(self.motor_rates.iter());
+        d.extend(self.gear_stretch_rates.iter().flatten());
+        d
+    }
+}
+
 /// Constants of the equations that depend only on the parameters and the frame: computed
 /// once per step by [`integrate`], kept by a vehicle until its parameters change
 /// ([`ConstantsCache`]).
@@ -249,26 +263,7 @@ pub fn derivative_vector(
     command: &Motors,
     wind: &Vector3<f64>,
 ) -> Vec<f64> {
-    by_size!(
-        frame.rotor_count(),
-        derivative_compact(params, frame, state, command, wind)
-    )
-}
-
-/// The sized derivative without its unused motor slots.
-fn derivative_compact<const L: usize, const C: usize>(
-    params: &QuadrotorParams,
-    frame: &Frame,
-    state: &BodyState,
-    command: &Motors,
-    wind: &Vector3<f64>,
-) -> Vec<f64> {
-    let d = derivative_sized::<L, C>(params, frame, state, command, wind);
-    let rotors = frame.rotor_count();
-    let mut out = Vec::with_capacity(state_len(rotors));
-    out.extend_from_slice(&d[..BODY + rotors]);
-    out.extend_from_slice(&d[L..]);
-    out
+    derivatives(params, frame, state, command, wind).to_vec()
 }
 
 fn derivative_sized<const L: usize, const C: usize>(

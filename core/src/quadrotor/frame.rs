@@ -246,63 +246,50 @@ const COEFFICIENT_BOUNDS: [(&str, f64, f64, &str); 3] = [
 ];
 
 fn check_table(table: &FrameTable) -> Result<(), FrameError> {
-    let frame = || table.name.clone();
     let count = table.rotors.len();
     if !(4..=MAX_ROTORS).contains(&count) {
         return Err(FrameError::RotorCount {
-            frame: frame(),
+            frame: table.name.clone(),
             count,
         });
     }
     for (rotor, r) in table.rotors.iter().enumerate() {
-        for (field, value) in [("x", r.x), ("y", r.y)] {
+        // One value of rotor `rotor`: finite, then inside [min, max].
+        let check = |field, value: f64, min, max, unit| {
+            let frame = table.name.clone();
             if !value.is_finite() {
-                return Err(FrameError::NotFinite {
-                    frame: frame(),
+                Err(FrameError::NotFinite {
+                    frame,
                     rotor,
                     field,
                     value,
-                });
-            }
-            if value.abs() > 100.0 {
-                return Err(FrameError::OutOfRange {
-                    frame: frame(),
-                    rotor,
-                    field,
-                    value,
-                    min: -100.0,
-                    max: 100.0,
-                    unit: " arm lengths",
-                });
-            }
-        }
-        if r.x == 0.0 && r.y == 0.0 {
-            return Err(FrameError::AtCentre {
-                frame: frame(),
-                rotor,
-            });
-        }
-        let own = [r.thrust_coefficient, r.torque_coefficient, r.time_constant];
-        for ((field, min, max, unit), value) in COEFFICIENT_BOUNDS.into_iter().zip(own) {
-            let Some(value) = value else { continue };
-            if !value.is_finite() {
-                return Err(FrameError::NotFinite {
-                    frame: frame(),
-                    rotor,
-                    field,
-                    value,
-                });
-            }
-            if !(min..=max).contains(&value) {
-                return Err(FrameError::OutOfRange {
-                    frame: frame(),
+                })
+            } else if !(min..=max).contains(&value) {
+                Err(FrameError::OutOfRange {
+                    frame,
                     rotor,
                     field,
                     value,
                     min,
                     max,
                     unit,
-                });
+                })
+            } else {
+                Ok(())
+            }
+        };
+        check("x", r.x, -100.0, 100.0, " arm lengths")?;
+        check("y", r.y, -100.0, 100.0, " arm lengths")?;
+        if r.x == 0.0 && r.y == 0.0 {
+            return Err(FrameError::AtCentre {
+                frame: table.name.clone(),
+                rotor,
+            });
+        }
+        let own = [r.thrust_coefficient, r.torque_coefficient, r.time_constant];
+        for ((field, min, max, unit), value) in COEFFICIENT_BOUNDS.into_iter().zip(own) {
+            if let Some(value) = value {
+                check(field, value, min, max, unit)?;
             }
         }
     }

@@ -18,6 +18,7 @@ use flyloop_core::quadrotor::continuous::{BODY_STATE_OUTPUTS, BRISTLES, EVENT_IN
 use flyloop_core::quadrotor::dynamics::state_len;
 use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial, wind};
 use flyloop_core::variables::{self, Variable};
+use flyloop_core::vehicle::Vehicle;
 use flyloop_core::{ParamError, SnapshotError};
 use std::sync::OnceLock;
 
@@ -155,14 +156,7 @@ impl FmuModel for Quadrotor {
     }
 
     fn is_finite(&self) -> bool {
-        let b = &self.body;
-        b.position
-            .iter()
-            .chain(b.velocity.iter())
-            .chain(b.body_rates.iter())
-            .chain(b.attitude.coords.iter())
-            .chain(b.motors.iter())
-            .all(|v| v.is_finite())
+        Vehicle::is_finite(self)
     }
 
     fn save(&self) -> Result<Vec<u8>, SnapshotError> {

@@ -4,7 +4,7 @@
 use super::packet::{self, MAX_PWM, PacketError, ServoFrame};
 use super::reply::{self, State};
 use crate::config::AutopilotVehicle;
-use crate::kinematics::{attitude_ned, enu_to_ned, flu_to_frd};
+use crate::kinematics::{attitude_ned, flu_to_frd};
 use crate::speed::SpeedLog;
 use crate::stats::us_per;
 use crate::track::SessionTrack;
@@ -311,18 +311,18 @@ impl Session {
         self.time_us += step_us;
         let dt = step_us as f64 * 1e-6;
         self.quad.step(dt);
-        let imu = self.sensors.sample_imu(&self.quad.kinematics(), dt);
+        let k = self.quad.kinematics();
+        let imu = self.sensors.sample_imu(&k, dt);
         self.stats.steps += 1;
         self.stats.physics += start.elapsed();
         self.speed.observe(self.time_us);
-        let b = &self.quad.body;
-        let q = attitude_ned(&self.quad.attitude());
+        let q = attitude_ned(&k.attitude);
         let state = State {
             timestamp: self.time_us as f64 / 1e6,
             gyro: imu.gyro.into(),
             accel_body: imu.accel.into(),
-            position: enu_to_ned(&b.position).into(),
-            velocity: enu_to_ned(&b.velocity).into(),
+            position: k.position_ned().into(),
+            velocity: k.velocity_ned().into(),
             quaternion: [q.w, q.i, q.j, q.k],
         };
         if !reply::is_finite(&state) {
