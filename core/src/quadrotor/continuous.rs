@@ -110,7 +110,7 @@ impl Quadrotor {
             self.frame(),
             &self.body,
             &self.command(),
-            &self.wind_velocity(),
+            &self.surroundings(),
         )
     }
 
@@ -187,7 +187,7 @@ mod tests {
             quad.frame(),
             &quad.body,
             &quad.command(),
-            &quad.wind_velocity(),
+            &quad.surroundings(),
         );
         assert_eq!(d[..3], [0.3, 0.1, -0.4]);
         assert_eq!(d[3..6], *core.acceleration.as_slice());

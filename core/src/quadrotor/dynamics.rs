@@ -189,18 +189,35 @@ macro_rules! by_size {
     };
 }
 
-/// The state derivative for motor commands `command` (in [0, 1]) and air velocity `wind`,
+/// What acts on a vehicle from outside, held over a step: the wind, and a push (an
+/// acceleration: force / mass) from other bodies — a neighbour's contact or downwash in a
+/// world. A vehicle alone has no push, and then none of its arithmetic is done.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Surroundings {
+    /// Air velocity, world ENU, m/s.
+    pub wind: Vector3<f64>,
+    /// Acceleration from outside forces, world ENU, m/s²; `None` when nothing pushes.
+    pub push: Option<Vector3<f64>>,
+}
+
+impl From<Vector3<f64>> for Surroundings {
+    fn from(wind: Vector3<f64>) -> Self {
+        Surroundings { wind, push: None }
+    }
+}
+
+/// The state derivative for motor commands `command` (in [0, 1]) and surroundings `air`,
 /// ground contact included: a pure function of the state.
 pub fn derivatives(
     params: &QuadrotorParams,
     frame: &Frame,
     state: &BodyState,
     command: &Motors,
-    wind: &Vector3<f64>,
+    air: &Surroundings,
 ) -> Derivative {
     by_size!(
         frame.rotor_count(),
-        derivatives_sized(params, frame, state, command, wind)
+        derivatives_sized(params, frame, state, command, air)
     )
 }
 
@@ -209,9 +226,9 @@ fn derivatives_sized<const L: usize, const C: usize>(
     frame: &Frame,
     state: &BodyState,
     command: &Motors,
-    wind: &Vector3<f64>,
+    air: &Surroundings,
 ) -> Derivative {
-    let d = derivative_sized::<L, C>(params, frame, state, command, wind);
+    let d = derivative_sized::<L, C>(params, frame, state, command, air);
     let n = frame.rotor_count();
     let s = &d[L..];
     let mut motor_rates = Motors::zeros(n);
@@ -261,9 +278,9 @@ pub fn derivative_vector(
     frame: &Frame,
     state: &BodyState,
     command: &Motors,
-    wind: &Vector3<f64>,
+    air: &Surroundings,
 ) -> Vec<f64> {
-    derivatives(params, frame, state, command, wind).to_vec()
+    derivatives(params, frame, state, command, air).to_vec()
 }
 
 fn derivative_sized<const L: usize, const C: usize>(
@@ -271,7 +288,7 @@ fn derivative_sized<const L: usize, const C: usize>(
     frame: &Frame,
     state: &BodyState,
     command: &Motors,
-    wind: &Vector3<f64>,
+    air: &Surroundings,
 ) -> [f64; C] {
     let k = Constants::new(params, frame);
     let c = Coefficients {
@@ -286,11 +303,11 @@ fn derivative_sized<const L: usize, const C: usize>(
             &Gear::new(params),
             &flatten_contact::<L, C>(state),
             command,
-            wind,
+            air,
         )
     } else {
         let mut d = [0.0; C];
-        d[..L].copy_from_slice(&rates::<L>(params, &c, &flatten::<L>(state), command, wind));
+        d[..L].copy_from_slice(&rates::<L>(params, &c, &flatten::<L>(state), command, air));
         d
     }
 }
@@ -359,14 +376,14 @@ fn rates<const L: usize>(
     c: &Coefficients,
     x: &[f64; L],
     command: &[f64; MAX_ROTORS],
-    wind: &Vector3<f64>,
+    air: &Surroundings,
 ) -> [f64; L] {
     let (thrust, torque) = if L == BODY + 4 && c.mixing.quad_x_terms {
         quad_x_sums(c, x)
     } else {
         rotor_sums(c, x)
     };
-    let [ax, ay, az] = acceleration(c, x, thrust, wind);
+    let [ax, ay, az] = acceleration(c, x, thrust, air);
     let [alpha_x, alpha_y, alpha_z] = angular_acceleration(p, c, x, torque);
     let [dqw, dqx, dqy, dqz] = attitude_rate(x);
     let mut d = [0.0; L];
@@ -411,9 +428,11 @@ fn quad_x_sums<const L: usize>(c: &Coefficients, x: &[f64; L]) -> (f64, [f64; 3]
 }
 
 /// Acceleration (world) of a flat state with `thrust` (the thrust sum: acceleration along
-/// body z): thrust, gravity, quadratic drag on the air-relative velocity.
+/// body z): thrust, gravity, quadratic drag on the air-relative velocity, and the push from
+/// outside when there is one.
 #[inline(always)]
-fn acceleration(c: &Coefficients, x: &[f64], thrust: f64, wind: &Vector3<f64>) -> [f64; 3] {
+fn acceleration(c: &Coefficients, x: &[f64], thrust: f64, air: &Surroundings) -> [f64; 3] {
+    let wind = &air.wind;
     let (vx, vy, vz) = (x[3], x[4], x[5]);
     let (qw, qx, qy, qz) = (x[6], x[7], x[8], x[9]);
     let (bx, by, bz) = (
@@ -423,11 +442,18 @@ fn acceleration(c: &Coefficients, x: &[f64], thrust: f64, wind: &Vector3<f64>) -
     );
     let (rx, ry, rz) = (vx - wind.x, vy - wind.y, vz - wind.z);
     let drag = -c.drag_per_mass * (rx * rx + ry * ry + rz * rz).sqrt();
-    [
+    let mut a = [
         bx * thrust + rx * drag,
         by * thrust + ry * drag,
         bz * thrust + rz * drag - c.gravity,
-    ]
+    ];
+    // Added only when present: a vehicle alone runs exactly the operations it always ran.
+    if let Some(push) = &air.push {
+        a[0] += push.x;
+        a[1] += push.y;
+        a[2] += push.z;
+    }
+    a
 }
 
 /// Angular acceleration (body) of a flat state with the rotors' `torque` (body, N·m):
@@ -481,12 +507,12 @@ fn contact_rates<const L: usize, const C: usize>(
     gear: &Gear,
     x: &[f64; C],
     command: &[f64; MAX_ROTORS],
-    wind: &Vector3<f64>,
+    air: &Surroundings,
 ) -> [f64; C] {
     let mut body = [0.0; L];
     body.copy_from_slice(&x[..L]);
     let mut d = [0.0; C];
-    d[..L].copy_from_slice(&rates::<L>(p, c, &body, command, wind));
+    d[..L].copy_from_slice(&rates::<L>(p, c, &body, command, air));
     gear.add_rates(x, &mut d);
     d
 }
@@ -529,7 +555,7 @@ fn rk4<const N: usize>(x: &[f64; N], h: f64, f: impl Fn(&[f64; N]) -> [f64; N]) 
     out
 }
 
-/// Advances `state` by `dt` under constant `command` and `wind`, in ceil(dt / max_substep)
+/// Advances `state` by `dt` under constant `command` and surroundings `air`, in ceil(dt / max_substep)
 /// equal RK4 substeps — ceil(dt / min(max_substep, contact_substep)) when a foot may touch
 /// the ground during the step.
 pub fn integrate(
@@ -537,11 +563,11 @@ pub fn integrate(
     frame: &Frame,
     state: &mut BodyState,
     command: &Motors,
-    wind: &Vector3<f64>,
+    air: &Surroundings,
     dt: f64,
 ) {
     let k = Constants::new(params, frame);
-    integrate_with(params, frame, &k, state, command, wind, dt);
+    integrate_with(params, frame, &k, state, command, air, dt);
 }
 
 /// [`integrate`] with the [`Constants`] of `params` on `frame` computed already.
@@ -551,7 +577,7 @@ pub fn integrate_with(
     k: &Constants,
     state: &mut BodyState,
     command: &Motors,
-    wind: &Vector3<f64>,
+    air: &Surroundings,
     dt: f64,
 ) {
     let c = Coefficients {
@@ -560,7 +586,7 @@ pub fn integrate_with(
     };
     by_size!(
         frame.rotor_count(),
-        integrate_sized(params, &c, state, command, wind, dt)
+        integrate_sized(params, &c, state, command, air, dt)
     )
 }
 
@@ -570,15 +596,15 @@ fn integrate_sized<const L: usize, const C: usize>(
     c: &Coefficients,
     state: &mut BodyState,
     command: &Motors,
-    wind: &Vector3<f64>,
+    air: &Surroundings,
     dt: f64,
 ) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx") {
         // SAFETY: the CPU supports AVX, checked just above.
-        return unsafe { integrate_avx::<L, C>(params, c, state, command, wind, dt) };
+        return unsafe { integrate_avx::<L, C>(params, c, state, command, air, dt) };
     }
-    integrate_portable::<L, C>(params, c, state, command, wind, dt)
+    integrate_portable::<L, C>(params, c, state, command, air, dt)
 }
 
 /// [`integrate`] compiled with AVX's three-operand instructions: a third fewer instructions
@@ -591,10 +617,10 @@ fn integrate_avx<const L: usize, const C: usize>(
     c: &Coefficients,
     state: &mut BodyState,
     command: &Motors,
-    wind: &Vector3<f64>,
+    air: &Surroundings,
     dt: f64,
 ) {
-    integrate_portable::<L, C>(params, c, state, command, wind, dt)
+    integrate_portable::<L, C>(params, c, state, command, air, dt)
 }
 
 /// ceil(dt / max_substep), at least 1. A ratio within 1e-9 (relative) above a whole number
@@ -617,14 +643,16 @@ fn may_touch(
     p: &QuadrotorParams,
     c: &Coefficients,
     s: &BodyState,
-    wind: &Vector3<f64>,
+    air: &Surroundings,
     dt: f64,
 ) -> bool {
     let v = &s.velocity;
     let thrust_and_gravity = c.gravity + c.full_thrust_per_mass;
     let speed = v.x.abs() + v.y.abs() + v.z.abs() + thrust_and_gravity * dt;
-    let air = speed + wind.x.abs() + wind.y.abs() + wind.z.abs();
-    let acceleration = thrust_and_gravity + c.drag_per_mass * air * air;
+    let wind = &air.wind;
+    let air_speed = speed + wind.x.abs() + wind.y.abs() + wind.z.abs();
+    let push = air.push.map_or(0.0, |p| p.x.abs() + p.y.abs() + p.z.abs());
+    let acceleration = thrust_and_gravity + push + c.drag_per_mass * air_speed * air_speed;
     s.position.z - speed * dt - acceleration * dt * dt < gear_reach(p)
 }
 
@@ -634,18 +662,18 @@ fn integrate_portable<const L: usize, const C: usize>(
     c: &Coefficients,
     state: &mut BodyState,
     command: &Motors,
-    wind: &Vector3<f64>,
+    air: &Surroundings,
     dt: f64,
 ) {
     let command = command.padded();
-    if params.ground_enabled && may_touch(params, c, state, wind, dt) {
+    if params.ground_enabled && may_touch(params, c, state, air, dt) {
         let gear = Gear::new(params);
         let substeps = substep_count(dt, params.max_substep.min(params.contact_substep));
         let h = if substeps == 1.0 { dt } else { dt / substeps };
         let mut x = flatten_contact::<L, C>(state);
         for _ in 0..substeps as u64 {
             x = rk4(&x, h, |y| {
-                contact_rates::<L, C>(params, c, &gear, y, command, wind)
+                contact_rates::<L, C>(params, c, &gear, y, command, air)
             });
             gear.release_lifted_feet(&mut x);
         }
@@ -656,7 +684,7 @@ fn integrate_portable<const L: usize, const C: usize>(
     let h = if substeps == 1.0 { dt } else { dt / substeps };
     let mut x = flatten::<L>(state);
     for _ in 0..substeps as u64 {
-        x = rk4(&x, h, |y| rates::<L>(params, c, y, command, wind));
+        x = rk4(&x, h, |y| rates::<L>(params, c, y, command, air));
     }
     unflatten_into(&x, state);
     // No foot reached the ground: every bristle is released.
@@ -670,9 +698,9 @@ pub fn accelerations(
     frame: &Frame,
     state: &BodyState,
     command: &Motors,
-    wind: &Vector3<f64>,
+    air: &Surroundings,
 ) -> (Vector3<f64>, Vector3<f64>) {
-    let d = derivatives(params, frame, state, command, wind);
+    let d = derivatives(params, frame, state, command, air);
     (d.acceleration, d.angular_acceleration)
 }
 
@@ -704,7 +732,7 @@ mod tests {
                 motors: Motors::from_slice(&motors).unwrap(),
                 ..BodyState::at_rest(Vector3::new(0.0, 0.0, 5.0), 0.0, 0.0, 0.0, 0.0)
             };
-            let d = derivatives(&p, &frame, &state, &command, &Vector3::zeros());
+            let d = derivatives(&p, &frame, &state, &command, &Surroundings::default());
             let mut torque = Vector3::zeros();
             let mut thrust = 0.0;
             for (r, m) in frame.rotors().iter().zip(&motors) {
@@ -783,9 +811,11 @@ mod tests {
             let m = 0.3 + 0.4 * ((i % 7) as f64 / 7.0);
             let command = Motors::from([m, 0.9 - m, 0.5, 0.45]);
             let dt = if i % 3 == 0 { 0.025 } else { 0.01 };
-            integrate_portable::<17, 25>(&p, &c, &mut a, &command, &wind, dt);
+            integrate_portable::<17, 25>(&p, &c, &mut a, &command, &Surroundings::from(wind), dt);
             // SAFETY: AVX support was checked at the top of the test.
-            unsafe { integrate_avx::<17, 25>(&p, &c, &mut b, &command, &wind, dt) };
+            unsafe {
+                integrate_avx::<17, 25>(&p, &c, &mut b, &command, &Surroundings::from(wind), dt)
+            };
         }
         let bits = |s: &BodyState| flatten_contact::<17, 25>(s).map(f64::to_bits);
         assert_eq!(bits(&a), bits(&b));
@@ -799,9 +829,11 @@ mod tests {
         let (mut a, mut b) = (touchdown, touchdown);
         let low = Motors::from([0.1; 4]);
         for _ in 0..200 {
-            integrate_portable::<17, 25>(&p, &c, &mut a, &low, &wind, 0.01);
+            integrate_portable::<17, 25>(&p, &c, &mut a, &low, &Surroundings::from(wind), 0.01);
             // SAFETY: AVX support was checked at the top of the test.
-            unsafe { integrate_avx::<17, 25>(&p, &c, &mut b, &low, &wind, 0.01) };
+            unsafe {
+                integrate_avx::<17, 25>(&p, &c, &mut b, &low, &Surroundings::from(wind), 0.01)
+            };
         }
         assert_eq!(bits(&a), bits(&b));
         assert!(a.position.z < 0.1, "{}", a.position.z);
@@ -832,7 +864,7 @@ mod tests {
         let f = Frame::quad_x();
         let command = Motors::from([0.5, 0.45, 0.55, 0.5]);
         for _ in 0..100_000 {
-            integrate(&p, &f, &mut s, &command, &Vector3::zeros(), 0.01);
+            integrate(&p, &f, &mut s, &command, &Surroundings::default(), 0.01);
         }
         assert!(
             (s.attitude.norm() - 1.0).abs() < 1e-14,
@@ -845,7 +877,7 @@ mod tests {
             &f,
             &mut s,
             &Motors::from([0.5; 4]),
-            &Vector3::zeros(),
+            &Surroundings::default(),
             0.01,
         );
         assert!(

@@ -2,7 +2,7 @@
 //! an FMU instance or a SITL vehicle holds.
 
 use super::contact::{foot_heights, rest_height};
-use super::dynamics::{ConstantsCache, accelerations, integrate_with};
+use super::dynamics::{ConstantsCache, Surroundings, accelerations, integrate_with};
 use super::frame::Frame;
 use super::params::{QuadrotorInitial, QuadrotorParams};
 use super::state::{BodyState, Motors, WindState};
@@ -23,8 +23,13 @@ pub struct Quadrotor {
     frame: Frame,
     pub body: BodyState,
     pub wind: WindState,
-    /// Wind added from outside (the FMU's wind input), world ENU, m/s.
+    /// Wind added from outside (the FMU's wind input, a world's wind field), world ENU, m/s.
     pub external_wind: Vector3<f64>,
+    /// Force from outside the vehicle (a world's contact between vehicles and downwash),
+    /// world ENU, N, held until changed. Not saved with the vehicle: whoever applies it (the
+    /// world) keeps and saves it, and sets it again after a restore.
+    #[serde(skip)]
+    pub external_force: Vector3<f64>,
     /// Motor commands in [0, 1], one per rotor, held until changed.
     command: Motors,
     /// Time since the last point of the physics grid, s, in [0, max_substep): 0 after any
@@ -53,6 +58,7 @@ impl Quadrotor {
             body,
             wind,
             external_wind: Vector3::zeros(),
+            external_force: Vector3::zeros(),
             command: Motors::from([0.0; 4]),
             grid_phase: 0.0,
             rng,
@@ -110,6 +116,7 @@ impl Quadrotor {
         self.command = Motors::uniform(n, body.motors[0].clamp(0.0, 1.0)).unwrap_or(self.command);
         self.body = body;
         self.external_wind = Vector3::zeros();
+        self.external_force = Vector3::zeros();
         self.grid_phase = 0.0;
         self.rng = rng;
         self.ou_cache = OuCache::default();
@@ -205,7 +212,7 @@ impl Quadrotor {
                     at_sample = true;
                 }
             }
-            let wind = self.wind_velocity();
+            let air = self.surroundings();
             let constants = self.constants.get(&self.params, &self.frame);
             integrate_with(
                 &self.params,
@@ -213,7 +220,7 @@ impl Quadrotor {
                 constants,
                 &mut self.body,
                 &self.command,
-                &wind,
+                &air,
                 piece,
             );
             self.grid_phase = if at_grid {
@@ -247,6 +254,16 @@ impl Quadrotor {
         self.wind.velocity() + self.external_wind
     }
 
+    /// The wind at the vehicle and the push of the external force (none when it is zero).
+    pub fn surroundings(&self) -> Surroundings {
+        let f = &self.external_force;
+        let push = (*f != Vector3::zeros()).then(|| f / self.params.mass);
+        Surroundings {
+            wind: self.wind_velocity(),
+            push,
+        }
+    }
+
     /// Velocity relative to the air (the vehicle's minus the wind's), world ENU, m/s.
     pub fn air_velocity(&self) -> Vector3<f64> {
         self.body.velocity - self.wind_velocity()
@@ -270,7 +287,7 @@ impl Quadrotor {
             &self.frame,
             &self.body,
             &self.command,
-            &self.wind_velocity(),
+            &self.surroundings(),
         )
     }
 
