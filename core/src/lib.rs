@@ -35,6 +35,7 @@ pub mod snapshot;
 pub mod tasks;
 pub mod variables;
 pub mod vehicle;
+pub mod world;
 
 pub use error::{CommandError, InputError, ParamError, Role};
 pub use params::{ParamSpec, Parameters, ValueKind};

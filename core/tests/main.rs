@@ -17,3 +17,4 @@ mod quadrotor_rates;
 mod quadrotor_tasks;
 mod quadrotor_wind_grid;
 mod trace_hash;
+mod world;

@@ -83,6 +83,14 @@ impl Quadrotor {
         &self.frame
     }
 
+    /// Total rotor thrust now, N: Σ kᵢ mᵢ² over the motor states.
+    pub fn thrust(&self) -> f64 {
+        let k = self.params.thrust_coefficient;
+        (self.frame.rotors().iter().zip(self.body.motors.iter()))
+            .map(|(r, m)| r.thrust_coefficient.unwrap_or(k) * m * m)
+            .sum()
+    }
+
     /// Motor state at which every rotor at the same state carries the weight: √(m g / Σ kᵢ)
     /// (the quad X's is [`QuadrotorParams::hover_motor_state`]). `None` when no motor state
     /// in [0, 1] can hover.
