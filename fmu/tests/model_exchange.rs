@@ -112,7 +112,7 @@ fn derivatives_are_the_cores_right_hand_side_bit_for_bit() {
         quad.frame(),
         &quad.body,
         &quad.command(),
-        &quad.wind_velocity(),
+        &quad.surroundings(),
     );
     let fmu_dx = derivatives(&fmu);
     assert_eq!(
