@@ -100,6 +100,8 @@ pub struct World {
     rng: SimRng,
     #[serde(skip)]
     reach: f64,
+    #[serde(skip)]
+    columns: broad_phase::Columns,
 }
 
 impl World {
@@ -144,6 +146,7 @@ impl World {
             grid_phase: 0.0,
             rng,
             reach: 0.0,
+            columns: broad_phase::Columns::default(),
         };
         world.reach = world.interaction_reach();
         world.check_apart()?;
@@ -328,40 +331,51 @@ impl World {
             return;
         }
         let time = self.time();
+        let bodies: Vec<Body> = (self.vehicles.iter())
+            .map(|v| Body {
+                position: v.body.position,
+                velocity: v.body.velocity,
+                thrust_ratio: v.thrust() / (v.params.mass * v.params.gravity),
+            })
+            .collect();
         let mut touching = Vec::new();
-        let pairs = broad_phase::candidate_pairs(&self.horizontal_positions(), self.reach);
-        for (i, j) in pairs {
-            let (i, j) = (i as usize, j as usize);
-            let (a, b) = (&self.vehicles[i], &self.vehicles[j]);
-            let (pa, pb) = (&a.body.position, &b.body.position);
-            let (va, vb) = (&a.body.velocity, &b.body.velocity);
-            if p.collisions_enabled {
-                let on_a = contact_force(p, (pa, va, &self.shapes[i]), (pb, vb, &self.shapes[j]));
+        let xy = self.horizontal_positions();
+        for (i, j) in self.columns.candidate_pairs(&xy, self.reach) {
+            let (i, j) = (i.min(j) as usize, i.max(j) as usize);
+            let (a, b) = (&bodies[i], &bodies[j]);
+            let (sa, sb) = (&self.shapes[i], &self.shapes[j]);
+            let offset = a.position - b.position;
+            let hulls = sa.hull_radius + sb.hull_radius;
+            if p.collisions_enabled && offset.norm_squared() < hulls * hulls {
+                let on_a = contact_force(
+                    p,
+                    (&a.position, &a.velocity, sa),
+                    (&b.position, &b.velocity, sb),
+                );
                 if let Some(f) = on_a {
                     self.forces[i] += f;
                     self.forces[j] -= f;
                     touching.push((i, j));
                     if self.touching.binary_search(&(i, j)).is_err() {
-                        let normal = (pa - pb).try_normalize(1e-12).unwrap_or(Vector3::z());
+                        let normal = offset.try_normalize(1e-12).unwrap_or(Vector3::z());
                         self.collisions.push(Collision {
                             time,
                             a: i,
                             b: j,
-                            speed: -(va - vb).dot(&normal),
+                            speed: -(a.velocity - b.velocity).dot(&normal),
                         });
                     }
                 }
             }
-            if p.downwash_enabled {
-                let off_axis = (pa.xy() - pb.xy()).norm();
-                let (upper, lower) = if pa.z > pb.z { (i, j) } else { (j, i) };
-                let below = (pa.z - pb.z).abs();
-                let u = &self.vehicles[upper];
-                let ratio = u.thrust() / (u.params.mass * u.params.gravity);
+            if p.downwash_enabled && offset.z != 0.0 {
+                let (upper, lower) = if offset.z > 0.0 { (i, j) } else { (j, i) };
+                let off_axis = offset.xy().norm();
                 let radius = self.shapes[upper].propeller_radius;
-                self.forces[lower].z -= downwash_force(p, below, off_axis, radius, ratio);
+                let ratio = bodies[upper].thrust_ratio;
+                self.forces[lower].z -= downwash_force(p, offset.z.abs(), off_axis, radius, ratio);
             }
         }
+        touching.sort_unstable();
         self.touching = touching;
     }
 
@@ -411,6 +425,14 @@ pub fn shape(params: &WorldParams, vehicle: &Quadrotor) -> Shape {
         hull_radius: farthest * arm + propeller_radius,
         propeller_radius,
     }
+}
+
+/// What the interactions read of a vehicle at a grid point.
+struct Body {
+    position: Vector3<f64>,
+    velocity: Vector3<f64>,
+    /// Rotor thrust / weight: 1 in a hover.
+    thrust_ratio: f64,
 }
 
 /// Format tag of a World snapshot.

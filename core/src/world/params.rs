@@ -52,7 +52,8 @@ pub struct WorldParams {
     pub downwash_spread: f64,
     /// Wake width offset (DW_COEFF_3), m. Default −0.11.
     pub downwash_offset: f64,
-    /// Deepest point of the wake below a vehicle, m. Default 5.
+    /// Deepest point of the wake below a vehicle, m. Default 3 (there the default quad's wake
+    /// pushes with 0.4 % of its weight).
     pub downwash_range: f64,
 }
 
@@ -77,7 +78,7 @@ impl Default for WorldParams {
             downwash_strength: 2267.18,
             downwash_spread: 0.16,
             downwash_offset: -0.11,
-            downwash_range: 5.0,
+            downwash_range: 3.0,
         }
     }
 }
