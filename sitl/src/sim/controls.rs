@@ -168,12 +168,13 @@ impl Sim {
         let Some(system_id) = self.vehicles.get(i).map(|v| v.system_id) else {
             return;
         };
-        let mut text = refusal.text(system_id);
-        tracing::debug!(%from, ?link, "{text}");
+        // The text is made only when it is logged or sent: a flood is mostly held back.
+        tracing::debug!(%from, ?link, "{}", refusal.text(system_id));
         let Some(held) = self.refusal_texts.take(from, now) else {
             self.stats.refusal_texts_held += 1;
             return;
         };
+        let mut text = refusal.text(system_id);
         if held > 0 {
             text.push_str(&format!(" ({held} more refused since, not answered)"));
         }
