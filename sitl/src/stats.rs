@@ -37,8 +37,16 @@ pub struct Stats {
     /// reply was sent again, nothing stepped.
     pub repeated_steps: u64,
     /// Lockstep commands for a step the vehicle is already past (a late duplicate, or a
-    /// step before its last reset): skipped, no reply.
+    /// step before its last reset): not stepped, answered by a STATUSTEXT.
     pub stale_controls: u64,
+    /// Lockstep mode: HIL_ACTUATOR_CONTROLS without the LOCKSTEP flag, not stepped.
+    pub unflagged_controls: u64,
+    /// HIL_ACTUATOR_CONTROLS on the ground-station link, not flown.
+    pub gcs_controls: u64,
+    /// STATUSTEXTs that answered refused controls.
+    pub refusal_texts: u64,
+    /// Refused controls left unanswered by the per-peer rate limit of those texts.
+    pub refusal_texts_held: u64,
     /// Wall time from a datagram's arrival to its reply being sent (controller link).
     pub busy: Duration,
     /// Of which in the handler (decoding, physics, encoding; no socket calls).
@@ -52,7 +60,7 @@ impl Stats {
         match e {
             FrameError::Truncated => self.truncated += 1,
             FrameError::BadCrc { .. } => self.bad_crc += 1,
-            FrameError::MavlinkV1 => self.mavlink1 += 1,
+            FrameError::MavlinkV1 { .. } => self.mavlink1 += 1,
             FrameError::UnknownMessage { .. } => self.unknown_message += 1,
             FrameError::Malformed { .. } => self.malformed += 1,
             FrameError::Garbage => self.garbage += 1,
@@ -70,6 +78,8 @@ impl Stats {
             + self.refused_controls
             + self.unknown_vehicle
             + self.refused_requests
+            + self.unflagged_controls
+            + self.gcs_controls
     }
 }
 
@@ -80,7 +90,8 @@ impl fmt::Display for Stats {
             "datagrams={} gcs_datagrams={} frames={} steps={} resets={} truncated={} bad_crc={} mavlink1={} \
              unknown_message={} malformed={} garbage={} refused_controls={} clamped_controls={} \
              unknown_vehicle={} ignored_messages={} refused_requests={} io_errors={} \
-             repeated_steps={} stale_controls={} \
+             repeated_steps={} stale_controls={} unflagged_controls={} gcs_controls={} \
+             refusal_texts={} refusal_texts_held={} \
              busy_us_per_datagram={:.2} handling_us_per_datagram={:.2} physics_us_per_step={:.2}",
             self.datagrams,
             self.gcs_datagrams,
@@ -101,6 +112,10 @@ impl fmt::Display for Stats {
             self.io_errors,
             self.repeated_steps,
             self.stale_controls,
+            self.unflagged_controls,
+            self.gcs_controls,
+            self.refusal_texts,
+            self.refusal_texts_held,
             us_per(self.busy, self.datagrams),
             us_per(self.handling, self.datagrams),
             us_per(self.physics, self.steps),

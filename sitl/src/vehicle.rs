@@ -38,9 +38,10 @@ pub struct Vehicle {
     pub frame_values: Vec<f32>,
     /// The lockstep step last done by a command that named it (its `time_usec`, ≠ 0), and
     /// the reply bytes sent for it: a repeat of that command gets them again (protocol §3).
-    /// Cleared by a reset.
+    /// A reset drops the reply but keeps the name, so a late copy of that command is not
+    /// taken for the new episode's first step.
     pub last_step: Option<u64>,
-    pub last_reply: Vec<u8>,
+    pub last_reply: Option<Vec<u8>>,
 }
 
 /// What one step did.
@@ -74,7 +75,7 @@ impl Vehicle {
             bounds,
             frame_values: Vec::new(),
             last_step: None,
-            last_reply: Vec::new(),
+            last_reply: None,
         };
         v.reset(seed)?;
         Ok(v)
@@ -91,8 +92,7 @@ impl Vehicle {
         self.seed = seed;
         self.last = FrameHeader::default();
         self.command = self.task.motors_off();
-        self.last_step = None;
-        self.last_reply.clear();
+        self.last_reply = None;
         Ok(())
     }
 

@@ -3,7 +3,7 @@
 //! frame of the common dialect, happens here.
 
 use mavlink::dialects::common::MavMessage;
-use mavlink::{MAVLinkV2MessageRaw, MavHeader, MavlinkVersion, Message};
+use mavlink::{MAVLinkV2MessageRaw, MavHeader, MavlinkVersion, Message, MessageData};
 
 const STX_V1: u8 = 0xFE;
 const STX_V2: u8 = 0xFD;
@@ -20,8 +20,10 @@ pub enum FrameError {
     Truncated,
     /// The checksum does not match.
     BadCrc { message_id: u32 },
-    /// A MAVLink 1 frame (this SITL speaks MAVLink 2 only).
-    MavlinkV1,
+    /// A MAVLink 1 frame (this SITL speaks MAVLink 2 only). `controls_from`: the sender's
+    /// system id when the frame is an intact HIL_ACTUATOR_CONTROLS (its checksum holds): a
+    /// client that forgot MAVLink 2 is told so rather than met with silence.
+    MavlinkV1 { controls_from: Option<u8> },
     /// A message id outside the common dialect.
     UnknownMessage { message_id: u32 },
     /// A known message whose payload does not decode (e.g. an enum value out of range), or
@@ -60,7 +62,7 @@ impl Iterator for Frames<'_> {
         let (result, used) = match first {
             STX_V2 => decode_v2(rest),
             STX_V1 => match rest.get(1).map(|&len| usize::from(len) + V1_OVERHEAD) {
-                Some(n) if n <= rest.len() => (Err(FrameError::MavlinkV1), Some(n)),
+                Some(n) if n <= rest.len() => (Err(v1_frame(&rest[..n])), Some(n)),
                 _ => (Err(FrameError::Truncated), None),
             },
             _ => (Err(FrameError::Garbage), None),
@@ -70,6 +72,23 @@ impl Iterator for Frames<'_> {
             None => &[],
         };
         Some(result)
+    }
+}
+
+/// The error for the whole MAVLink 1 frame `frame` (STX, len, seq, sysid, compid, msgid,
+/// payload, checksum): whether it is intact controls, and from whom.
+fn v1_frame(frame: &[u8]) -> FrameError {
+    use mavlink::dialects::common::HIL_ACTUATOR_CONTROLS_DATA;
+    let (id, crc_end) = (
+        HIL_ACTUATOR_CONTROLS_DATA::ID,
+        frame.len().saturating_sub(CHECKSUM),
+    );
+    let intact = frame.len() > 6
+        && u32::from(frame[5]) == id
+        && frame[crc_end..]
+            == mavlink::calculate_crc(&frame[1..crc_end], MavMessage::extra_crc(id)).to_le_bytes();
+    FrameError::MavlinkV1 {
+        controls_from: intact.then(|| frame[3]),
     }
 }
 
@@ -174,7 +193,7 @@ impl StreamDecoder {
                 .get(1)
                 .map(|&len| usize::from(len) + V1_OVERHEAD)
             {
-                Some(n) if n <= self.pending.len() => (Err(FrameError::MavlinkV1), Some(n)),
+                Some(n) if n <= self.pending.len() => (Err(v1_frame(&self.pending[..n])), Some(n)),
                 _ => (Err(FrameError::Truncated), None),
             }
         };
@@ -307,7 +326,12 @@ mod tests {
             got[1],
             Err(FrameError::UnknownMessage { message_id: 0xEEEE })
         );
-        assert_eq!(got[2], Err(FrameError::MavlinkV1));
+        assert_eq!(
+            got[2],
+            Err(FrameError::MavlinkV1 {
+                controls_from: None
+            })
+        );
         assert_eq!(got[3].as_ref().unwrap().message, controls());
         assert_eq!(
             collect(&good[..good.len() - 1]),

@@ -5,3 +5,4 @@
 mod handler_fuzz;
 mod lockstep_over_udp;
 mod lockstep_resend;
+mod refused_controls;

@@ -8,7 +8,7 @@ import math
 import random
 import struct
 
-from sitl_client import Client, decode_frame, mavlink2, of_type
+from sitl_client import Client, decode_frame, mavlink2, of_type, statustexts
 
 STEPS = 300
 JUNK_PER_STEP = 10
@@ -66,10 +66,12 @@ def test_malformed_datagrams_never_disturb_the_stepping_client(start_sitl, clien
         for _ in range(JUNK_PER_STEP):
             fuzzer.send_raw(next(junk))
         assert contents(client.step(motors(k))) == expected[k], f"step {k}"
-    # The fuzzer got answers only where one is due (refused NaN controls, vehicle 2 steps).
+    # The fuzzer got answers only where one is due: refused controls (NaN, unknown system
+    # ids; rate-limited texts) and vehicle 2's steps.
     answers = fuzzer.drain(0.5)
-    warnings = [m.text for m in of_type(answers, "STATUSTEXT")]
+    warnings = statustexts(answers)
     assert warnings and all("step refused" in t for t in warnings)
+    assert any("no such vehicle" in t for t in warnings)
     assert {m.get_srcSystem() for m in of_type(answers, "DEBUG_FLOAT_ARRAY")} == {2}
 
     assert sitl.stop() == 0
@@ -99,3 +101,20 @@ def test_a_nan_control_is_refused_with_a_statustext_and_no_step(start_sitl, clie
     assert decode_frame(client.step([0.5] * 4), 1).step == first.step + 1
     # Channels past the task's four are not used, so a NaN there is harmless.
     assert decode_frame(client.step([0.5] * 4 + [math.nan]), 1).step == first.step + 2
+
+
+def test_controls_in_mavlink_1_are_refused_with_a_statustext(start_sitl, client_for):
+    from pymavlink.dialects.v10 import common as mavlink1
+
+    sitl = start_sitl()
+    client = client_for(sitl)
+    mav = mavlink1.MAVLink(None, srcSystem=1)
+    v1 = mav.hil_actuator_controls_encode(10_000, [0.5] * 16, 0, 1).pack(mav)
+    assert v1[0] == 0xFE  # a MAVLink 1 frame, as pymavlink's mavutil sends by default
+    assert statustexts(client.exchange(v1)) == [
+        "system 1: controls in MAVLink 1, which this SITL does not read "
+        "(pymavlink: set MAVLINK20=1): step refused"
+    ]
+    assert sitl.stop() == 0
+    stats = sitl.stats()
+    assert (stats["mavlink1"], stats["steps"], stats["refusal_texts"]) == (1, 0, 1)

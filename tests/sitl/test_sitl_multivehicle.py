@@ -4,7 +4,7 @@ HIL_STATE_QUATERNION out of its replies."""
 
 from __future__ import annotations
 
-from sitl_client import decode_frame, mavlink2, of_type, seed_params
+from sitl_client import decode_frame, mavlink2, of_type, seed_params, statustexts
 
 N = 16
 
@@ -58,10 +58,15 @@ def test_a_reset_of_all_vehicles_gives_vehicle_k_seed_plus_k_minus_1(start_sitl,
     assert third.obs == single.obs and third.step == 0
 
 
-def test_controls_for_an_unknown_system_id_are_skipped(start_sitl, client_for):
+def test_controls_for_an_unknown_system_id_are_skipped_and_said_so(start_sitl, client_for):
     sitl = start_sitl("--vehicles", "2")
     client = client_for(sitl)
     msgs = batch_step(client, {7: [0.5] * 4, 2: [0.5] * 4})
-    assert [m.get_srcSystem() for m in msgs] == [2, 2]
+    # The SITL's own texts come from vehicle 1; vehicle 2 stepped.
+    assert [(m.get_type(), m.get_srcSystem()) for m in msgs if m.get_srcSystem() == 2] == [
+        ("HIL_STATE_QUATERNION", 2),
+        ("DEBUG_FLOAT_ARRAY", 2),
+    ]
+    assert statustexts(msgs) == ["system 7: no such vehicle (system ids 1..2): step refused"]
     assert sitl.stop() == 0
     assert sitl.stats()["unknown_vehicle"] == 1

@@ -9,19 +9,21 @@ use crate::pacer::Cadence;
 use crate::stats::Stats;
 use crate::telemetry;
 use crate::vehicle::Vehicle;
-use crate::wire::{self, Encoder, Incoming};
+use crate::wire::{self, Encoder, FrameError, Incoming};
 use flyloop_core::tasks::registry::{TaskConfig, TaskKind};
 
 use flyloop_core::ParamError;
-use mavlink::MavHeader;
-use mavlink::dialects::common::{
-    HIL_ACTUATOR_CONTROLS_DATA, HilActuatorControlsFlags, MavCmd, MavMessage, MavSeverity,
-};
+use mavlink::dialects::common::{MavCmd, MavMessage, MavSeverity};
 use std::net::SocketAddr;
 use std::time::{Duration, Instant};
 
 mod command_handler;
+mod controls;
 mod realtime;
+mod refusal;
+
+use refusal::{Refusal, TextBudget};
+pub use refusal::{TEXT_WINDOW, TEXTS_PER_WINDOW};
 
 /// How physics is paced.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -130,6 +132,8 @@ pub struct Sim {
     gcs_encoder: Encoder,
     peers: Vec<Peer>,
     next_text_id: u16,
+    /// The per-peer rate limit of the texts that answer refused controls.
+    refusal_texts: TextBudget,
     gcs_streams: GcsStreams,
     /// Messages for the ground station raised by events (failsafe, resets), sent by the server.
     pub gcs_outbox: Vec<u8>,
@@ -168,6 +172,7 @@ impl Sim {
             gcs_encoder: Encoder::default(),
             peers: Vec::new(),
             next_text_id: 1,
+            refusal_texts: TextBudget::default(),
             gcs_streams: GcsStreams::new(now),
             gcs_outbox: Vec::new(),
             controller_outbox: Vec::new(),
@@ -270,6 +275,14 @@ impl Sim {
                 Err(e) => {
                     self.stats.count_frame_error(e);
                     tracing::debug!(%from, ?link, error = ?e, "frame skipped");
+                    if let FrameError::MavlinkV1 {
+                        controls_from: Some(system_id),
+                    } = e
+                    {
+                        let i = self.vehicle_index(system_id).unwrap_or(0);
+                        let refusal = Refusal::MavlinkV1 { system_id };
+                        self.refuse(link, from, i, refusal, now, out);
+                    }
                 }
             }
         }
@@ -287,7 +300,11 @@ impl Sim {
         let Incoming { header, message } = incoming;
         match (&message, peer) {
             (MavMessage::HIL_ACTUATOR_CONTROLS(c), Some(p)) => {
-                self.on_controls(header, c, p, now, out)
+                self.on_controls(header, c, from, p, now, out)
+            }
+            (MavMessage::HIL_ACTUATOR_CONTROLS(_), None) => {
+                let i = self.vehicle_index(header.system_id).unwrap_or(0);
+                self.refuse(link, from, i, Refusal::GcsLink, now, out);
             }
             (MavMessage::COMMAND_LONG(c), _) => self.on_command(link, header, c, peer, out),
             (MavMessage::PARAM_REQUEST_LIST(m), _) => {
@@ -304,131 +321,6 @@ impl Sim {
                 tracing::debug!(%from, ?link, message = message_name(&message), "message ignored");
             }
         }
-    }
-
-    fn on_controls(
-        &mut self,
-        header: MavHeader,
-        c: &HIL_ACTUATOR_CONTROLS_DATA,
-        peer: usize,
-        now: Instant,
-        out: &mut Vec<u8>,
-    ) {
-        let Some(i) = self.vehicle_to_command(header.system_id, c, out) else {
-            return;
-        };
-        if !self.set_controls(i, &c.controls, out) {
-            return;
-        }
-        match self.options.mode {
-            Mode::Lockstep => self.lockstep_step(i, peer, c.time_usec, out),
-            Mode::Realtime => self.command_arrived(i, now),
-        }
-    }
-
-    /// The index of the vehicle `system_id` if these controls are a new command for it;
-    /// `None` for an unknown vehicle, and in lockstep for controls without the LOCKSTEP flag
-    /// or for a step already taken (its cached reply sent again, see
-    /// [`Self::repeated_or_stale`]).
-    fn vehicle_to_command(
-        &mut self,
-        system_id: u8,
-        c: &HIL_ACTUATOR_CONTROLS_DATA,
-        out: &mut Vec<u8>,
-    ) -> Option<usize> {
-        let Some(i) = self.vehicle_index(system_id) else {
-            self.stats.unknown_vehicle += 1;
-            tracing::debug!(system_id, "controls for an unknown system id skipped");
-            return None;
-        };
-        if self.options.mode == Mode::Realtime {
-            return Some(i);
-        }
-        let lockstep_flag = c
-            .flags
-            .contains(HilActuatorControlsFlags::HIL_ACTUATOR_CONTROLS_FLAGS_LOCKSTEP);
-        if !lockstep_flag {
-            self.stats.ignored_messages += 1;
-            tracing::debug!(
-                system_id,
-                "controls without the LOCKSTEP flag ignored in lockstep"
-            );
-            return None;
-        }
-        (!self.repeated_or_stale(i, c.time_usec, out)).then_some(i)
-    }
-
-    /// Sets vehicle `i`'s command (clamped into the action bounds, counted); a refused one
-    /// is counted and answered by a warning. Returns whether the command was set.
-    fn set_controls(&mut self, i: usize, controls: &[f32], out: &mut Vec<u8>) -> bool {
-        let system_id = self.vehicles[i].system_id;
-        match self.vehicles[i].set_controls(controls) {
-            Ok(report) => {
-                if report.clamped {
-                    self.stats.clamped_controls += 1;
-                    tracing::debug!(system_id, "controls clamped into the action bounds");
-                }
-                true
-            }
-            Err(e) => {
-                self.stats.refused_controls += 1;
-                tracing::debug!(system_id, error = %e, "controls refused");
-                let text = format!("vehicle {system_id}: {e}");
-                let warning = MavSeverity::MAV_SEVERITY_WARNING;
-                self.push_text(Link::Controller, out, i, warning, &text);
-                false
-            }
-        }
-    }
-
-    /// One lockstep step of vehicle `i`, answered to `peer`; the answer is kept for a
-    /// command naming `step` again (`step` 0 names none).
-    fn lockstep_step(&mut self, i: usize, peer: usize, step: u64, out: &mut Vec<u8>) {
-        let start = Instant::now();
-        self.vehicles[i].step();
-        self.stats.physics += start.elapsed();
-        self.stats.steps += 1;
-        let from = out.len();
-        self.push_vehicle_reply(i, peer, out);
-        self.record(i, &out[from..]);
-        let v = &mut self.vehicles[i];
-        v.last_step = (step != 0).then_some(step);
-        v.last_reply.clear();
-        if v.last_step.is_some() {
-            v.last_reply.extend_from_slice(&out[from..]);
-        }
-    }
-
-    /// Lockstep loss recovery (protocol §3) for a command naming a step (`time_usec` ≠ 0):
-    /// if it names the vehicle's last step, the reply cached for that step goes out again
-    /// (the first reply was lost, or the command arrived twice); else, at or below the
-    /// vehicle's clock, it is a late duplicate of an older step and is skipped. Returns
-    /// whether the command was handled so (false: a new step).
-    fn repeated_or_stale(&mut self, i: usize, step: u64, out: &mut Vec<u8>) -> bool {
-        let v = &self.vehicles[i];
-        if step == 0 {
-            return false;
-        }
-        if v.last_step == Some(step) {
-            self.stats.repeated_steps += 1;
-            out.extend_from_slice(&v.last_reply);
-            tracing::debug!(
-                system_id = v.system_id,
-                step,
-                "repeated step: cached reply sent again"
-            );
-        } else if step > v.clock_us {
-            return false;
-        } else {
-            self.stats.stale_controls += 1;
-            tracing::debug!(
-                system_id = v.system_id,
-                step,
-                clock_us = v.clock_us,
-                "controls for a step the vehicle is past skipped"
-            );
-        }
-        true
     }
 
     /// Appends vehicle `i`'s step (or reset) to the recording, if one is made; `reply`: the
