@@ -20,6 +20,7 @@
 pub mod broad_phase;
 pub mod interaction;
 pub mod params;
+mod trig;
 pub mod wind_field;
 
 pub use interaction::Shape;

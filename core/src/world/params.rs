@@ -33,7 +33,8 @@ pub struct WorldParams {
     /// Correlation length of the turbulence field, m: two points d apart see gusts
     /// correlated by exp(−d²/2ℓ²). Default 10.
     pub turbulence_correlation_length: f64,
-    /// Number of random Fourier modes of the turbulence field. Default 32.
+    /// Number of random Fourier modes of the turbulence field. Default 16 (each world's
+    /// correlation is the mean of 16 cosines: unbiased, rough to about ±0.25).
     pub turbulence_modes: u32,
     /// Vehicles collide (sphere hulls). Default true.
     pub collisions_enabled: bool,
@@ -69,7 +70,7 @@ impl Default for WorldParams {
             turbulence_vertical_ratio: 0.2,
             turbulence_dt: 0.01,
             turbulence_correlation_length: 10.0,
-            turbulence_modes: 32,
+            turbulence_modes: 16,
             collisions_enabled: true,
             contact_stiffness: 2000.0,
             contact_damping: 20.0,

@@ -11,6 +11,7 @@
 //! random-Fourier-feature form of a Gaussian-covariance field (Rahimi & Recht 2007).
 
 use super::params::WorldParams;
+use super::trig::sin_cos;
 use crate::rng::SimRng;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -62,7 +63,7 @@ impl WindField {
     pub fn at(&self, position: &Vector3<f64>) -> Vector3<f64> {
         let mut u = self.mean;
         for m in &self.modes {
-            let (s, c) = m.wave.dot(position).sin_cos();
+            let (s, c) = sin_cos(m.wave.dot(position));
             u += m.cos * c + m.sin * s;
         }
         u
