@@ -2,9 +2,14 @@
 //! reference, unit, causality, variability, start and range. The FMU writes its
 //! modelDescription.xml from it and dispatches get/set through it; the SITL serves it over
 //! the MAVLink parameter protocol.
+//!
+//! A table is built for a shape ([`VariableTable::Shape`]): a multirotor has one motor
+//! command and one motor state per rotor of its frame, so its [`Rows`] are made from the
+//! frame, and an FMU for another frame is the same code with another table.
 
 use crate::error::{InputError, ParamError, Role};
 use crate::params::{ParamSpec, Parameters, ValueKind};
+use std::borrow::Cow;
 
 /// FMI 2.0 causality.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -38,7 +43,8 @@ pub struct Variable {
     pub causality: Causality,
     pub variability: Variability,
     pub unit: &'static str,
-    pub description: &'static str,
+    /// Fixed text, or text made from the shape (a rotor's place in its frame).
+    pub description: Cow<'static, str>,
     /// Start value (inputs and parameters; FMI forbids one on continuous outputs).
     pub start: Option<f64>,
     pub min: Option<f64>,
@@ -70,7 +76,7 @@ pub fn parameter_variables<P: Parameters>(
             causality: Causality::Parameter,
             variability,
             unit: s.unit,
-            description: s.description,
+            description: Cow::Borrowed(s.description),
             start: Some((s.get)(&defaults)),
             min: (s.kind != ValueKind::Boolean).then_some(s.min),
             max: (s.kind != ValueKind::Boolean).then_some(s.max),
@@ -82,7 +88,7 @@ pub fn parameter_variables<P: Parameters>(
 pub struct InputRow<M> {
     pub name: &'static str,
     pub unit: &'static str,
-    pub description: &'static str,
+    pub description: Cow<'static, str>,
     /// Inclusive range; a value outside (or NaN) is refused with [`ParamError::OutOfRange`].
     pub min: f64,
     pub max: f64,
@@ -106,7 +112,7 @@ impl<M> InputRow<M> {
         InputRow {
             name,
             unit,
-            description,
+            description: Cow::Borrowed(description),
             min,
             max,
             start,
@@ -123,7 +129,7 @@ pub struct OutputRow<M> {
     /// Real, or Boolean for flags (read as 0 / 1).
     pub kind: ValueKind,
     pub unit: &'static str,
-    pub description: &'static str,
+    pub description: Cow<'static, str>,
     pub get: fn(&M) -> f64,
 }
 
@@ -139,7 +145,7 @@ impl<M> OutputRow<M> {
             name,
             kind: ValueKind::Real,
             unit,
-            description,
+            description: Cow::Borrowed(description),
             get,
         }
     }
@@ -150,34 +156,61 @@ impl<M> OutputRow<M> {
             name,
             kind: ValueKind::Boolean,
             unit: "",
-            description,
+            description: Cow::Borrowed(description),
             get,
         }
     }
 }
 
-/// A model with a variable table: inputs and outputs as rows, physical parameters and start
-/// values as [`Parameters`]. [`variables`], [`get`] and [`set`] serve every such model.
+// By hand: a row is cloneable whatever the model (derive would ask `M: Clone`).
+impl<M> Clone for InputRow<M> {
+    fn clone(&self) -> Self {
+        InputRow {
+            description: self.description.clone(),
+            ..*self
+        }
+    }
+}
+
+impl<M> Clone for OutputRow<M> {
+    fn clone(&self) -> Self {
+        OutputRow {
+            description: self.description.clone(),
+            ..*self
+        }
+    }
+}
+
+/// A model with a variable table: inputs and outputs as rows for its shape, physical
+/// parameters and start values as [`Parameters`]. [`Rows`] serves every such model.
 pub trait VariableTable: Sized + 'static {
     /// The physical parameters (value references from [`vr_block::PARAMETER`]).
     type Params: Parameters;
     /// The start values that are not physical parameters (from [`vr_block::INITIAL`]).
     type Initial: Parameters;
+    /// What sizes and names the rows: a multirotor's frame (one motor command and one motor
+    /// state per rotor); `()` for a model whose table is always the same.
+    type Shape;
+
     /// Inputs in value-reference order from [`vr_block::INPUT`].
-    const INPUTS: &'static [InputRow<Self>];
+    fn inputs(shape: &Self::Shape) -> Vec<InputRow<Self>>;
     /// Outputs in value-reference order from [`vr_block::OUTPUT`].
-    const OUTPUTS: &'static [OutputRow<Self>];
+    fn outputs(shape: &Self::Shape) -> Vec<OutputRow<Self>>;
+    /// The shape of this instance (its table is `Rows::of(model.shape())`).
+    fn shape(&self) -> &Self::Shape;
 
     fn params(&self) -> &Self::Params;
     /// Sets one physical parameter (range-checked; nothing changes when it is refused).
     fn set_parameter(&mut self, name: &'static str, value: f64) -> Result<(), ParamError>;
 }
 
-/// The row a value reference points at: what reads and writes the variable in the model.
+/// Where a value reference points in a table ([`Rows::row`]): an input or output by its
+/// position in the rows, or a parameter row. Plain data, so a front end can look it up once
+/// and read through it on every call.
 #[derive(Debug)]
 pub enum Row<M: VariableTable> {
-    Input(&'static InputRow<M>),
-    Output(&'static OutputRow<M>),
+    Input(usize),
+    Output(usize),
     Parameter(&'static ParamSpec<M::Params>),
     Initial(&'static ParamSpec<M::Initial>),
 }
@@ -190,42 +223,77 @@ impl<M: VariableTable> Clone for Row<M> {
 
 impl<M: VariableTable> Copy for Row<M> {}
 
-/// The row of value reference `vr` of `M`.
-pub fn row<M: VariableTable>(vr: u32) -> Result<Row<M>, ParamError> {
-    let unknown = ParamError::UnknownValueReference(vr);
-    let index = |first: u32| (vr - first) as usize;
-    Ok(if vr >= vr_block::INITIAL {
-        Row::Initial(parameter_at::<M::Initial>(vr, vr_block::INITIAL)?)
-    } else if vr >= vr_block::PARAMETER {
-        Row::Parameter(parameter_at::<M::Params>(vr, vr_block::PARAMETER)?)
-    } else if vr >= vr_block::OUTPUT {
-        Row::Output(M::OUTPUTS.get(index(vr_block::OUTPUT)).ok_or(unknown)?)
-    } else {
-        Row::Input(M::INPUTS.get(index(vr_block::INPUT)).ok_or(unknown)?)
-    })
+/// The variable table of `M` for one shape: its input and output rows (the parameter rows
+/// are `M`'s types). Built once per shape; lookups by value reference are index arithmetic.
+#[derive(Debug)]
+pub struct Rows<M> {
+    pub inputs: Vec<InputRow<M>>,
+    pub outputs: Vec<OutputRow<M>>,
 }
 
-impl<M: VariableTable> Row<M> {
-    /// The variable's value in `model` (start values from `initial`).
-    pub fn get(self, model: &M, initial: &M::Initial) -> f64 {
-        match self {
-            Row::Input(r) => (r.get)(model),
-            Row::Output(r) => (r.get)(model),
+impl<M: VariableTable> Rows<M> {
+    /// The table of `M` for `shape`.
+    pub fn of(shape: &M::Shape) -> Self {
+        Rows {
+            inputs: M::inputs(shape),
+            outputs: M::outputs(shape),
+        }
+    }
+
+    /// The table of `model`'s shape.
+    pub fn of_model(model: &M) -> Self {
+        Rows::of(model.shape())
+    }
+
+    /// The row of value reference `vr`.
+    pub fn row(&self, vr: u32) -> Result<Row<M>, ParamError> {
+        let unknown = ParamError::UnknownValueReference(vr);
+        let index = |first: u32| (vr - first) as usize;
+        Ok(if vr >= vr_block::INITIAL {
+            Row::Initial(parameter_at::<M::Initial>(vr, vr_block::INITIAL)?)
+        } else if vr >= vr_block::PARAMETER {
+            Row::Parameter(parameter_at::<M::Params>(vr, vr_block::PARAMETER)?)
+        } else if vr >= vr_block::OUTPUT {
+            let at = index(vr_block::OUTPUT);
+            (at < self.outputs.len())
+                .then_some(Row::Output(at))
+                .ok_or(unknown)?
+        } else {
+            let at = index(vr_block::INPUT);
+            (at < self.inputs.len())
+                .then_some(Row::Input(at))
+                .ok_or(unknown)?
+        })
+    }
+
+    /// The value behind `row` in `model` (start values from `initial`).
+    ///
+    /// # Panics
+    /// If `row` is not one of this table's ([`Rows::row`] of another shape).
+    pub fn get_at(&self, row: Row<M>, model: &M, initial: &M::Initial) -> f64 {
+        match row {
+            Row::Input(at) => (self.inputs[at].get)(model),
+            Row::Output(at) => (self.outputs[at].get)(model),
             Row::Parameter(spec) => (spec.get)(model.params()),
             Row::Initial(spec) => (spec.get)(initial),
         }
     }
 
-    /// Writes the variable; the value is checked against its range and nothing changes when
-    /// it is refused. Outputs cannot be set.
-    pub fn set(
-        self,
+    /// Writes the value behind `row`; it is checked against its range and nothing changes
+    /// when it is refused. Outputs cannot be set.
+    ///
+    /// # Panics
+    /// If `row` is not one of this table's ([`Rows::row`] of another shape).
+    pub fn set_at(
+        &self,
+        row: Row<M>,
         model: &mut M,
         initial: &mut M::Initial,
         value: f64,
     ) -> Result<(), ParamError> {
-        match self {
-            Row::Input(r) => {
+        match row {
+            Row::Input(at) => {
+                let r = &self.inputs[at];
                 let out_of_range = ParamError::OutOfRange {
                     role: Role::Input,
                     name: r.name,
@@ -239,34 +307,43 @@ impl<M: VariableTable> Row<M> {
                 }
                 (r.set)(model, value).map_err(|_| out_of_range)
             }
-            Row::Output(r) => Err(ParamError::NotSettable(r.name)),
+            Row::Output(at) => Err(ParamError::NotSettable(self.outputs[at].name)),
             Row::Parameter(spec) => model.set_parameter(spec.name, value),
             Row::Initial(spec) => initial.set(spec.name, value),
         }
     }
-}
 
-/// Every variable of `M`, in value-reference order.
-pub fn variables<M: VariableTable>() -> Vec<Variable> {
-    let inputs = M::INPUTS
-        .iter()
-        .zip(vr_block::INPUT..)
-        .map(|(r, vr)| Variable {
+    /// Reads variable `vr` of `model` (start values from `initial`).
+    pub fn get(&self, model: &M, initial: &M::Initial, vr: u32) -> Result<f64, ParamError> {
+        Ok(self.get_at(self.row(vr)?, model, initial))
+    }
+
+    /// Writes variable `vr` (see [`Rows::set_at`]).
+    pub fn set(
+        &self,
+        model: &mut M,
+        initial: &mut M::Initial,
+        vr: u32,
+        value: f64,
+    ) -> Result<(), ParamError> {
+        self.set_at(self.row(vr)?, model, initial, value)
+    }
+
+    /// Every variable, in value-reference order.
+    pub fn variables(&self) -> Vec<Variable> {
+        let inputs = (self.inputs.iter().zip(vr_block::INPUT..)).map(|(r, vr)| Variable {
             name: r.name,
             value_reference: vr,
             kind: ValueKind::Real,
             causality: Causality::Input,
             variability: Variability::Continuous,
             unit: r.unit,
-            description: r.description,
+            description: r.description.clone(),
             start: Some(r.start),
             min: Some(r.min),
             max: Some(r.max),
         });
-    let outputs = M::OUTPUTS
-        .iter()
-        .zip(vr_block::OUTPUT..)
-        .map(|(r, vr)| Variable {
+        let outputs = (self.outputs.iter().zip(vr_block::OUTPUT..)).map(|(r, vr)| Variable {
             name: r.name,
             value_reference: vr,
             kind: r.kind,
@@ -277,37 +354,34 @@ pub fn variables<M: VariableTable>() -> Vec<Variable> {
                 Variability::Discrete
             },
             unit: r.unit,
-            description: r.description,
+            description: r.description.clone(),
             start: None,
             min: None,
             max: None,
         });
-    inputs
-        .chain(outputs)
-        .chain(parameter_variables::<M::Params>(
-            vr_block::PARAMETER,
-            Variability::Fixed,
-        ))
-        .chain(parameter_variables::<M::Initial>(
-            vr_block::INITIAL,
-            Variability::Fixed,
-        ))
-        .collect()
+        let fixed = Variability::Fixed;
+        inputs
+            .chain(outputs)
+            .chain(parameter_variables::<M::Params>(vr_block::PARAMETER, fixed))
+            .chain(parameter_variables::<M::Initial>(vr_block::INITIAL, fixed))
+            .collect()
+    }
 }
 
-/// Reads variable `vr` of `model` (start values from `initial`).
+/// Reads variable `vr` of `model` through the table of its shape (built for this one call:
+/// for many, build [`Rows`] once).
 pub fn get<M: VariableTable>(model: &M, initial: &M::Initial, vr: u32) -> Result<f64, ParamError> {
-    Ok(row::<M>(vr)?.get(model, initial))
+    Rows::of_model(model).get(model, initial, vr)
 }
 
-/// Writes variable `vr` (see [`Row::set`]).
+/// Writes variable `vr` of `model` (see [`get`], [`Rows::set_at`]).
 pub fn set<M: VariableTable>(
     model: &mut M,
     initial: &mut M::Initial,
     vr: u32,
     value: f64,
 ) -> Result<(), ParamError> {
-    row::<M>(vr)?.set(model, initial, value)
+    Rows::of_model(model).set(model, initial, vr, value)
 }
 
 /// Looks up the parameter row behind `vr` in a block that starts at `first_vr`.
@@ -337,10 +411,11 @@ pub(crate) fn assert_names_and_value_references_are_unique(vars: &[Variable]) {
     }
 }
 
-/// Test helper: the value reference of the variable `name` of `M`'s table.
+/// Test helper: the value reference of the variable `name` of `model`'s table.
 #[cfg(test)]
-pub(crate) fn value_reference<M: VariableTable>(name: &str) -> u32 {
-    variables::<M>()
+pub(crate) fn value_reference<M: VariableTable>(model: &M, name: &str) -> u32 {
+    Rows::of_model(model)
+        .variables()
         .into_iter()
         .find(|v| v.name == name)
         .unwrap_or_else(|| panic!("no variable {name}"))
@@ -357,7 +432,7 @@ pub(crate) fn assert_every_variable_reads<M: VariableTable>(
     initial: &M::Initial,
     inputs_read_start: bool,
 ) {
-    let vars = variables::<M>();
+    let vars = Rows::of_model(model).variables();
     assert_names_and_value_references_are_unique(&vars);
     for v in &vars {
         let value = get(model, initial, v.value_reference).unwrap();

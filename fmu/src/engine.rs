@@ -8,7 +8,7 @@ use crate::error::FmuError;
 use crate::model::{Access, FmuModel, Hybrid, Table};
 use crate::table::ModelTable;
 use flyloop_core::number::Compact;
-use flyloop_core::variables::{self, Causality, Variability};
+use flyloop_core::variables::{Causality, Variability};
 use flyloop_core::{SnapshotError, snapshot};
 use serde::{Deserialize, Serialize};
 
@@ -104,6 +104,8 @@ pub trait Simulation: std::fmt::Debug {
 
 #[derive(Debug)]
 pub struct Engine<M: FmuModel> {
+    /// The FMU's table: which FMU of the model this is.
+    table: &'static Table<M>,
     model: M,
     book: Book<M::Initial>,
 }
@@ -145,19 +147,21 @@ const STATE_TAG: &[u8; 8] = b"FLYFMI01";
 const STATE_NAME: &str = "flyloop FMU state";
 
 impl<M: FmuModel> Engine<M> {
-    /// The engine of `model`, which was just built from the default start values
-    /// (`M::build(None, &Default::default())`), boxed as an instance holds it.
-    pub fn boxed(model: M) -> Box<dyn Simulation> {
-        let book = Book::default();
-        Box::new(Engine { model, book })
+    /// A fresh simulation of the FMU with `table`, built from the default start values,
+    /// boxed as an instance holds it.
+    pub fn start(table: &'static Table<M>) -> Result<Box<dyn Simulation>, FmuError> {
+        let book = Book::<M::Initial>::default();
+        let model = M::build(&table.shape, None, &book.initial)?;
+        Ok(Box::new(Engine { table, model, book }))
     }
 
     /// Rebuilds the model from the start values, keeping the inputs set so far.
     fn rebuild(&mut self) -> Result<(), FmuError> {
         let book = &mut self.book;
-        let mut model = M::build(Some(&self.model), &book.initial)?;
+        let rows = &self.table.rows;
+        let mut model = M::build(&self.table.shape, Some(&self.model), &book.initial)?;
         for &(vr, value) in &book.early_inputs {
-            variables::set(&mut model, &mut book.initial, vr, value)?;
+            rows.set(&mut model, &mut book.initial, vr, value)?;
         }
         self.model = model;
         Ok(())
@@ -165,8 +169,8 @@ impl<M: FmuModel> Engine<M> {
 
     /// Fails unless the model has Model Exchange and the importer's array `name` of length
     /// `len` has one entry per continuous state (`ni`: per event indicator).
-    fn check_len(len: usize, name: &str) -> Result<(), FmuError> {
-        let table = &M::table().table;
+    fn check_len(&self, len: usize, name: &str) -> Result<(), FmuError> {
+        let table = &self.table.table;
         let me = table
             .model_exchange
             .as_ref()
@@ -185,9 +189,9 @@ impl<M: FmuModel> Engine<M> {
     }
 
     /// The stage code, book and model snapshot of state bytes of this model.
-    fn decode(bytes: &[u8]) -> Result<(u8, Body<M::Initial>), FmuError> {
+    fn decode(&self, bytes: &[u8]) -> Result<(u8, Body<M::Initial>), FmuError> {
         let record: Record = snapshot::decode(STATE_TAG, STATE_NAME, bytes)?;
-        let table = &M::table().table;
+        let table = &self.table.table;
         if record.guid != table.token(Api::Fmi2) {
             return Err(FmuError::InvalidArgument(format!(
                 "the FMU state belongs to a model with GUID {}, not to {} {}",
@@ -200,11 +204,25 @@ impl<M: FmuModel> Engine<M> {
             .map_err(|e| FmuError::State(SnapshotError::Decode(e.to_string())))?;
         Ok((record.stage, body))
     }
+
+    /// The model in a state's snapshot, which must have this FMU's shape (its GUID said so;
+    /// this checks what the model holds).
+    fn restore_model(&self, bytes: &[u8]) -> Result<M, FmuError> {
+        let model = M::restore(bytes)?;
+        if *model.shape() != self.table.shape {
+            return Err(FmuError::InvalidArgument(format!(
+                "the FMU state holds a model of another shape than {}'s ({:?})",
+                self.table.table.info.identifier,
+                model.shape()
+            )));
+        }
+        Ok(model)
+    }
 }
 
 impl<M: FmuModel> Simulation for Engine<M> {
     fn table(&self) -> &'static ModelTable {
-        &M::table().table
+        &self.table.table
     }
 
     fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> Result<(), FmuError> {
@@ -230,14 +248,20 @@ impl<M: FmuModel> Simulation for Engine<M> {
     }
 
     fn get(&self, index: usize) -> f64 {
-        match M::table().access[index] {
-            Access::Core(row) => row.get(&self.model, &self.book.initial),
+        let Table { rows, access, .. } = self.table;
+        match access[index] {
+            Access::Core(row) => rows.get_at(row, &self.model, &self.book.initial),
             Access::Local { read, at } => read(&self.model, at),
         }
     }
 
     fn set(&mut self, index: usize, value: f64, initialised: bool) -> Result<(), FmuError> {
-        let Table { table, access } = M::table();
+        let Table {
+            table,
+            rows,
+            access,
+            ..
+        } = self.table;
         let variable = &table.variables[index];
         let (name, vr) = (variable.name, variable.value_reference);
         match variable.causality {
@@ -258,7 +282,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
         let Access::Core(row) = access[index] else {
             return Err(FmuError::UnknownValueReference(vr));
         };
-        row.set(&mut self.model, &mut self.book.initial, value)?;
+        rows.set_at(row, &mut self.model, &mut self.book.initial, value)?;
         if !initialised {
             if variable.causality == Causality::Input {
                 self.book.early_inputs.retain(|&(v, _)| v != vr);
@@ -314,7 +338,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
 
     fn reset(&mut self) -> Result<(), FmuError> {
         let book = Book::<M::Initial>::default();
-        self.model = M::build(None, &book.initial)?;
+        self.model = M::build(&self.table.shape, None, &book.initial)?;
         self.book = book;
         Ok(())
     }
@@ -322,7 +346,7 @@ impl<M: FmuModel> Simulation for Engine<M> {
     fn save(&self, stage: u8) -> Result<Vec<u8>, FmuError> {
         let body: Body<M::Initial> = (self.book.clone(), self.model.save()?);
         let record = Record {
-            guid: M::table().table.token(Api::Fmi2).to_string(),
+            guid: self.table.table.token(Api::Fmi2).to_string(),
             stage,
             body: postcard::to_stdvec(&body)
                 .map_err(|e| FmuError::State(SnapshotError::Encode(e.to_string())))?,
@@ -331,15 +355,15 @@ impl<M: FmuModel> Simulation for Engine<M> {
     }
 
     fn check_saved(&self, bytes: &[u8]) -> Result<u8, FmuError> {
-        let (stage, (_, model)) = Self::decode(bytes)?;
-        M::restore(&model)?;
+        let (stage, (_, model)) = self.decode(bytes)?;
+        self.restore_model(&model)?;
         Ok(stage)
     }
 
     fn restore(&mut self, bytes: &[u8]) -> Result<u8, FmuError> {
-        let (stage, (book, model)) = Self::decode(bytes)?;
-        let model = M::restore(&model)?;
-        *self = Engine { model, book };
+        let (stage, (book, model)) = self.decode(bytes)?;
+        let model = self.restore_model(&model)?;
+        (self.model, self.book) = (model, book);
         Ok(stage)
     }
 
@@ -359,12 +383,12 @@ impl<M: FmuModel> Simulation for Engine<M> {
     }
 
     fn hybrid(&self, len: usize, name: &str) -> Result<&dyn Hybrid, FmuError> {
-        Self::check_len(len, name)?;
+        self.check_len(len, name)?;
         self.model.hybrid().ok_or_else(co_simulation_only)
     }
 
     fn hybrid_mut(&mut self, len: usize, name: &str) -> Result<&mut dyn Hybrid, FmuError> {
-        Self::check_len(len, name)?;
+        self.check_len(len, name)?;
         self.model.hybrid_mut().ok_or_else(co_simulation_only)
     }
 

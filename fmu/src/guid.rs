@@ -53,12 +53,12 @@ pub fn of_interface(api: Api, identifier: &str, variables: &[Variable]) -> Strin
 #[cfg(test)]
 mod tests {
     use super::*;
-    use flyloop_core::quadrotor::Quadrotor;
-    use flyloop_core::variables::variables;
+    use flyloop_core::quadrotor::{Frame, Quadrotor};
+    use flyloop_core::variables::Rows;
 
     #[test]
     fn guid_has_the_uuid_shape_and_follows_the_interface() {
-        let vars = variables::<Quadrotor>();
+        let vars = Rows::<Quadrotor>::of(&Frame::quad_x()).variables();
         let guid = of_interface(Api::Fmi2, "Quadrotor", &vars);
         assert_eq!(guid.len(), 38, "{guid}");
         assert!(guid.starts_with('{') && guid.ends_with('}'));
@@ -73,5 +73,9 @@ mod tests {
         let mut changed = vars.clone();
         changed[0].max = Some(2.0);
         assert_ne!(guid, of_interface(Api::Fmi2, "Quadrotor", &changed));
+        // Another frame is another interface (six motor commands and states).
+        let hexa = Frame::named("hexa_x").unwrap();
+        let hexa = Rows::<Quadrotor>::of(&hexa).variables();
+        assert_ne!(guid, of_interface(Api::Fmi2, "Quadrotor", &hexa));
     }
 }

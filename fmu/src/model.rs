@@ -1,12 +1,13 @@
 //! What the FMI layer needs from a model, and nothing about physics: [`FmuModel`] over the
-//! core's variable table, and the model's [`Table`]: the FMI table plus, at the same
-//! positions, the core rows that read and write each variable.
+//! core's variable table, and an FMU's [`Table`]: the model's shape (a multirotor's frame),
+//! the FMI table made for it plus, at the same positions, the core rows that read and write
+//! each variable. One model type serves as many FMUs as it has tables.
 
 use crate::error::FmuError;
 use crate::table::{ModelExchangeTable, ModelInfo, ModelTable};
 use flyloop_core::ParamError;
 use flyloop_core::SnapshotError;
-use flyloop_core::variables::{self, Row, Variable, VariableTable};
+use flyloop_core::variables::{Row, Rows, Variable, VariableTable};
 use std::fmt;
 
 /// How the FMU reaches a variable in the model.
@@ -21,39 +22,50 @@ pub enum Access<M: FmuModel> {
     },
 }
 
-/// A model's FMI table with the access to each of its variables, at the same positions.
+/// An FMU's table: the shape its instances have, the FMI table, the core's rows for that
+/// shape and the access to each variable, at the FMI table's positions.
 #[derive(Debug)]
 pub struct Table<M: FmuModel> {
+    pub shape: M::Shape,
     pub table: ModelTable,
+    pub rows: Rows<M>,
     pub access: Vec<Access<M>>,
 }
 
 impl<M: FmuModel> Table<M> {
-    /// The core's variables of `M`, then `locals`.
+    /// The core's variables of `M` for `shape` (`rows`), then `locals`.
     pub fn new(
-        info: &'static ModelInfo,
+        info: ModelInfo,
+        shape: M::Shape,
+        rows: Rows<M>,
         locals: Vec<(Variable, Access<M>)>,
         model_exchange: Option<ModelExchangeTable>,
     ) -> Self {
-        let core = variables::variables::<M>().into_iter().filter_map(|v| {
-            let row = variables::row::<M>(v.value_reference).ok()?;
+        let core = rows.variables().into_iter().filter_map(|v| {
+            let row = rows.row(v.value_reference).ok()?;
             Some((v, Access::Core(row)))
         });
         let (variables, access): (Vec<Variable>, Vec<Access<M>>) = core.chain(locals).unzip();
         Table {
+            shape,
             table: ModelTable::new(info, variables, model_exchange),
+            rows,
             access,
         }
     }
 }
 
 /// A model behind the FMU, over its core variable table.
-pub trait FmuModel: VariableTable<Initial: fmt::Debug, Params: fmt::Debug> + fmt::Debug {
-    fn table() -> &'static Table<Self>;
-
-    /// A fresh model from `initial`, with the physical parameters of `previous` (or the
-    /// defaults when there is none).
-    fn build(previous: Option<&Self>, initial: &Self::Initial) -> Result<Self, ParamError>;
+pub trait FmuModel:
+    VariableTable<Initial: fmt::Debug, Params: fmt::Debug, Shape: fmt::Debug + PartialEq> + fmt::Debug
+{
+    /// A fresh model of `shape` from `initial`, with the physical parameters of `previous`
+    /// (or the defaults when there is none).
+    fn build(
+        shape: &Self::Shape,
+        previous: Option<&Self>,
+        initial: &Self::Initial,
+    ) -> Result<Self, ParamError>;
 
     /// How many internal steps [`advance`](Self::advance) would take (to refuse steps that
     /// would run for hours).

@@ -123,7 +123,7 @@ impl Writer<'_> {
     /// The ids output `i` depends on: its elements' direct-feedthrough inputs and, under
     /// Model Exchange, the continuous states (none for a state itself, its own known).
     fn dependencies(&self, i: usize) -> String {
-        let (table, info) = (self.table, self.table.info);
+        let (table, info) = (self.table, &self.table.info);
         let mut vrs = Vec::new();
         for output in &table.variables[self.variables[i].elements()] {
             let feedthrough = info.direct_feedthrough.iter();
@@ -144,7 +144,7 @@ impl Writer<'_> {
     /// Everything before ModelVariables: the root element, ModelExchange and CoSimulation, the
     /// units, LogCategories and DefaultExperiment.
     fn header(&mut self) {
-        let (api, table, info) = (self.api, self.table, self.table.info);
+        let (api, table, info) = (self.api, self.table, &self.table.info);
         let n = self.me.event_indicators;
         let (version, token, events) = match api {
             Api::Fmi2 => ("2.0", "guid", format!(" numberOfEventIndicators=\"{n}\"")),
@@ -157,7 +157,7 @@ impl Writer<'_> {
              version=\"{}\" generationTool=\"flyloop\" variableNamingConvention=\"flat\"{events}>",
             info.identifier,
             table.token(api),
-            escape(info.description),
+            escape(&info.description),
             env!("CARGO_PKG_VERSION"),
         );
         let ([me, cs], id) = (capabilities(api), info.identifier);
@@ -194,7 +194,7 @@ impl Writer<'_> {
             ),
             Api::Fmi3 => (format!("<{ty}"), String::new()),
         };
-        let (name, vr, text) = (escape(v.name), v.value_reference, escape(v.description));
+        let (name, vr, text) = (escape(v.name), v.value_reference, escape(&v.description));
         let causality = match v.source {
             Source::Time => "independent".to_string(),
             _ => format!("{:?}", v.causality).to_lowercase(),

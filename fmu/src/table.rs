@@ -6,6 +6,7 @@ use crate::error::FmuError;
 use crate::guid;
 use flyloop_core::params::ValueKind;
 use flyloop_core::variables::{Causality, Variability, Variable};
+use std::borrow::Cow;
 use std::ffi::CString;
 use std::ops::{Deref, Range};
 
@@ -13,7 +14,7 @@ use std::ops::{Deref, Range};
 #[derive(Debug)]
 pub struct Array {
     pub name: &'static str,
-    pub description: &'static str,
+    pub description: Cow<'static, str>,
     /// The name of element 0; the other elements follow it in the table.
     pub first: &'static str,
     pub len: usize,
@@ -25,7 +26,7 @@ pub struct ModelInfo {
     /// modelIdentifier and modelName: the FMU is `<identifier>.fmu`, its binary
     /// `binaries/linux64/<identifier>.so`.
     pub identifier: &'static str,
-    pub description: &'static str,
+    pub description: Cow<'static, str>,
     /// DefaultExperiment: start, stop, step size (s).
     pub default_experiment: (f64, f64, f64),
     /// Inputs (by name) each output depends on directly, without a step in between
@@ -33,9 +34,12 @@ pub struct ModelInfo {
     pub direct_feedthrough: &'static [(&'static str, &'static [&'static str])],
     /// Outputs that do not depend on the continuous states (Model Exchange dependencies).
     pub state_free_outputs: &'static [&'static str],
-    pub arrays: &'static [Array],
+    pub arrays: Vec<Array>,
     /// FMI 3.0: a variable for each event indicator (name, unit, description), in order.
     pub event_indicators: &'static [(&'static str, &'static str, &'static str)],
+    /// Descriptions that replace the core table's for this FMU (variable name, text): a
+    /// start value described for every motor counts the FMU's motors.
+    pub descriptions: Vec<(&'static str, Cow<'static, str>)>,
 }
 
 /// What a Model-Exchange capable model adds to its table: value references of its continuous
@@ -72,7 +76,7 @@ impl VrIndex {
 
 #[derive(Debug)]
 pub struct ModelTable {
-    pub info: &'static ModelInfo,
+    pub info: ModelInfo,
     /// Every variable in value-reference order (the modelDescription's order).
     pub variables: Vec<Variable>,
     /// FMI 2.0's GUID and FMI 3.0's instantiationToken (of its own interface: arrays, `time`,
@@ -94,14 +98,17 @@ impl ModelTable {
     /// If a declared array's elements are not in the table (a fault of the model's
     /// [`ModelInfo::arrays`], found by the crate's tests).
     pub fn new(
-        info: &'static ModelInfo,
-        variables: Vec<Variable>,
+        info: ModelInfo,
+        mut variables: Vec<Variable>,
         model_exchange: Option<ModelExchangeTable>,
     ) -> Self {
+        for (name, text) in &info.descriptions {
+            let described = variables.iter_mut().filter(|v| v.name == *name);
+            described.for_each(|v| v.description = text.clone());
+        }
         let token = |api| CString::new(guid::of_interface(api, info.identifier, &variables));
-        let fmi3 = Variable3::fmi3(info, &variables);
+        let fmi3 = Variable3::fmi3(&info, &variables);
         ModelTable {
-            info,
             guid: token(Api::Fmi2).unwrap_or_default(),
             token3: token(Api::Fmi3).unwrap_or_default(),
             by_vr: VrIndex::new(variables.iter().map(|v| v.value_reference)),
@@ -109,6 +116,7 @@ impl ModelTable {
             fmi3,
             variables,
             model_exchange,
+            info,
         }
     }
 
@@ -155,7 +163,7 @@ pub fn local(name: &'static str, vr: u32, unit: &'static str, text: &'static str
         causality: Causality::Local,
         variability: Variability::Continuous,
         unit,
-        description: text,
+        description: Cow::Borrowed(text),
         start: None,
         min: None,
         max: None,
@@ -210,10 +218,11 @@ impl Variable3 {
             let array = arrays.iter().find(|a| a.first == model[at].name);
             let len = array.map_or(1, |a| a.len);
             assert!(at + len <= model.len(), "array {array:?}");
+            let description = array.map_or(&model[at].description, |a| &a.description);
             let variable = Variable {
                 name: array.map_or(model[at].name, |a| a.name),
-                description: array.map_or(model[at].description, |a| a.description),
-                ..model[at]
+                description: description.clone(),
+                ..model[at].clone()
             };
             variables.push(Variable3 {
                 variable,
@@ -234,7 +243,7 @@ impl Variable3 {
         };
         let time = local("time", TIME_VR, "s", "Simulation time");
         let mut variables = vec![computed(time, Source::Time)];
-        variables.extend(Variable3::of(model, info.arrays));
+        variables.extend(Variable3::of(model, &info.arrays));
         let event_indicators = (EVENT_INDICATOR_VR..).zip(info.event_indicators);
         for (i, (vr, &(name, unit, text))) in event_indicators.enumerate() {
             let source = Source::EventIndicator(i);
@@ -255,7 +264,7 @@ mod tests {
 
     #[test]
     fn motor_commands_are_one_array_and_every_model_value_has_one_home() {
-        let [quad, lander] = tables();
+        let [quad, lander, hexa] = tables();
         let command = by_name(quad, "motor_command");
         assert_eq!(command.value_reference, 0);
         assert_eq!(command.dimension, Some(4));
@@ -278,7 +287,14 @@ mod tests {
             .filter(|v| matches!(v.source, Source::EventIndicator(_)))
             .map(|v| v.value_reference);
         assert_eq!(indicators.collect::<Vec<_>>(), [1001, 1002, 1003, 1004]);
-        for table in [quad, lander] {
+        // The hexacopter: the same layout with six motors (27 states, still 22 variables).
+        let command = by_name(hexa, "motor_command");
+        assert_eq!((command.value_reference, command.dimension), (0, Some(6)));
+        assert_eq!(by_name(hexa, "motor_state").dimension, Some(6));
+        assert_eq!(by_name(hexa, "wind_input_x").value_reference, 6);
+        let me = hexa.model_exchange.as_ref().unwrap();
+        assert_eq!((me.states.len(), me.derivatives.len()), (27, 27));
+        for table in [quad, lander, hexa] {
             assert_eq!(table.fmi3[0].source, Source::Time);
             // Every model variable in exactly one FMI 3.0 variable, in table order.
             let elements: Vec<usize> = table.fmi3.iter().flat_map(|v| v.elements()).collect();

@@ -185,7 +185,7 @@ fn fmi2_outputs(model: Model) -> Vec<u32> {
 
 #[test]
 fn fmi3_co_simulation_equals_fmi2_bit_for_bit_with_wind_and_arrays() {
-    for model in [Model::Quadrotor, Model::Lander2D] {
+    for model in Model::ALL {
         let fmu2 = Fmu::started(model, 0.0, &[("seed", 11.0), ("wind_enabled", 1.0)]);
         let fmu3 = Fmu3::started(model, false, |f| f.seed_and_wind(11));
         let inputs2: Vec<u32> = model

@@ -12,7 +12,7 @@ use support::{Fmu, Model};
 /// Steps from t to `end` in steps of h with a command that changes every step.
 fn run(fmu: &Fmu, t: &mut f64, end: f64, h: f64) -> Vec<Vec<u64>> {
     let input = match fmu.model {
-        Model::Quadrotor => "motor_command_1",
+        Model::Quadrotor | Model::Hexacopter => "motor_command_1",
         Model::Lander2D => "motor_command_right",
     };
     let mut outputs = Vec::new();
@@ -43,7 +43,7 @@ fn started(model: Model) -> Fmu {
 
 #[test]
 fn get_run_set_rerun_repeats_every_output_bit_for_bit() {
-    for model in [Model::Quadrotor, Model::Lander2D] {
+    for model in Model::ALL {
         let fmu = started(model);
         let mut t = 0.0;
         run(&fmu, &mut t, 1.0, 0.02);
@@ -61,7 +61,7 @@ fn get_run_set_rerun_repeats_every_output_bit_for_bit() {
 
 #[test]
 fn serialize_and_deserialize_repeat_the_run_here_and_in_a_second_instance() {
-    for model in [Model::Quadrotor, Model::Lander2D] {
+    for model in Model::ALL {
         let fmu = started(model);
         let mut t = 0.0;
         run(&fmu, &mut t, 0.6, 0.03);

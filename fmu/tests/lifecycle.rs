@@ -25,7 +25,7 @@ fn version_and_platform_are_the_standards() {
 
 #[test]
 fn a_whole_run_follows_the_allowed_sequence_and_logs_its_events() {
-    for model in [Model::Quadrotor, Model::Lander2D] {
+    for model in Model::ALL {
         let fmu = Fmu::new(model);
         assert_eq!(fmu.setup(0.0, Some(1.0)), fmi2OK);
         assert_eq!(fmu.enter_init(), fmi2OK);
@@ -143,7 +143,7 @@ fn inputs_set_before_initialisation_survive_later_start_values() {
 
 #[test]
 fn reset_goes_back_to_the_start_values_from_any_stage() {
-    for model in [Model::Quadrotor, Model::Lander2D] {
+    for model in Model::ALL {
         let fresh = Fmu::started(model, 0.0, &[]);
         let start = fresh.output_bits();
         let fmu = Fmu::started(model, 0.0, &[("seed", 9.0), ("initial_x", 2.0)]);

@@ -6,6 +6,7 @@ mod support;
 
 mod fmi3;
 mod fmu_state;
+mod frame_in_test;
 mod lifecycle;
 mod misuse;
 mod model_description;

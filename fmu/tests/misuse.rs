@@ -202,8 +202,8 @@ fn null_arrays_with_elements_are_refused() {
 
 #[test]
 fn nan_and_out_of_range_inputs_are_refused_and_the_previous_value_stays() {
-    for model in [Model::Quadrotor, Model::Lander2D] {
-        let input = if model == Model::Quadrotor {
+    for model in Model::ALL {
+        let input = if model.is_multirotor() {
             "motor_command_2"
         } else {
             "motor_command_left"
@@ -302,5 +302,8 @@ fn a_quadrotor_state_does_not_restore_into_a_lander() {
             .contains("belongs to a model with GUID"),
         "{}",
         lander.last_message()
-    );
+    ); // Nor into the hexacopter: the same model type, another FMU.
+    let hexa = Fmu::started(Model::Hexacopter, 0.0, &[]);
+    assert_eq!(hexa.deserialize(&bytes, &mut state), fmi2Error);
+    assert!(hexa.last_message().contains("belongs to a model with GUID"));
 }

@@ -25,7 +25,7 @@ fn checked_in_dir() -> PathBuf {
 fn checked_in_model_descriptions_match_the_generated_ones() {
     let dir = checked_in_dir();
     let update = std::env::var_os("UPDATE_MODEL_DESCRIPTION").is_some_and(|v| v == "1");
-    for (model, version) in [Model::Quadrotor, Model::Lander2D]
+    for (model, version) in Model::ALL
         .into_iter()
         .flat_map(|m| Api::ALL.map(|v| (m, v)))
     {
@@ -55,7 +55,7 @@ fn checked_in_model_descriptions_match_the_generated_ones() {
 /// an output without a step in between. Checked in a state where everything is in motion.
 #[test]
 fn direct_feedthrough_is_declared_exactly() {
-    for model in [Model::Quadrotor, Model::Lander2D] {
+    for model in Model::ALL {
         let table = model.table();
         let fmu = Fmu::started(model, 0.0, &[("seed", 4.0)]);
         let inputs: Vec<_> = table
@@ -77,7 +77,7 @@ fn direct_feedthrough_is_declared_exactly() {
             assert_eq!(fmu.do_step(f64::from(n) * 0.04, 0.04), fmi2OK);
         }
         assert!(
-            fmu.get(if model == Model::Quadrotor { "z" } else { "y" }) > 0.5,
+            fmu.get(if model.is_multirotor() { "z" } else { "y" }) > 0.5,
             "airborne"
         );
         let outputs: Vec<_> = table

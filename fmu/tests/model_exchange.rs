@@ -8,7 +8,7 @@ use flyloop_core::quadrotor::dynamics::{derivative_vector, state_len};
 
 /// The quad's continuous states: 13 rigid-body values, 4 motors, 8 bristles.
 const STATE_LEN: usize = 25;
-use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial, QuadrotorParams};
+use flyloop_core::quadrotor::{Frame, Quadrotor, QuadrotorInitial, QuadrotorParams};
 use flyloop_fmu::exports::*;
 use flyloop_fmu::fmi2_types::fmi2Status::{fmi2Error, fmi2OK};
 use flyloop_fmu::fmi2_types::*;
@@ -27,7 +27,11 @@ fn event_info() -> fmi2EventInfo {
 
 /// A Model Exchange instance through initialisation and the first event, in continuous time.
 fn running(values: &[(&str, f64)]) -> (Fmu, fmi2EventInfo) {
-    let fmu = Fmu::model_exchange(Model::Quadrotor);
+    running_model(Model::Quadrotor, values)
+}
+
+fn running_model(model: Model, values: &[(&str, f64)]) -> (Fmu, fmi2EventInfo) {
+    let fmu = Fmu::model_exchange(model);
     assert_eq!(fmu.setup(0.0, None), fmi2OK);
     assert_eq!(fmu.enter_init(), fmi2OK);
     for &(name, value) in values {
@@ -43,9 +47,15 @@ fn running(values: &[(&str, f64)]) -> (Fmu, fmi2EventInfo) {
     (fmu, info)
 }
 
+/// The number of continuous states of `fmu`'s model.
+fn state_len_of(fmu: &Fmu) -> usize {
+    let me = fmu.model.table().model_exchange.as_ref();
+    me.map_or(0, |me| me.states.len())
+}
+
 fn states(fmu: &Fmu) -> Vec<f64> {
-    let mut x = vec![0.0; STATE_LEN];
-    // SAFETY: live instance, STATE_LEN writable values.
+    let mut x = vec![0.0; state_len_of(fmu)];
+    // SAFETY: live instance, as many writable values as it has states.
     assert_eq!(
         unsafe { fmi2GetContinuousStates(fmu.c, x.as_mut_ptr(), x.len()) },
         fmi2OK
@@ -54,8 +64,8 @@ fn states(fmu: &Fmu) -> Vec<f64> {
 }
 
 fn derivatives(fmu: &Fmu) -> Vec<f64> {
-    let mut dx = vec![0.0; STATE_LEN];
-    // SAFETY: live instance, STATE_LEN writable values.
+    let mut dx = vec![0.0; state_len_of(fmu)];
+    // SAFETY: live instance, as many writable values as it has states.
     assert_eq!(
         unsafe { fmi2GetDerivatives(fmu.c, dx.as_mut_ptr(), dx.len()) },
         fmi2OK
@@ -130,6 +140,45 @@ fn derivatives_are_the_cores_right_hand_side_bit_for_bit() {
     );
     assert_eq!(z, quad.foot_heights());
     assert!(z.iter().any(|&h| h < 0.0), "{z:?}");
+}
+
+/// Hexacopter.fmu's Model Exchange is the core hexa's right-hand side: 27 states (six
+/// motors), the derivative equal to the last bit in the air and with feet in the ground.
+#[test]
+fn hexacopter_derivatives_are_the_core_hexas_bit_for_bit() {
+    let (fmu, _) = running_model(Model::Hexacopter, FLYING);
+    let initial = QuadrotorInitial {
+        initial_z: 2.0,
+        initial_roll: 0.2,
+        initial_vx: 0.5,
+        initial_wy: -0.4,
+        initial_motor: 0.5,
+        seed: 11,
+        ..Default::default()
+    };
+    let quad = Quadrotor::from_initial(QuadrotorParams::default(), &initial).unwrap();
+    let mut quad = quad.with_frame(Frame::named("hexa_x").unwrap());
+    quad.set_command([0.6, 0.45, 0.5, 0.5, 0.5, 0.5]).unwrap();
+    quad.external_wind.x = 1.5;
+    assert_eq!(states(&fmu), quad.continuous_state());
+    assert_eq!(states(&fmu).len(), 27);
+    let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    for z in [2.0, 0.04] {
+        let mut x = quad.continuous_state();
+        x[2] = z; // 0.04: feet in the ground, the contact forces count
+        x[20] = 1e-4; // a stretched bristle (after the six motors)
+        // SAFETY: live instance, 27 readable values.
+        let status = unsafe { fmi2SetContinuousStates(fmu.c, x.as_ptr(), x.len()) };
+        assert_eq!(status, fmi2OK);
+        quad.set_continuous_state(&x).unwrap();
+        assert_eq!(
+            bits(&derivatives(&fmu)),
+            bits(&quad.state_derivative()),
+            "z = {z}"
+        );
+    }
+    assert_eq!(fmu.get("der(motor_state_5)"), (0.5 - 0.5) / 0.08);
+    assert_eq!(fmu.get("der(motor_state_0)"), (0.6 - 0.5) / 0.08);
 }
 
 #[test]

@@ -6,8 +6,8 @@
 use crate::support;
 
 use flyloop_core::lander2d::{Lander2d, Lander2dInitial, Lander2dParams};
-use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial, QuadrotorParams};
-use flyloop_core::variables::Causality;
+use flyloop_core::quadrotor::{Frame, Quadrotor, QuadrotorInitial, QuadrotorParams};
+use flyloop_core::variables::{Causality, Rows};
 use flyloop_fmu::fmi2_types::fmi2Status::{fmi2Error, fmi2OK};
 use support::{Fmu, Model};
 
@@ -126,54 +126,64 @@ fn step_sizes_computed_as_differences_of_grid_times_give_the_clean_grids_outputs
     assert_eq!(jittered.time(), 300.0 * 0.01);
 }
 
+/// Quadrotor.fmu is the core's quad X and Hexacopter.fmu the core's hexa X
+/// (`Quadrotor::with_frame`): every output equal to the last bit after the same commands.
 #[test]
-fn quadrotor_outputs_are_the_cores_after_the_same_steps_bit_for_bit() {
-    let seed = 5;
-    let fmu = Fmu::started(
-        Model::Quadrotor,
-        0.0,
-        &[("seed", f64::from(seed)), ("initial_motor", 0.5)],
-    );
-    let initial = QuadrotorInitial {
-        seed,
-        initial_motor: 0.5,
-        ..Default::default()
-    };
-    let mut core = Quadrotor::from_initial(QuadrotorParams::default(), &initial).unwrap();
-    let vrs = output_vrs(Model::Quadrotor);
-    let inputs = [
-        "motor_command_0",
-        "motor_command_1",
-        "motor_command_2",
-        "motor_command_3",
-    ];
-    let schedule = [
-        (0.01, 0.5),
-        (0.013, 0.52),
-        (0.25, 0.55),
-        (0.01, 0.4),
-        (0.001, 0.6),
-        (0.5, 0.49),
-    ];
-    let mut t = 0.0;
-    for (round, &(h, command)) in schedule.iter().cycle().take(60).enumerate() {
-        let skew = if round % 3 == 0 { 0.01 } else { 0.0 };
-        let commands = [command + skew, command, command - skew, command];
-        for (name, c) in inputs.iter().zip(commands) {
-            assert_eq!(fmu.set(name, c), fmi2OK);
+fn multirotor_outputs_are_the_cores_after_the_same_steps_bit_for_bit() {
+    for (model, frame) in [(Model::Quadrotor, "quad_x"), (Model::Hexacopter, "hexa_x")] {
+        let seed = 5;
+        let fmu = Fmu::started(
+            model,
+            0.0,
+            &[("seed", f64::from(seed)), ("initial_motor", 0.5)],
+        );
+        let initial = QuadrotorInitial {
+            seed,
+            initial_motor: 0.5,
+            ..Default::default()
+        };
+        let core = Quadrotor::from_initial(QuadrotorParams::default(), &initial).unwrap();
+        let mut core = core.with_frame(Frame::named(frame).unwrap());
+        let rows = Rows::of_model(&core);
+        let vrs = output_vrs(model);
+        let rotors = core.frame().rotor_count();
+        let inputs: Vec<String> = (0..rotors).map(|i| format!("motor_command_{i}")).collect();
+        let schedule = [
+            (0.01, 0.5),
+            (0.013, 0.52),
+            (0.25, 0.55),
+            (0.01, 0.4),
+            (0.001, 0.6),
+            (0.5, 0.49),
+        ];
+        let mut t = 0.0;
+        for (round, &(h, command)) in schedule.iter().cycle().take(60).enumerate() {
+            let skew = if round % 3 == 0 { 0.01 } else { 0.0 };
+            // +skew, 0, -skew, 0, ...: a moment about some axis, the same total thrust.
+            let commands: Vec<f64> = (0..rotors)
+                .map(|i| command + [skew, 0.0, -skew, 0.0][i % 4])
+                .collect();
+            for (name, &c) in inputs.iter().zip(&commands) {
+                assert_eq!(fmu.set(name, c), fmi2OK);
+            }
+            core.set_command(&commands).unwrap();
+            assert_eq!(fmu.do_step(t, h), fmi2OK);
+            core.step(h);
+            t = fmu.time();
+            let (status, values) = fmu.get_reals(&vrs);
+            assert_eq!(status, fmi2OK);
+            for (&vr, value) in vrs.iter().zip(values) {
+                let expected = rows.get(&core, &initial, vr).unwrap();
+                assert_eq!(
+                    value.to_bits(),
+                    expected.to_bits(),
+                    "{model:?} vr {vr} at t = {t}"
+                );
+            }
         }
-        core.set_command(commands).unwrap();
-        assert_eq!(fmu.do_step(t, h), fmi2OK);
-        core.step(h);
-        t = fmu.time();
-        let (status, values) = fmu.get_reals(&vrs);
-        assert_eq!(status, fmi2OK);
-        for (&vr, value) in vrs.iter().zip(values) {
-            let expected = flyloop_core::variables::get(&core, &initial, vr).unwrap();
-            assert_eq!(value.to_bits(), expected.to_bits(), "vr {vr} at t = {t}");
-        }
+        assert_eq!(vrs.len(), 22 + rotors, "{model:?}: every output compared");
+        assert!(fmu.get("z") != 1.5, "the vehicle moved");
     }
-    assert!(fmu.get("z") != 1.5, "the vehicle moved");
 }
 
 #[test]

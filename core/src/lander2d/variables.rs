@@ -161,8 +161,19 @@ fn set_wind<const I: usize>(lander: &mut Lander2d, value: f64) -> Result<(), Inp
 impl VariableTable for Lander2d {
     type Params = Lander2dParams;
     type Initial = Lander2dInitial;
-    const INPUTS: &'static [InputRow<Self>] = INPUTS;
-    const OUTPUTS: &'static [OutputRow<Self>] = OUTPUTS;
+    type Shape = ();
+
+    fn inputs(_: &()) -> Vec<InputRow<Self>> {
+        INPUTS.to_vec()
+    }
+
+    fn outputs(_: &()) -> Vec<OutputRow<Self>> {
+        OUTPUTS.to_vec()
+    }
+
+    fn shape(&self) -> &() {
+        &()
+    }
 
     fn params(&self) -> &Lander2dParams {
         Lander2d::params(self)
@@ -180,21 +191,26 @@ mod tests {
     use super::*;
     use crate::params::ValueKind;
     use crate::variables::Variability;
-    use crate::variables::{get, set, variables};
+    use crate::variables::{Rows, get, set};
+
+    fn variables() -> Vec<crate::variables::Variable> {
+        Rows::<Lander2d>::of(&()).variables()
+    }
 
     fn lander() -> Lander2d {
         Lander2d::from_initial(Lander2dParams::default(), &Lander2dInitial::default()).unwrap()
     }
 
     fn vr(name: &str) -> u32 {
-        crate::variables::value_reference::<Lander2d>(name)
+        let mut variables = variables().into_iter();
+        variables.find(|v| v.name == name).unwrap().value_reference
     }
 
     #[test]
     fn names_and_value_references_are_unique_and_every_one_reads() {
         let (l, init) = (lander(), Lander2dInitial::default());
         crate::variables::assert_every_variable_reads(&l, &init, true);
-        assert_eq!(variables::<Lander2d>().len(), 4 + 22 + 29 + 7);
+        assert_eq!(variables().len(), 4 + 22 + 29 + 7);
         // 4 lies between the inputs (0..=3) and the outputs: no variable.
         assert_eq!(get(&l, &init, 4), Err(ParamError::UnknownValueReference(4)));
     }
@@ -221,7 +237,7 @@ mod tests {
             set(&mut l, &mut init, vr("crashed"), 1.0),
             Err(ParamError::NotSettable("crashed"))
         );
-        let landed = variables::<Lander2d>()
+        let landed = variables()
             .into_iter()
             .find(|v| v.name == "landed")
             .unwrap();

@@ -12,6 +12,7 @@
 use super::contact::Gear;
 use super::dynamics;
 use super::model::Quadrotor;
+use super::variables::MOTOR_STATE_NAMES;
 use super::wind;
 use crate::error::{CommandError, check_finite};
 
@@ -19,8 +20,8 @@ use crate::error::{CommandError, check_finite};
 pub const EVENT_INDICATORS: usize = 4;
 
 /// The continuous states that are not outputs of the variable table (those are x .. z,
-/// vx .. vz, qw .. qz, wx .. wz, motor_state_0 .. 3): the bristle stretches, (name,
-/// description), in state-vector order after the 17 body values.
+/// vx .. vz, qw .. qz, wx .. wz and one motor_state_<i> per rotor): the bristle stretches,
+/// (name, description), in state-vector order after the body values.
 pub const BRISTLES: [(&str, &str); 8] = [
     (
         "gear_stretch_0_x",
@@ -56,26 +57,18 @@ pub const BRISTLES: [(&str, &str); 8] = [
     ),
 ];
 
-/// The output names of the 17 body states, in state-vector order.
-pub const BODY_STATE_OUTPUTS: [&str; 17] = [
-    "x",
-    "y",
-    "z",
-    "vx",
-    "vy",
-    "vz",
-    "qw",
-    "qx",
-    "qy",
-    "qz",
-    "wx",
-    "wy",
-    "wz",
-    "motor_state_0",
-    "motor_state_1",
-    "motor_state_2",
-    "motor_state_3",
+/// The output names of the 13 rigid-body states, in state-vector order (the motor states
+/// `motor_state_<i>` follow them, one per rotor).
+pub const RIGID_BODY_STATE_OUTPUTS: [&str; 13] = [
+    "x", "y", "z", "vx", "vy", "vz", "qw", "qx", "qy", "qz", "wx", "wy", "wz",
 ];
+
+/// The output names of the body states of a vehicle with `rotors` rotors (at most
+/// `MAX_ROTORS`), in state-vector order: the rigid body, then the motor states.
+pub fn body_state_outputs(rotors: usize) -> impl Iterator<Item = &'static str> + Clone {
+    let motors = MOTOR_STATE_NAMES.iter().take(rotors).copied();
+    RIGID_BODY_STATE_OUTPUTS.into_iter().chain(motors)
+}
 
 impl Quadrotor {
     /// Number of continuous states: 13 rigid-body values, one per motor, 8 bristles.

@@ -2,6 +2,7 @@
 //! coefficients where they differ from the vehicle's.
 
 use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
 
 /// Most rotors a frame may have.
 pub const MAX_ROTORS: usize = 12;
@@ -24,7 +25,27 @@ impl Spin {
             Spin::Ccw => -1.0,
         }
     }
+
+    /// "CW" or "CCW", as the variable descriptions write it.
+    pub fn label(self) -> &'static str {
+        match self {
+            Spin::Cw => "CW",
+            Spin::Ccw => "CCW",
+        }
+    }
 }
+
+/// The body's eight compass words, counter-clockwise from forward in 45° steps.
+const PLACES: [&str; 8] = [
+    "front",
+    "front-left",
+    "left",
+    "rear-left",
+    "rear",
+    "rear-right",
+    "right",
+    "front-right",
+];
 
 /// One rotor of a frame.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -59,5 +80,39 @@ impl Rotor {
             torque_coefficient: None,
             time_constant: None,
         }
+    }
+
+    /// Where the rotor sits, seen from above: a compass word of the body ("front-right")
+    /// when it is on one of the eight, else its bearing ("30° left of forward").
+    pub fn place(&self) -> Cow<'static, str> {
+        let bearing = self.y.atan2(self.x).to_degrees();
+        let octant = bearing / 45.0;
+        if (octant - octant.round()).abs() < 1e-9 {
+            return Cow::Borrowed(PLACES[(octant.round() as i64).rem_euclid(8) as usize]);
+        }
+        let side = if bearing > 0.0 { "left" } else { "right" };
+        let degrees = (bearing.abs() * 10.0).round() / 10.0;
+        Cow::Owned(format!("{degrees}° {side} of forward"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_rotor_is_placed_by_compass_word_or_by_bearing() {
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let place = |x, y| Rotor::at(x, y, Spin::Cw).place();
+        assert_eq!(place(h, -h), "front-right");
+        assert_eq!(place(-h, h), "rear-left");
+        assert_eq!(place(0.0, -1.0), "right");
+        assert_eq!(place(-1.0, 0.0), "rear");
+        assert_eq!(place(0.866_025_403_784_438_6, 0.5), "30° left of forward");
+        assert_eq!(
+            place(-0.923_879_532_511_286_7, -0.382_683_432_365_089_8),
+            "157.5° right of forward"
+        );
+        assert_eq!(Spin::Ccw.label(), "CCW");
     }
 }

@@ -1,14 +1,19 @@
-//! The quadrotor's variable table: inputs, outputs, physical parameters and start values,
-//! with value references, for the FMU and the SITL.
+//! The multirotor's variable table: inputs, outputs, physical parameters and start values,
+//! with value references, for the FMU and the SITL. It is built from the frame: one motor
+//! command (input) and one motor state (output) per rotor, named by index and described by
+//! the rotor's place and spin; the value references follow in table order, so the quad X's
+//! are those of the table before frames existed.
 
+use super::frame::{Frame, MAX_ROTORS};
 use super::model::Quadrotor;
 use super::params::{QuadrotorInitial, QuadrotorParams};
 use crate::error::{InputError, ParamError, check_finite};
 use crate::params::Parameters;
 use crate::variables::{InputRow, OutputRow, VariableTable};
+use std::borrow::Cow;
 
-/// Outputs; their order fixes the value references.
-const OUTPUTS: &[OutputRow<Quadrotor>] = &[
+/// Outputs before the motor states; their order fixes the value references.
+const BODY_OUTPUTS: &[OutputRow<Quadrotor>] = &[
     OutputRow::real("x", "m", "Position east (world ENU)", |q| q.body.position.x),
     OutputRow::real("y", "m", "Position north (world ENU)", |q| {
         q.body.position.y
@@ -73,30 +78,10 @@ const OUTPUTS: &[OutputRow<Quadrotor>] = &[
     OutputRow::real("wz", "rad/s", "Body rate about z (up)", |q| {
         q.body.body_rates.z
     }),
-    OutputRow::real(
-        "motor_state_0",
-        "1",
-        "Lagged state of motor 0 (front-right, CCW)",
-        |q| q.body.motors[0],
-    ),
-    OutputRow::real(
-        "motor_state_1",
-        "1",
-        "Lagged state of motor 1 (rear-left, CCW)",
-        |q| q.body.motors[1],
-    ),
-    OutputRow::real(
-        "motor_state_2",
-        "1",
-        "Lagged state of motor 2 (front-left, CW)",
-        |q| q.body.motors[2],
-    ),
-    OutputRow::real(
-        "motor_state_3",
-        "1",
-        "Lagged state of motor 3 (rear-right, CW)",
-        |q| q.body.motors[3],
-    ),
+];
+
+/// Outputs after the motor states.
+const WIND_OUTPUTS: &[OutputRow<Quadrotor>] = &[
     OutputRow::real(
         "wind_x",
         "m/s",
@@ -111,12 +96,8 @@ const OUTPUTS: &[OutputRow<Quadrotor>] = &[
     }),
 ];
 
-/// Inputs; their order fixes the value references.
-const INPUTS: &[InputRow<Quadrotor>] = &[
-    motor::<0>("motor_command_0", "Command of motor 0 (front-right, CCW)"),
-    motor::<1>("motor_command_1", "Command of motor 1 (rear-left, CCW)"),
-    motor::<2>("motor_command_2", "Command of motor 2 (front-left, CW)"),
-    motor::<3>("motor_command_3", "Command of motor 3 (rear-right, CW)"),
+/// Inputs after the motor commands.
+const WIND_INPUTS: &[InputRow<Quadrotor>] = &[
     wind::<0>(
         "wind_input_x",
         "External wind east, added to the model's wind",
@@ -131,16 +112,96 @@ const INPUTS: &[InputRow<Quadrotor>] = &[
     ),
 ];
 
-/// Motor command `I` in [0, 1], starting at 0.
-const fn motor<const I: usize>(name: &'static str, text: &'static str) -> InputRow<Quadrotor> {
-    InputRow::new(
-        name,
-        "1",
-        text,
-        [0.0, 1.0, 0.0],
-        |q| q.command()[I],
-        set_motor::<I>,
-    )
+/// `f::<0>` .. `f::<11>`: one function per rotor index (a row reads through a plain fn
+/// pointer, which cannot carry the index).
+macro_rules! per_rotor {
+    ($f:ident) => {
+        [
+            $f::<0>, $f::<1>, $f::<2>, $f::<3>, $f::<4>, $f::<5>, $f::<6>, $f::<7>, $f::<8>,
+            $f::<9>, $f::<10>, $f::<11>,
+        ]
+    };
+}
+const _: () = assert!(MAX_ROTORS == 12, "per_rotor! lists one function per rotor");
+
+/// Names of the motor command inputs, by rotor index.
+pub const MOTOR_COMMAND_NAMES: [&str; MAX_ROTORS] = [
+    "motor_command_0",
+    "motor_command_1",
+    "motor_command_2",
+    "motor_command_3",
+    "motor_command_4",
+    "motor_command_5",
+    "motor_command_6",
+    "motor_command_7",
+    "motor_command_8",
+    "motor_command_9",
+    "motor_command_10",
+    "motor_command_11",
+];
+
+/// Names of the motor state outputs, by rotor index.
+pub const MOTOR_STATE_NAMES: [&str; MAX_ROTORS] = [
+    "motor_state_0",
+    "motor_state_1",
+    "motor_state_2",
+    "motor_state_3",
+    "motor_state_4",
+    "motor_state_5",
+    "motor_state_6",
+    "motor_state_7",
+    "motor_state_8",
+    "motor_state_9",
+    "motor_state_10",
+    "motor_state_11",
+];
+
+/// What reads a value of the vehicle, and what writes an input.
+type Getter = fn(&Quadrotor) -> f64;
+type Setter = fn(&mut Quadrotor, f64) -> Result<(), InputError>;
+
+const GET_COMMAND: [Getter; MAX_ROTORS] = per_rotor!(get_command);
+const SET_COMMAND: [Setter; MAX_ROTORS] = per_rotor!(set_motor);
+const GET_MOTOR_STATE: [Getter; MAX_ROTORS] = per_rotor!(get_motor_state);
+
+fn get_command<const I: usize>(quad: &Quadrotor) -> f64 {
+    quad.command().get(I).copied().unwrap_or_default()
+}
+
+fn get_motor_state<const I: usize>(quad: &Quadrotor) -> f64 {
+    quad.body.motors.get(I).copied().unwrap_or_default()
+}
+
+/// "(front-right, CCW)": where rotor `index` of `frame` sits and which way it turns.
+fn rotor_text(frame: &Frame, index: usize) -> String {
+    let rotor = &frame.rotors()[index];
+    format!("({}, {})", rotor.place(), rotor.spin.label())
+}
+
+/// Motor command inputs in [0, 1], starting at 0, one per rotor of `frame`.
+fn motor_commands(frame: &Frame) -> impl Iterator<Item = InputRow<Quadrotor>> + '_ {
+    (0..frame.rotor_count()).map(|i| InputRow {
+        description: Cow::Owned(format!("Command of motor {i} {}", rotor_text(frame, i))),
+        ..InputRow::new(
+            MOTOR_COMMAND_NAMES[i],
+            "1",
+            "",
+            [0.0, 1.0, 0.0],
+            GET_COMMAND[i],
+            SET_COMMAND[i],
+        )
+    })
+}
+
+/// Motor state outputs, one per rotor of `frame`.
+fn motor_states(frame: &Frame) -> impl Iterator<Item = OutputRow<Quadrotor>> + '_ {
+    (0..frame.rotor_count()).map(|i| OutputRow {
+        description: Cow::Owned(format!(
+            "Lagged state of motor {i} {}",
+            rotor_text(frame, i)
+        )),
+        ..OutputRow::real(MOTOR_STATE_NAMES[i], "1", "", GET_MOTOR_STATE[i])
+    })
 }
 
 /// External wind component `I` in m/s.
@@ -171,8 +232,23 @@ fn set_wind<const I: usize>(quad: &mut Quadrotor, value: f64) -> Result<(), Inpu
 impl VariableTable for Quadrotor {
     type Params = QuadrotorParams;
     type Initial = QuadrotorInitial;
-    const INPUTS: &'static [InputRow<Self>] = INPUTS;
-    const OUTPUTS: &'static [OutputRow<Self>] = OUTPUTS;
+    type Shape = Frame;
+
+    fn inputs(frame: &Frame) -> Vec<InputRow<Self>> {
+        motor_commands(frame).chain(WIND_INPUTS.to_vec()).collect()
+    }
+
+    fn outputs(frame: &Frame) -> Vec<OutputRow<Self>> {
+        let wind = WIND_OUTPUTS.iter().cloned();
+        (BODY_OUTPUTS.iter().cloned())
+            .chain(motor_states(frame))
+            .chain(wind)
+            .collect()
+    }
+
+    fn shape(&self) -> &Frame {
+        self.frame()
+    }
 
     fn params(&self) -> &QuadrotorParams {
         &self.params
@@ -188,7 +264,7 @@ mod tests {
     use super::*;
     use crate::quadrotor::BodyState;
     use crate::rng::SimRng;
-    use crate::variables::{get, set};
+    use crate::variables::{Rows, get, set};
     use nalgebra::Vector3;
 
     fn quad() -> Quadrotor {
@@ -206,7 +282,7 @@ mod tests {
     fn outputs_read_the_state_and_cannot_be_set() {
         let mut q = quad();
         let mut init = QuadrotorInitial::default();
-        let vr = crate::variables::value_reference::<Quadrotor>;
+        let vr = |name| crate::variables::value_reference(&quad(), name);
         assert_eq!(get(&q, &init, vr("z")).unwrap(), 3.0);
         assert!((get(&q, &init, vr("yaw")).unwrap() - 0.5).abs() < 1e-12);
         assert_eq!(
@@ -219,7 +295,7 @@ mod tests {
     fn inputs_and_parameters_are_range_checked_and_refusals_change_nothing() {
         let mut q = quad();
         let mut init = QuadrotorInitial::default();
-        let vr = crate::variables::value_reference::<Quadrotor>;
+        let vr = |name| crate::variables::value_reference(&quad(), name);
         set(&mut q, &mut init, vr("motor_command_2"), 0.7).unwrap();
         assert_eq!(q.command()[2], 0.7);
         let err = set(&mut q, &mut init, vr("motor_command_2"), f64::NAN).unwrap_err();
@@ -234,5 +310,26 @@ mod tests {
         assert_eq!(q.params.mass, 2.0);
         set(&mut q, &mut init, vr("initial_z"), 4.0).unwrap();
         assert_eq!(init.initial_z, 4.0);
+    }
+
+    #[test]
+    fn a_hexas_table_has_a_command_and_a_state_per_rotor_in_value_reference_order() {
+        let hexa = quad().with_frame(Frame::named("hexa_x").unwrap());
+        crate::variables::assert_every_variable_reads(&hexa, &QuadrotorInitial::default(), false);
+        let vr = |name| crate::variables::value_reference(&hexa, name);
+        assert_eq!((vr("motor_command_5"), vr("wind_input_x")), (5, 6));
+        assert_eq!(
+            (vr("motor_state_0"), vr("motor_state_5"), vr("wind_x")),
+            (119, 124, 125)
+        );
+        let rows = Rows::of_model(&hexa);
+        let text = &rows.inputs[2].description;
+        assert_eq!(text, "Command of motor 2 (30° left of forward, CW)");
+        let (mut hexa, mut init) = (hexa, QuadrotorInitial::default());
+        rows.set(&mut hexa, &mut init, 5, 0.7).unwrap();
+        assert_eq!(hexa.command()[5], 0.7);
+        assert_eq!(rows.get(&hexa, &init, 5), Ok(0.7));
+        // The quad's table has no sixth motor: value reference 6 is its wind_input_z.
+        assert_eq!(Rows::of_model(&quad()).inputs[6].name, "wind_input_z");
     }
 }

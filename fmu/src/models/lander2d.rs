@@ -7,33 +7,43 @@
 use crate::model::{FmuModel, Table};
 use crate::table::ModelInfo;
 use flyloop_core::lander2d::{Lander2d, Lander2dInitial};
+use flyloop_core::variables::Rows;
 use flyloop_core::{ParamError, SnapshotError};
-use std::sync::OnceLock;
+use std::borrow::Cow;
 
-static INFO: ModelInfo = ModelInfo {
-    identifier: "Lander2D",
-    description: "flyloop Lander2D: 2D drone with two thrusters over a landing platform \
+/// Lander2D.fmu's table: the core's variables as they are.
+pub(super) fn table() -> Table<Lander2d> {
+    Table::new(info(), (), Rows::of(&()), Vec::new(), None)
+}
+
+fn info() -> ModelInfo {
+    ModelInfo {
+        identifier: "Lander2D",
+        description: Cow::Borrowed(
+            "flyloop Lander2D: 2D drone with two thrusters over a landing platform \
                   (rapier2d), thrust noise, battery, wind",
-    default_experiment: (0.0, 20.0, 0.02),
-    // The wind force output is the episode wind plus the input; everything else moves only
-    // with a step.
-    direct_feedthrough: &[
-        ("wind_force_x", &["wind_force_input_x"]),
-        ("wind_force_y", &["wind_force_input_y"]),
-    ],
-    state_free_outputs: &[],
-    // Two commands read better by name (left, right) than as an array.
-    arrays: &[],
-    event_indicators: &[],
-};
+        ),
+        default_experiment: (0.0, 20.0, 0.02),
+        // The wind force output is the episode wind plus the input; everything else moves only
+        // with a step.
+        direct_feedthrough: &[
+            ("wind_force_x", &["wind_force_input_x"]),
+            ("wind_force_y", &["wind_force_input_y"]),
+        ],
+        state_free_outputs: &[],
+        // Two commands read better by name (left, right) than as an array.
+        arrays: Vec::new(),
+        event_indicators: &[],
+        descriptions: Vec::new(),
+    }
+}
 
 impl FmuModel for Lander2d {
-    fn table() -> &'static Table<Self> {
-        static TABLE: OnceLock<Table<Lander2d>> = OnceLock::new();
-        TABLE.get_or_init(|| Table::new(&INFO, Vec::new(), None))
-    }
-
-    fn build(previous: Option<&Self>, initial: &Lander2dInitial) -> Result<Self, ParamError> {
+    fn build(
+        _: &(),
+        previous: Option<&Self>,
+        initial: &Lander2dInitial,
+    ) -> Result<Self, ParamError> {
         let params = previous.map(|l| l.params().clone()).unwrap_or_default();
         Lander2d::from_initial(params, initial)
     }

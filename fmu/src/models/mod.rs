@@ -1,31 +1,66 @@
-//! The two models this one library serves, and the choice between them by GUID.
+//! The FMUs this one library serves, and the choice between them by GUID: each is a
+//! declaration (a name, and for the multirotor its frame) whose table is built on first use.
 
 mod lander2d;
 mod quadrotor;
 
+pub use quadrotor::Multirotor;
+
 use crate::api::Api;
 use crate::engine::{Engine, Simulation};
 use crate::error::FmuError;
-use crate::model::FmuModel;
+use crate::model::{FmuModel, Table};
 use crate::table::ModelTable;
 use flyloop_core::lander2d::Lander2d;
-use flyloop_core::quadrotor::Quadrotor;
+use flyloop_core::quadrotor::{Frame, Quadrotor};
+use std::sync::LazyLock;
 
-/// The tables of every model, Quadrotor first.
-pub fn tables() -> [&'static ModelTable; 2] {
-    [&Quadrotor::table().table, &Lander2d::table().table]
+/// A shipped frame by name (the crate's tests build every declared FMU).
+fn shipped(name: &str) -> Frame {
+    Frame::named(name).unwrap_or_else(|e| unreachable!("{name} is shipped: {e}"))
 }
 
-/// A fresh simulation of the model whose GUID (FMI 2.0) or instantiation token (FMI 3.0) is
+/// Quadrotor.fmu: the quad X.
+static QUADROTOR: LazyLock<Table<Quadrotor>> = LazyLock::new(|| {
+    let frame = shipped("quad_x");
+    Multirotor {
+        identifier: "Quadrotor",
+        noun: "quadrotor",
+        frame,
+    }
+    .table()
+});
+
+/// Lander2D.fmu.
+static LANDER2D: LazyLock<Table<Lander2d>> = LazyLock::new(lander2d::table);
+
+/// Hexacopter.fmu: the same model with the hexa X's rotor table (PX4's 6001 motor order).
+static HEXACOPTER: LazyLock<Table<Quadrotor>> = LazyLock::new(|| {
+    let frame = shipped("hexa_x");
+    Multirotor {
+        identifier: "Hexacopter",
+        noun: "hexacopter",
+        frame,
+    }
+    .table()
+});
+
+/// The tables of every FMU: Quadrotor, Lander2D, Hexacopter.
+pub fn tables() -> [&'static ModelTable; 3] {
+    [&QUADROTOR.table, &LANDER2D.table, &HEXACOPTER.table]
+}
+
+/// A fresh simulation of the FMU whose GUID (FMI 2.0) or instantiation token (FMI 3.0) is
 /// `token`, or `None` for an unknown one.
 pub fn simulation_for(api: Api, token: &str) -> Option<Result<Box<dyn Simulation>, FmuError>> {
-    if token == Quadrotor::table().table.token(api) {
-        let built = <Quadrotor as FmuModel>::build(None, &Default::default());
-        Some(built.map(Engine::boxed).map_err(FmuError::from))
-    } else if token == Lander2d::table().table.token(api) {
-        let built = <Lander2d as FmuModel>::build(None, &Default::default());
-        Some(built.map(Engine::boxed).map_err(FmuError::from))
-    } else {
-        None
+    fn of<M: FmuModel>(
+        table: &'static Table<M>,
+        api: Api,
+        token: &str,
+    ) -> Option<Result<Box<dyn Simulation>, FmuError>> {
+        (token == table.table.token(api)).then(|| Engine::start(table))
     }
+    of(&QUADROTOR, api, token)
+        .or_else(|| of(&LANDER2D, api, token))
+        .or_else(|| of(&HEXACOPTER, api, token))
 }

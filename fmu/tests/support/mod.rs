@@ -12,13 +12,24 @@ use std::ffi::CString;
 pub enum Model {
     Quadrotor,
     Lander2D,
+    Hexacopter,
 }
 
 impl Model {
+    /// Every FMU the library serves.
+    pub const ALL: [Model; 3] = [Model::Quadrotor, Model::Lander2D, Model::Hexacopter];
+    /// The multirotor FMUs (one model, two frames).
+    pub const MULTIROTORS: [Model; 2] = [Model::Quadrotor, Model::Hexacopter];
+
+    pub fn is_multirotor(self) -> bool {
+        self != Model::Lander2D
+    }
+
     pub fn table(self) -> &'static flyloop_fmu::table::ModelTable {
         match self {
             Model::Quadrotor => tables()[0],
             Model::Lander2D => tables()[1],
+            Model::Hexacopter => tables()[2],
         }
     }
 

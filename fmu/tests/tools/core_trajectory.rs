@@ -3,7 +3,7 @@
 //! gets from the FMU for the same experiment.
 //!
 //! ```text
-//! input:  {"model": "Quadrotor" | "Lander2D", "start_values": {"seed": 7, ...},
+//! input:  {"model": "Quadrotor" | "Hexacopter" | "Lander2D", "start_values": {"seed": 7, ...},
 //!          "step_size": 0.01, "steps": 300,
 //!          "inputs": [{"time": 0.0, "values": {"motor_command_0": 0.5, ...}}, ...],
 //!          "outputs": ["x", "z", ...]}
@@ -18,51 +18,51 @@
 
 use flyloop_core::Parameters;
 use flyloop_core::lander2d::{Lander2d, Lander2dInitial, Lander2dParams};
-use flyloop_core::quadrotor::{Quadrotor, QuadrotorInitial, QuadrotorParams};
-use flyloop_core::variables::{self, Variable};
+use flyloop_core::quadrotor::{Frame, Quadrotor, QuadrotorInitial, QuadrotorParams};
+use flyloop_core::variables::{Rows, VariableTable};
 use serde_json::{Map, Value, json};
 use std::io::Read;
 
 /// A core model seen through its own variable table.
-trait Core {
-    fn variables() -> Vec<Variable>;
-    fn get(&self, vr: u32) -> f64;
-    fn set(&mut self, vr: u32, value: f64);
+struct Core<M: VariableTable> {
+    model: M,
+    initial: M::Initial,
+    rows: Rows<M>,
+}
+
+impl<M: VariableTable> Core<M> {
+    fn new(model: M, initial: M::Initial) -> Self {
+        let rows = Rows::of_model(&model);
+        Core {
+            model,
+            initial,
+            rows,
+        }
+    }
+    fn get(&self, vr: u32) -> f64 {
+        self.rows.get(&self.model, &self.initial, vr).unwrap()
+    }
+    fn set(&mut self, vr: u32, value: f64) {
+        (self.rows.set(&mut self.model, &mut self.initial, vr, value)).unwrap();
+    }
+}
+
+/// How a model moves to the end of a communication step.
+trait Advance {
     fn advance(&mut self, end_time: f64, step_size: f64);
 }
 
-struct Quad(Quadrotor, QuadrotorInitial);
-struct Lander(Lander2d, Lander2dInitial);
-
-impl Core for Quad {
-    fn variables() -> Vec<Variable> {
-        variables::variables::<Quadrotor>()
-    }
-    fn get(&self, vr: u32) -> f64 {
-        variables::get(&self.0, &self.1, vr).unwrap()
-    }
-    fn set(&mut self, vr: u32, value: f64) {
-        variables::set(&mut self.0, &mut self.1, vr, value).unwrap();
-    }
+impl Advance for Quadrotor {
     fn advance(&mut self, _end_time: f64, step_size: f64) {
-        self.0.step(step_size);
+        self.step(step_size);
     }
 }
 
-impl Core for Lander {
-    fn variables() -> Vec<Variable> {
-        variables::variables::<Lander2d>()
-    }
-    fn get(&self, vr: u32) -> f64 {
-        variables::get(&self.0, &self.1, vr).unwrap()
-    }
-    fn set(&mut self, vr: u32, value: f64) {
-        variables::set(&mut self.0, &mut self.1, vr, value).unwrap();
-    }
+impl Advance for Lander2d {
     fn advance(&mut self, end_time: f64, _step_size: f64) {
         // To the state at end_time, as the FMU does (whole physics substeps on their grid,
         // a shortened one inside a substep).
-        self.0.advance_to(end_time);
+        self.advance_to(end_time);
     }
 }
 
@@ -83,8 +83,8 @@ fn start_values<P: Parameters, I: Parameters>(values: &Map<String, Value>) -> (P
     (params, initial)
 }
 
-fn run<C: Core>(mut core: C, spec: &Value) -> Value {
-    let variables = C::variables();
+fn run<M: VariableTable + Advance>(mut core: Core<M>, spec: &Value) -> Value {
+    let variables = core.rows.variables();
     let vr = |name: &str| {
         variables
             .iter()
@@ -103,7 +103,7 @@ fn run<C: Core>(mut core: C, spec: &Value) -> Value {
     let inputs = spec["inputs"].as_array().cloned().unwrap_or_default();
     let mut next_input = 0;
     let mut columns: Vec<Vec<f64>> = vec![Vec::new(); outputs.len() + 1];
-    let record = |core: &C, t: f64, columns: &mut Vec<Vec<f64>>| {
+    let record = |core: &Core<M>, t: f64, columns: &mut Vec<Vec<f64>>| {
         columns[0].push(t);
         for (column, name) in columns[1..].iter_mut().zip(&outputs) {
             column.push(core.get(vr(name)));
@@ -119,7 +119,7 @@ fn run<C: Core>(mut core: C, spec: &Value) -> Value {
             next_input += 1;
         }
         let end = (n + 1) as f64 * h;
-        core.advance(end, h);
+        core.model.advance(end, h);
         record(&core, end, &mut columns);
     }
     let mut out = Map::new();
@@ -138,18 +138,26 @@ fn main() {
         .as_object()
         .cloned()
         .unwrap_or_default();
-    let result = match spec["model"].as_str().unwrap() {
-        "Quadrotor" => {
+    let model = spec["model"].as_str().unwrap();
+    // The multirotor FMUs and their frames.
+    let frame = match model {
+        "Quadrotor" => Some("quad_x"),
+        "Hexacopter" => Some("hexa_x"),
+        _ => None,
+    };
+    let result = match (model, frame) {
+        (_, Some(frame)) => {
             let (params, initial) = start_values::<QuadrotorParams, QuadrotorInitial>(&values);
             let quad = Quadrotor::from_initial(params, &initial).unwrap();
-            run(Quad(quad, initial), &spec)
+            let quad = quad.with_frame(Frame::named(frame).unwrap());
+            run(Core::new(quad, initial), &spec)
         }
-        "Lander2D" => {
+        ("Lander2D", None) => {
             let (params, initial) = start_values::<Lander2dParams, Lander2dInitial>(&values);
             let lander = Lander2d::from_initial(params, &initial).unwrap();
-            run(Lander(lander, initial), &spec)
+            run(Core::new(lander, initial), &spec)
         }
-        other => panic!("unknown model {other}"),
+        _ => panic!("unknown model {model}"),
     };
     println!("{result}");
 }
