@@ -1,6 +1,7 @@
-//! FMI front end of flyloop-core: `Quadrotor.fmu` (FMI 2.0 Co-Simulation and Model Exchange),
-//! `Lander2D.fmu` (FMI 2.0 Co-Simulation) and their FMI 3.0 twins `Quadrotor-fmi3.fmu` and
-//! `Lander2D-fmi3.fmu`, all from one cdylib that exports both APIs. From the C boundary down:
+//! FMI front end of flyloop-core: `Quadrotor.fmu` and `Hexacopter.fmu` (one multirotor model
+//! with two rotor tables; FMI 2.0 Co-Simulation and Model Exchange), `Lander2D.fmu` (FMI 2.0
+//! Co-Simulation) and their FMI 3.0 twins `<Model>-fmi3.fmu`, all from one cdylib that exports
+//! both APIs. From the C boundary down:
 //! [`exports`], [`instance`] (the state machine), [`engine`] (for any [`model::FmuModel`]),
 //! [`models`]; [`model_description`] and [`pack`] write the FMUs.
 

@@ -11,6 +11,19 @@ from fmpy.logging import addLoggerProxy
 HOVER = (1.0 * 9.81 / (4 * 10.0)) ** 0.5
 """Motor state at which the default quadrotor (1 kg, k = 10 N) hovers: sqrt(mg / 4k)."""
 
+ROTORS = {"Quadrotor": 4, "Hexacopter": 6}
+"""The multirotor FMUs (one model, two rotor tables) and their rotor counts."""
+
+
+def hover(model: str) -> float:
+    """Motor state at which the default vehicle of `model` hovers: sqrt(mg / nk)."""
+    return (1.0 * 9.81 / (ROTORS[model] * 10.0)) ** 0.5
+
+
+def motors(model: str) -> list[str]:
+    """The motor command inputs of a multirotor FMU, in motor order."""
+    return [f"motor_command_{i}" for i in range(ROTORS[model])]
+
 
 class LoggedSlave:
     """A Co-Simulation instance whose log messages land in `messages`."""

@@ -1,6 +1,6 @@
-"""The FMI 3.0 FMUs (Quadrotor-fmi3.fmu, Lander2D-fmi3.fmu) through fmpy: what they hold, the
-same Co-Simulation as FMI 2.0 to the last bit, Model Exchange with CVode against FMI 2.0's,
-and FMU states that serialize and restore exactly."""
+"""The FMI 3.0 FMUs (Quadrotor-fmi3.fmu, Lander2D-fmi3.fmu, Hexacopter-fmi3.fmu) through fmpy:
+what they hold, the same Co-Simulation as FMI 2.0 to the last bit, Model Exchange with CVode
+against FMI 2.0's, and FMU states that serialize and restore exactly."""
 
 import shutil
 import zipfile
@@ -10,7 +10,7 @@ import pytest
 from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
-from fmu_support import HOVER
+from fmu_support import HOVER, ROTORS, hover
 
 
 def slave(fmu, version: int):
@@ -28,7 +28,7 @@ def slave(fmu, version: int):
     return md, instance, vrs, directory
 
 
-@pytest.mark.parametrize("name", ["Quadrotor", "Lander2D"])
+@pytest.mark.parametrize("name", ["Quadrotor", "Lander2D", "Hexacopter"])
 def test_the_fmi3_fmu_holds_a_3_0_description_and_the_x86_64_linux_binary(fmus, name):
     with zipfile.ZipFile(fmus[f"{name}-fmi3"]) as zf:
         assert set(zf.namelist()) == {
@@ -39,21 +39,22 @@ def test_the_fmi3_fmu_holds_a_3_0_description_and_the_x86_64_linux_binary(fmus, 
     assert md.fmiVersion == "3.0"
     assert md.coSimulation.modelIdentifier == name
     assert md.coSimulation.canGetAndSetFMUstate and md.coSimulation.canSerializeFMUstate
-    assert (md.modelExchange is not None) == (name == "Quadrotor")
+    assert (md.modelExchange is not None) == (name in ROTORS)
     variables = {v.name: v for v in md.modelVariables}
     assert variables["time"].causality == "independent"
     assert all(v.description for v in md.modelVariables)
-    if name == "Quadrotor":
+    if name in ROTORS:
+        n = ROTORS[name]
         command = variables["motor_command"]
         assert command.type == "Float64" and command.causality == "input"
-        assert [int(d.start) for d in command.dimensions] == [4]
+        assert [int(d.start) for d in command.dimensions] == [n]
         assert len(variables["motor_state"].dimensions) == 1
-        assert md.numberOfContinuousStates == 25 and md.numberOfEventIndicators == 4
+        assert md.numberOfContinuousStates == 21 + n and md.numberOfEventIndicators == 4
         assert variables["seed"].type == "Int32"
         assert variables["wind_enabled"].type == "Boolean"
 
 
-@pytest.mark.parametrize("name", ["Quadrotor", "Lander2D"])
+@pytest.mark.parametrize("name", ["Quadrotor", "Lander2D", "Hexacopter"])
 def test_fmi3_co_simulation_equals_fmi2_bit_for_bit(fmus, name):
     """Same seed, wind on, the same commands: every output of every step is the same f64."""
     md2, fmu2, vrs2, dir2 = slave(fmus[name], 2)
@@ -73,7 +74,7 @@ def test_fmi3_co_simulation_equals_fmi2_bit_for_bit(fmus, name):
     outputs3 = [v for v in md3.modelVariables if v.causality == "output" and v.type == "Float64"]
     n3 = sum(int(v.dimensions[0].start) if v.dimensions else 1 for v in outputs3)
     assert n3 == len(outputs2)
-    commands3 = [vrs3["motor_command"]] if name == "Quadrotor" else [vrs3[c] for c in commands2]
+    commands3 = [vrs3["motor_command"]] if name in ROTORS else [vrs3[c] for c in commands2]
     t = 0.0
     for k in range(300):
         command = [0.5 + 0.1 * np.sin(0.05 * k + i) for i in range(len(commands2))]
@@ -134,10 +135,11 @@ CALM3 = {
 }
 
 
-def test_fmi3_model_exchange_with_cvode_follows_fmi2_model_exchange(fmus):
+@pytest.mark.parametrize("model", ROTORS)
+def test_fmi3_model_exchange_with_cvode_follows_fmi2_model_exchange(fmus, model):
     """fmpy's CVode on the FMI 3.0 and the FMI 2.0 Model Exchange: the same right-hand side,
-    so the same path to the solver's accuracy. Motors at their (default) zero command: they
-    spin down (time constant 0.05 s) and the vehicle, rolling, falls from 10 m."""
+    so the same path to the solver's accuracy. The motors hold the vehicle's hover state (the
+    command starts at initial_motor) and the vehicle, rolling, loses lift and falls from 10 m."""
     runs = [
         simulate_fmu(
             str(fmus[name]),
@@ -146,10 +148,10 @@ def test_fmi3_model_exchange_with_cvode_follows_fmi2_model_exchange(fmus):
             relative_tolerance=1e-10,
             stop_time=1.0,
             output_interval=0.01,
-            start_values=CALM3,
+            start_values={**CALM3, "initial_motor": hover(model)},
             output=["x", "y", "z", "qw"],
         )
-        for name in ("Quadrotor", "Quadrotor-fmi3")
+        for name in (model, f"{model}-fmi3")
     ]
     fmi2, fmi3 = runs
     assert len(fmi3) == len(fmi2) > 100

@@ -14,9 +14,10 @@ from fmu_support import LoggedSlave
 ERROR = 3
 
 
-@pytest.fixture
-def quad(fmus):
-    instance = LoggedSlave(fmus["Quadrotor"])
+@pytest.fixture(params=["Quadrotor", "Hexacopter"])
+def quad(fmus, request):
+    """A multirotor instance: the quad X's and the hexa X's FMU refuse misuse alike."""
+    instance = LoggedSlave(fmus[request.param])
     yield instance
     instance.close()
 

@@ -1,11 +1,12 @@
-"""Quadrotor.fmu as Model Exchange with fmpy's solvers: the importer integrates the core's own
-right-hand side, so its path is the core's path (CVode), converges to it at first order
-(explicit Euler), matches Co-Simulation, and sees the same turbulence samples as
-Co-Simulation at any communication step."""
+"""Quadrotor.fmu and Hexacopter.fmu as Model Exchange with fmpy's solvers: the importer
+integrates the core's own right-hand side, so its path is the core's path (CVode), converges
+to it at first order (explicit Euler), matches Co-Simulation, and sees the same turbulence
+samples as Co-Simulation at any communication step."""
 
 import numpy as np
+import pytest
 from fmpy import read_model_description, simulate_fmu
-from fmu_support import HOVER
+from fmu_support import HOVER, ROTORS, hover, motors
 
 # Wind off, no ground contact in 5 s: a climbing, rolling, drifting flight.
 CALM = {
@@ -20,6 +21,11 @@ CALM = {
 POSITION = ["x", "y", "z"]
 
 
+def calm(model: str) -> dict:
+    """CALM for `model`: its own hover state, every one of its motors at 0.52."""
+    return {**CALM, "initial_motor": hover(model), **dict.fromkeys(motors(model), 0.52)}
+
+
 def model_exchange(fmu, stop: float, start_values: dict, solver="CVode", **options):
     return simulate_fmu(
         str(fmu),
@@ -32,13 +38,15 @@ def model_exchange(fmu, stop: float, start_values: dict, solver="CVode", **optio
     )
 
 
-def core_path(core_trajectory, start_values: dict, h: float, steps: int) -> dict:
+def core_path(
+    core_trajectory, start_values: dict, h: float, steps: int, model: str = "Quadrotor"
+) -> dict:
     """The core stepped directly from Rust with RK4 substeps of at most 1 ms (error ~1e-12)."""
     inputs = {k: v for k, v in start_values.items() if k.startswith("motor_command_")}
     params = {k: v for k, v in start_values.items() if k not in inputs}
     return core_trajectory(
         {
-            "model": "Quadrotor",
+            "model": model,
             "start_values": {**params, "max_substep": 0.001},
             "step_size": h,
             "steps": steps,
@@ -60,10 +68,12 @@ def gap(a, b, names=POSITION) -> float:
     return max(float(np.max(np.abs(np.asarray(a[n]) - np.asarray(b[n])))) for n in names)
 
 
-def test_the_model_description_offers_both_interfaces(fmus):
-    md = read_model_description(str(fmus["Quadrotor"]))
+@pytest.mark.parametrize("model", ROTORS)
+def test_the_model_description_offers_both_interfaces(fmus, model):
+    md = read_model_description(str(fmus[model]))
     assert md.modelExchange is not None and md.coSimulation is not None
-    assert md.numberOfEventIndicators == 4 and md.numberOfContinuousStates == 25
+    states = 13 + ROTORS[model] + 8  # rigid body, one per motor, the bristles
+    assert md.numberOfEventIndicators == 4 and md.numberOfContinuousStates == states
     derivatives = [u.variable for u in md.derivatives]
     assert [d.name for d in derivatives[:3]] == ["der(x)", "der(y)", "der(z)"]
     assert [d.derivative.name for d in derivatives[-2:]] == ["gear_stretch_3_x", "gear_stretch_3_y"]
@@ -71,21 +81,21 @@ def test_the_model_description_offers_both_interfaces(fmus):
     assert lander.modelExchange is None
 
 
-def test_cvode_matches_the_core_and_co_simulation_to_a_micrometre(fmus, core_trajectory):
+@pytest.mark.parametrize("model", ROTORS)
+def test_cvode_matches_the_core_and_co_simulation_to_a_micrometre(fmus, core_trajectory, model):
+    start = calm(model)
     me = on_grid(
-        model_exchange(
-            fmus["Quadrotor"], 5.0, CALM, relative_tolerance=1e-10, output_interval=0.01
-        ),
+        model_exchange(fmus[model], 5.0, start, relative_tolerance=1e-10, output_interval=0.01),
         0.01,
     )
-    core = core_path(core_trajectory, CALM, 0.01, 500)
+    core = core_path(core_trajectory, start, 0.01, 500, model)
     assert len(me) == 501 and np.allclose(me["time"], core["time"], atol=1e-12)
     assert gap(me, core) < 1e-6, gap(me, core)
     cs = simulate_fmu(
-        str(fmus["Quadrotor"]),
+        str(fmus[model]),
         stop_time=5.0,
         output_interval=0.01,
-        start_values=CALM,
+        start_values=start,
         output=POSITION,
     )
     assert gap(me, cs) < 1e-6, gap(me, cs)

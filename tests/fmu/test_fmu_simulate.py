@@ -1,40 +1,41 @@
 """fmpy.simulate_fmu with input tables: the hover command holds altitude, and a step
 input gives exactly the trajectory of the core stepped directly from Rust with the same
-seed."""
+seed — for the quadrotor, the hexacopter (the core's hexa X) and the lander."""
 
 import numpy as np
+import pytest
 from fmpy import read_model_description, simulate_fmu
-from fmu_support import HOVER
-
-MOTORS = [f"motor_command_{i}" for i in range(4)]
+from fmu_support import ROTORS, hover, motors
 
 
 def input_table(names: list[str], rows: list[tuple]) -> np.ndarray:
     return np.array(rows, dtype=[("time", np.float64)] + [(n, np.float64) for n in names])
 
 
-def test_hover_command_holds_altitude(fmus):
+@pytest.mark.parametrize("model", ROTORS)
+def test_hover_command_holds_altitude(fmus, model):
+    n, level = ROTORS[model], hover(model)
     result = simulate_fmu(
-        str(fmus["Quadrotor"]),
+        str(fmus[model]),
         stop_time=5.0,
         output_interval=0.01,
-        start_values={"initial_motor": HOVER, "wind_enabled": False, "initial_z": 2.0},
-        input=input_table(MOTORS, [(0.0, *[HOVER] * 4), (5.0, *[HOVER] * 4)]),
-        output=["x", "y", "z", "vz", "roll", "pitch", "motor_state_0"],
+        start_values={"initial_motor": level, "wind_enabled": False, "initial_z": 2.0},
+        input=input_table(motors(model), [(0.0, *[level] * n), (5.0, *[level] * n)]),
+        output=["x", "y", "z", "vz", "roll", "pitch", f"motor_state_{n - 1}"],
     )
     assert len(result) == 501
     assert np.max(np.abs(result["z"] - 2.0)) < 1e-9
     assert np.max(np.abs(result["vz"])) < 1e-9
     for name in ("x", "y", "roll", "pitch"):
         assert np.max(np.abs(result[name])) < 1e-12, name
-    assert np.allclose(result["motor_state_0"], HOVER, atol=1e-12)
+    assert np.allclose(result[f"motor_state_{n - 1}"], level, atol=1e-12)
     # Without the command the same vehicle falls: the test sees the difference.
     fallen = simulate_fmu(
-        str(fmus["Quadrotor"]),
+        str(fmus[model]),
         stop_time=0.5,
         output_interval=0.01,
-        start_values={"initial_motor": HOVER, "wind_enabled": False, "initial_z": 2.0},
-        input=input_table(MOTORS, [(0.0, *[0.3] * 4), (0.5, *[0.3] * 4)]),
+        start_values={"initial_motor": level, "wind_enabled": False, "initial_z": 2.0},
+        input=input_table(motors(model), [(0.0, *[0.3] * n), (0.5, *[0.3] * n)]),
         output=["z"],
     )
     assert fallen["z"][-1] < 1.9
@@ -81,21 +82,23 @@ def compare(fmu, core_trajectory, model, start_values, names, rows, stop_time, s
     return result, differing
 
 
-def test_quadrotor_step_input_matches_the_core_from_rust(fmus, core_trajectory):
-    high = HOVER + 0.02
-    rows = [
-        (0.0, HOVER, HOVER, HOVER, HOVER),
-        (1.0, HOVER, HOVER, HOVER, HOVER),
-        (1.0, high, HOVER, high, HOVER),
-        (3.0, high, HOVER, high, HOVER),
-    ]
-    start_values = {"seed": 7, "initial_motor": HOVER}
+@pytest.mark.parametrize("model", ROTORS)
+def test_multirotor_step_input_matches_the_core_from_rust(fmus, core_trajectory, model):
+    """Hexacopter.fmu is the core's hexa X (Quadrotor::with_frame) bit for bit, as
+    Quadrotor.fmu is its quad X."""
+    level = hover(model)
+    high = level + 0.02
+    steady = (level,) * ROTORS[model]
+    # Every other motor up: the quad's 0 and 2 (one diagonal), the hexa's 0, 2 and 4.
+    stepped = tuple(high if i % 2 == 0 else level for i in range(ROTORS[model]))
+    rows = [(0.0, *steady), (1.0, *steady), (1.0, *stepped), (3.0, *stepped)]
+    start_values = {"seed": 7, "initial_motor": level}
     result, differing = compare(
-        fmus["Quadrotor"],
+        fmus[model],
         core_trajectory,
-        "Quadrotor",
+        model,
         start_values,
-        MOTORS,
+        motors(model),
         rows,
         3.0,
         0.01,

@@ -5,7 +5,11 @@ import pytest
 from fmpy.fmi1 import FMICallException
 from fmu_support import HOVER, LoggedSlave
 
-INPUT = {"Quadrotor": "motor_command_1", "Lander2D": "motor_command_right"}
+INPUT = {
+    "Quadrotor": "motor_command_1",
+    "Hexacopter": "motor_command_1",
+    "Lander2D": "motor_command_right",
+}
 
 
 def run(instance: LoggedSlave, model: str, t: float, end: float, h: float):
@@ -21,7 +25,7 @@ def run(instance: LoggedSlave, model: str, t: float, end: float, h: float):
     return rows
 
 
-@pytest.fixture(params=["Quadrotor", "Lander2D"])
+@pytest.fixture(params=list(INPUT))
 def started(request, fmus):
     model = request.param
     instance = LoggedSlave(fmus[model])

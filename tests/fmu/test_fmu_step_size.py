@@ -54,7 +54,7 @@ def test_quadrotor_weather_and_path_do_not_depend_on_the_step_size(fmus):
     assert np.hypot(reference["x"][-1], reference["y"][-1]) > 1.0
 
 
-@pytest.mark.parametrize("fmu", ["Quadrotor", "Quadrotor-fmi3"])
+@pytest.mark.parametrize("fmu", ["Quadrotor", "Quadrotor-fmi3", "Hexacopter"])
 def test_a_windy_drop_to_the_ground_is_the_same_at_every_step_size_on_the_grid(fmus, fmu):
     """Dropped from 20 m with the motors off and wind on (seed 11): through the impact and
     the bounces, h = 0.005, 0.01 and 0.02 s give the same positions at every 0.02 s."""

@@ -1,5 +1,5 @@
 """fmpy's validator and fmutool (fmu-manipulation-toolbox: schema and semantic checks) find no
-problem in any of the four FMUs (FMI 2.0 and FMI 3.0); each FMU holds what it should."""
+problem in any of the six FMUs (FMI 2.0 and FMI 3.0); each FMU holds what it should."""
 
 import shutil
 import subprocess
@@ -11,7 +11,8 @@ import pytest
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
-ALL_FMUS = ["Quadrotor", "Lander2D", "Quadrotor-fmi3", "Lander2D-fmi3"]
+MODELS = ["Quadrotor", "Lander2D", "Hexacopter"]
+ALL_FMUS = MODELS + [f"{name}-fmi3" for name in MODELS]
 
 
 @pytest.mark.parametrize("name", ALL_FMUS)
@@ -36,7 +37,7 @@ def test_fmutool_check_finds_the_fmu_compliant(fmus, name):
     assert not [ln for ln in text.splitlines() if "WARNING" in ln or "ERROR" in ln], text
 
 
-@pytest.mark.parametrize("name", ["Quadrotor", "Lander2D"])
+@pytest.mark.parametrize("name", MODELS)
 def test_the_fmu_holds_its_model_description_and_binary(fmus, name):
     with zipfile.ZipFile(fmus[name]) as zf:
         names = set(zf.namelist())
@@ -65,5 +66,26 @@ def test_the_fmu_holds_its_model_description_and_binary(fmus, name):
             "wind_z",
         },
         "Lander2D": {"x", "y", "angle", "battery", "landed", "crashed", "platform_x"},
+        "Hexacopter": {"x", "vz", "az", "qw", "yaw", "motor_state_5", "wind_z"},
     }[name]
     assert expected <= outputs
+
+
+def test_the_hexacopter_has_a_command_and_a_state_per_rotor_after_the_quadrotors_layout(fmus):
+    hexa = read_model_description(str(fmus["Hexacopter"]))
+    quad = read_model_description(str(fmus["Quadrotor"]))
+    vr = {v.name: v.valueReference for v in hexa.modelVariables}
+    inputs = [v.name for v in hexa.modelVariables if v.causality == "input"]
+    assert inputs == [f"motor_command_{i}" for i in range(6)] + [
+        "wind_input_x",
+        "wind_input_y",
+        "wind_input_z",
+    ]
+    assert [vr[f"motor_state_{i}"] for i in (0, 5)] == [119, 124]
+    assert hexa.numberOfContinuousStates == 27 and hexa.numberOfEventIndicators == 4
+    # The same parameters and start values under the same value references.
+    params = {(v.name, v.valueReference) for v in quad.modelVariables if v.causality == "parameter"}
+    assert params == {
+        (v.name, v.valueReference) for v in hexa.modelVariables if v.causality == "parameter"
+    }
+    assert hexa.guid != quad.guid

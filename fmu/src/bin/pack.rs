@@ -1,5 +1,6 @@
-//! flyloop-fmu-pack: writes Quadrotor.fmu and Lander2D.fmu (FMI 2.0), Quadrotor-fmi3.fmu and
-//! Lander2D-fmi3.fmu (FMI 3.0), or the checked-in modelDescription copies of all four.
+//! flyloop-fmu-pack: writes every FMU of the library — Quadrotor.fmu, Lander2D.fmu and
+//! Hexacopter.fmu (FMI 2.0) and their `-fmi3.fmu` twins (FMI 3.0) — or the checked-in
+//! modelDescription copies of all six.
 //!
 //! ```text
 //! flyloop-fmu-pack fmus <libflyloop_fmu.so> <out-dir>
