@@ -2,9 +2,10 @@
 //! declaration (a name, and for the multirotor its frame) whose table is built on first use.
 
 mod lander2d;
+mod multirotor;
 mod quadrotor;
 
-pub use quadrotor::Multirotor;
+pub use multirotor::Multirotor;
 
 use crate::api::Api;
 use crate::engine::{Engine, Simulation};
