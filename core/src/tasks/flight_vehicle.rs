@@ -20,6 +20,7 @@
 //! the episode's own, so the same seed gives the same noise.
 
 use super::flight::{BASE_OBSERVATION, BASE_OBSERVATION_SIZE, base_bounds, write_base_observation};
+use super::flight_faults::FlightFaults;
 use super::randomization::{Randomization, VehicleParams};
 use crate::error::ParamError;
 use crate::frames::{attitude_ned, enu_to_ned, flu_to_frd};
@@ -59,6 +60,8 @@ pub struct FlightVehicle {
     flight: super::flight::FlightParams,
     quad: Quadrotor,
     rates: Option<RatesLink>,
+    /// The episode's faults (`None`: a healthy vehicle, stepped exactly as without faults).
+    faults: Option<FlightFaults>,
 }
 
 /// The rates interface's state.
@@ -118,7 +121,16 @@ impl FlightVehicle {
         } else {
             None
         };
+        let faults = if nominal.faults.is_empty() {
+            None
+        } else {
+            let f = &nominal.flight;
+            let duration = f64::from(f.max_steps) * f.dt;
+            let rotors = quad.frame().rotor_count();
+            Some(FlightFaults::new(nominal.faults.clone(), rotors, duration)?)
+        };
         Ok(FlightVehicle {
+            faults,
             flight: nominal.flight.clone(),
             nominal,
             randomization,
@@ -166,6 +178,19 @@ impl FlightVehicle {
             link.noise = SimRng::new(seed ^ NOISE_STREAM);
             link.estimate = estimate(&self.quad, &self.flight, &mut link.noise);
         }
+        if let Some(faults) = &mut self.faults {
+            faults.restart(seed, &mut self.quad, self.flight.dt);
+        }
+    }
+
+    /// The episode's faults, if the vehicle has any.
+    pub fn faults(&self) -> Option<&FlightFaults> {
+        self.faults.as_ref()
+    }
+
+    /// Mutable access to the faults (the task's waypoint, run-time injection).
+    pub fn faults_mut(&mut self) -> Option<&mut FlightFaults> {
+        self.faults.as_mut()
     }
 
     pub fn quadrotor(&self) -> &Quadrotor {
@@ -197,10 +222,15 @@ impl FlightVehicle {
         check_action(action, 4)?;
         let (lo, hi) = self.action_bounds();
         let a: [f64; 4] = std::array::from_fn(|i| action[i].clamp(lo[i], hi[i]));
+        if let Some(faults) = &mut self.faults {
+            faults.begin_step(&mut self.quad, dt);
+        }
         let Some(link) = &mut self.rates else {
             // Finite and clipped, so the motors accept it.
-            let _ = self.quad.set_command(a);
-            self.quad.step(dt);
+            drive(&mut self.quad, self.faults.as_mut(), &a, dt);
+            if let Some(faults) = &mut self.faults {
+                faults.end_step();
+            }
             return Ok(());
         };
         let period = link.rate_loop.params().rate_loop_period;
@@ -220,7 +250,8 @@ impl FlightVehicle {
                 break;
             }
             if tick > now {
-                self.quad.step(tick - now);
+                let held = held_command(&self.quad);
+                drive(&mut self.quad, self.faults.as_mut(), &held, tick - now);
                 now = tick;
             }
             while let Some(&(at, sp)) = link.pending.front() {
@@ -236,7 +267,11 @@ impl FlightVehicle {
             link.ticks += 1;
         }
         if end > now {
-            self.quad.step(end - now);
+            let held = held_command(&self.quad);
+            drive(&mut self.quad, self.faults.as_mut(), &held, end - now);
+        }
+        if let Some(faults) = &mut self.faults {
+            faults.end_step();
         }
         link.steps += 1;
         link.estimate = estimate(&self.quad, &self.flight, &mut link.noise);
@@ -326,10 +361,33 @@ impl FlightVehicle {
         (lo, hi)
     }
 
-    /// Info entries of the vehicle: the values drawn this episode, when randomised.
+    /// Info entries of the vehicle: the values drawn this episode, when randomised; the
+    /// faults' slots, when it has faults ([`FlightFaults::visit_info`]).
     pub fn visit_info(&self, visit: &mut InfoVisitor<'_>) {
         if !self.randomization.is_off() {
             visit("randomized", InfoRef::Vector(&self.drawn));
+        }
+        if let Some(faults) = &self.faults {
+            faults.visit_info(visit);
+        }
+    }
+}
+
+/// The four motor commands the vehicle holds.
+fn held_command(quad: &Quadrotor) -> [f64; 4] {
+    let c = quad.command();
+    std::array::from_fn(|i| c.get(i).copied().unwrap_or(0.0))
+}
+
+/// Commands and advances the vehicle by `dt`: through the fault paths when it has faults,
+/// else exactly as a healthy vehicle steps.
+fn drive(quad: &mut Quadrotor, faults: Option<&mut FlightFaults>, command: &[f64; 4], dt: f64) {
+    match faults {
+        Some(f) => f.drive(quad, command, dt),
+        None => {
+            // Finite and clipped, so the motors accept it.
+            let _ = quad.set_command(command);
+            quad.step(dt);
         }
     }
 }

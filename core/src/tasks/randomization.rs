@@ -8,6 +8,7 @@
 //! target, wind — are the same with or without randomisation).
 
 use crate::error::ParamError;
+use crate::faults::FaultPlan;
 use crate::number::Compact;
 use crate::params::{ParamSpec, Parameters, ValueKind};
 use crate::quadrotor::QuadrotorParams;
@@ -48,6 +49,9 @@ pub struct VehicleParams {
     pub quadrotor: QuadrotorParams,
     pub rate_loop: RateLoopParams,
     pub flight: FlightParams,
+    /// The vehicle's faults (empty: healthy). Not randomised by ranges: its own
+    /// `[[fault_randomization]]` draws them ([`crate::faults`]).
+    pub faults: FaultPlan,
 }
 
 /// Where a named parameter lives.

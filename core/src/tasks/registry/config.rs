@@ -1,5 +1,6 @@
 //! Every parameter set a task is built from.
 
+use crate::faults::FaultPlan;
 use crate::lander2d::Lander2dParams;
 use crate::quadrotor::QuadrotorParams;
 use crate::rate_loop::RateLoopParams;
@@ -21,6 +22,8 @@ pub struct TaskConfig {
     pub landing: LandingParams,
     /// Per-episode ranges of the flight tasks' vehicle parameters (empty: off).
     pub randomize: Randomization,
+    /// The flight tasks' faults (`[[faults]]`, `[[fault_randomization]]`; empty: none).
+    pub faults: FaultPlan,
 }
 
 impl TaskConfig {
@@ -30,6 +33,7 @@ impl TaskConfig {
             quadrotor: self.quadrotor.clone(),
             rate_loop: self.rate_loop.clone(),
             flight: self.flight.clone(),
+            faults: self.faults.clone(),
         }
     }
 }

@@ -4,6 +4,7 @@
 use super::param_rows::{self, Group, ParamEntry};
 use super::{ModelKind, TaskConfig, TaskInstance, TaskKind};
 use crate::ParamError;
+use crate::faults::{FaultPlan, Reach};
 use crate::params::Parameters;
 use crate::tasks::randomization::{ParamRange, Randomization};
 
@@ -24,6 +25,18 @@ pub fn from_values_and_ranges<'a>(
     task: TaskKind,
     pairs: impl IntoIterator<Item = (&'a str, f64)>,
     ranges: Vec<ParamRange>,
+) -> Result<TaskConfig, ParamError> {
+    from_values_ranges_and_faults(task, pairs, ranges, FaultPlan::default())
+}
+
+/// [`from_values_and_ranges`] with a fault plan (flight tasks only), checked against the
+/// task: a motor the frame lacks, a trigger that can never fire in its episodes (past
+/// `max_steps · dt`, a waypoint index it does not have) is refused.
+pub fn from_values_ranges_and_faults<'a>(
+    task: TaskKind,
+    pairs: impl IntoIterator<Item = (&'a str, f64)>,
+    ranges: Vec<ParamRange>,
+    faults: FaultPlan,
 ) -> Result<TaskConfig, ParamError> {
     let entries = param_rows::entries(task);
     let mut values: Vec<(ParamEntry, f64)> = Vec::new();
@@ -55,6 +68,21 @@ pub fn from_values_and_ranges<'a>(
             )));
         }
         config.randomize = Randomization::new(ranges)?;
+    }
+    if !faults.is_empty() {
+        if task.model() != ModelKind::Quadrotor {
+            return Err(ParamError::Parse(format!(
+                "task `{}` has no faults; the flight tasks (hover, waypoints) do",
+                task.frame_name()
+            )));
+        }
+        let f = &config.flight;
+        faults.check(&Reach {
+            duration: Some(f64::from(f.max_steps) * f.dt),
+            waypoints: (task == TaskKind::Waypoints).then_some(config.waypoints.max_num_waypoints),
+            rotors: 4,
+        })?;
+        config.faults = faults;
     }
     TaskInstance::build(task, &config)?;
     Ok(config)
