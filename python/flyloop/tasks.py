@@ -14,7 +14,7 @@ import difflib
 import functools
 import math
 import numbers
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,6 +22,7 @@ import numpy as np
 
 from . import _native
 from .errors import SitlParameterError
+from .faults import FAULTS_KEY, mentions_fault, plan_text
 
 # ---- argument conversion: seed names and Python values -> core names and numbers ----
 
@@ -194,6 +195,17 @@ FLIGHT_RENAMED = (
         Mapping[str, tuple[float, float]] | None,
         "domain randomisation: {core parameter: (low, high)} drawn per episode from its seed",
     ),
+    _renamed(
+        "faults", (), lambda a, v: (), lambda d: None, Sequence[Mapping[str, Any]] | None,
+        "faults (docs/faults.md): dicts with kind, motor (1 = first, 0 = all) or sensor, "
+        "parameters, one trigger (at, above_height, after_takeoff, at_waypoint), duration",
+    ),
+    _renamed(
+        "fault_randomization", (), lambda a, v: (), lambda d: None,
+        Mapping[str, Any] | Sequence[Mapping[str, Any]] | None,
+        "faults drawn per episode from its seed: kinds, probability, at, motor, sensors, "
+        "duration and (low, high) ranges of the kinds' parameters",
+    ),
 )  # fmt: skip
 LANDING_RENAMED = (
     _USE_WIND,
@@ -301,7 +313,13 @@ class TaskSpec:
         observation and action bounds, dt, info layout, parameters with their `value`.
         A value the core refuses raises SitlParameterError naming the env argument."""
         values = {
-            k: (tuple(map(float, v)) if k.startswith(RANGE_PREFIX) else float(v))
+            k: (
+                v
+                if k == FAULTS_KEY
+                else tuple(map(float, v))
+                if k.startswith(RANGE_PREFIX)
+                else float(v)
+            )
             for k, v in config.items()
         }
         try:
@@ -363,8 +381,13 @@ def resolve_config(
         if name == "randomize":
             config.update(randomize_entries(name, value))
             continue
+        if name in ("faults", "fault_randomization"):
+            continue
         for core, v in zip(arg.core, arg.convert(name, value), strict=True):
             config[core] = v
+    text = plan_text(arguments.get("faults"), arguments.get("fault_randomization"))
+    if text is not None:
+        config[FAULTS_KEY] = text
     extra = dict(model_params or {})
     for name, value in extra.items():
         if name not in spec.model_params:
@@ -408,6 +431,8 @@ def parameter_error(spec: TaskSpec, message: str) -> SitlParameterError:
     where = ", ".join(argument_for(spec, n) for n in names) or "an argument"
     if "randomisation" in lead:
         where = "randomize"
+    elif not names and mentions_fault(lead):
+        where = "faults / fault_randomization"
     return SitlParameterError(f"{spec.env_id}: {where} refused by the core: {lead}")
 
 
@@ -420,7 +445,7 @@ def to_toml(config: Mapping[str, Any]) -> str:
         for k, (lo, hi) in ((k, v) for k, v in config.items() if k.startswith(RANGE_PREFIX))
     ]
     for name, v in config.items():
-        if name.startswith(RANGE_PREFIX):
+        if name.startswith(RANGE_PREFIX) or name == FAULTS_KEY:
             continue
         if isinstance(v, bool):
             text = "true" if v else "false"
@@ -431,4 +456,6 @@ def to_toml(config: Mapping[str, Any]) -> str:
         lines.append(f"{name} = {text}")
     if ranges:
         lines += ["", "[randomize]", *ranges]
+    if FAULTS_KEY in config:
+        lines += ["", config[FAULTS_KEY]]
     return "\n".join(lines) + "\n"
