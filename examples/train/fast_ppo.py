@@ -48,7 +48,7 @@ import gymnasium as gym  # noqa: E402
 import numpy as np  # noqa: E402
 import torch  # noqa: E402
 from torch import nn  # noqa: E402
-from training_envs import HOVER_SUCCESS_DISTANCE_M, preset  # noqa: E402
+from training_envs import FRAMES, HOVER_SUCCESS_DISTANCE_M, preset  # noqa: E402
 
 EVAL_SEED = 1_000_000
 # The validation episodes that choose the policy a run keeps (Config.select_every): disjoint
@@ -162,6 +162,17 @@ TASKS: dict[str, Task] = {
     "hover": Task(
         "hover", Config(), timesteps=300_000, eval_episodes=100, title="PPO on QuadHover-v0"
     ),
+    # QuadHover on the other frames (--frame): the quad's settings, one output per rotor.
+    **{
+        f"hover_{frame}": Task(
+            f"hover_{frame}",
+            Config(),
+            timesteps=300_000,
+            eval_episodes=100,
+            title=f"PPO on QuadHover-v0, frame {frame}",
+        )
+        for frame in FRAMES
+    },
     "lander": Task(
         "lander",
         LANDER,
@@ -803,12 +814,22 @@ def main(argv: list[str] | None = None) -> int:
         metavar="KEY=VALUE",
         help="override one of the task's PPO settings (Config), e.g. --set epochs=4",
     )
+    parser.add_argument(
+        "--frame",
+        default="quad_x",
+        choices=("quad_x", *FRAMES),
+        help="the multirotor of --env hover (the core's rotor tables; default the quad X)",
+    )
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--eval-episodes", type=int, help="default: the task's")
     parser.add_argument("--out", type=Path, default=Path("runs/fast_ppo"))
     parser.add_argument("--curve", type=Path, help="also draw the learning curve to this file")
     parser.add_argument("--no-progress-bar", action="store_true")
     args = parser.parse_args(argv)
+    if args.frame != "quad_x":
+        if args.env != "hover":
+            parser.error(f"--frame {args.frame} flies --env hover only")
+        args.env = f"hover_{args.frame}"
     task = TASKS[args.env]
     if args.timesteps is None:
         args.timesteps = task.timesteps

@@ -17,7 +17,7 @@ RLlib (train_rllib.py), so a model is always evaluated on the env it was trained
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -169,6 +169,17 @@ PRESETS: dict[str, Preset] = {
         success_text="landed on the platform (info['landed'])",
     ),
 }
+
+
+# QuadHover on another of the core's frames (fast_ppo.py --frame): the hover preset with the
+# env's `frame`, one motor command per rotor. The quad X is "hover" itself.
+FRAMES = ("quad_plus", "hexa_x", "octo_x")
+for _frame in FRAMES:
+    PRESETS[f"hover_{_frame}"] = replace(
+        PRESETS["hover"],
+        name=f"hover_{_frame}",
+        env_kwargs={**PRESETS["hover"].env_kwargs, "frame": _frame},
+    )
 
 
 def offboard_preset() -> Preset:

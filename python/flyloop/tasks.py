@@ -159,6 +159,26 @@ def randomize_entries(arg: str, v: Any) -> dict[str, tuple[float, float]]:
     return out
 
 
+# The config key naming the flight tasks' rotor table (a shipped frame of the core's): the
+# native extension reads it so, and to_toml writes it as the SITL's [frame] table.
+FRAME_KEY = "frame"
+
+
+def _frame_names() -> tuple[str, ...]:
+    return tuple(_native.frames())
+
+
+def frame_entry(arg: str, v: Any) -> dict[str, str]:
+    """`frame="hexa_x"` as a config entry; an unknown name raises ValueError listing the
+    core's shipped frames."""
+    names = _frame_names()
+    if not isinstance(v, str):
+        raise TypeError(f"{arg} must be a frame name, one of {list(names)}, got {v!r}")
+    if v not in names:
+        raise ValueError(f"{arg} must be one of {list(names)}, got {v!r}")
+    return {FRAME_KEY: v}
+
+
 # The seeds' arguments whose name or form differs from the core's parameters, mapped by
 # hand; every other argument is a core parameter under its own name (`own_argument`).
 _USE_WIND = _renamed(
@@ -193,6 +213,11 @@ FLIGHT_RENAMED = (
         "randomize", (), randomize_entries, lambda d: None,
         Mapping[str, tuple[float, float]] | None,
         "domain randomisation: {core parameter: (low, high)} drawn per episode from its seed",
+    ),
+    _renamed(
+        "frame", (), frame_entry, lambda d: "quad_x", str,
+        "the multirotor's rotor table: 'quad_x', 'quad_plus', 'hexa_x' or 'octo_x' (the "
+        "motor interface takes one command per rotor)",
     ),
 )  # fmt: skip
 LANDING_RENAMED = (
@@ -301,7 +326,13 @@ class TaskSpec:
         observation and action bounds, dt, info layout, parameters with their `value`.
         A value the core refuses raises SitlParameterError naming the env argument."""
         values = {
-            k: (tuple(map(float, v)) if k.startswith(RANGE_PREFIX) else float(v))
+            k: (
+                v
+                if k == FRAME_KEY
+                else tuple(map(float, v))
+                if k.startswith(RANGE_PREFIX)
+                else float(v)
+            )
             for k, v in config.items()
         }
         try:
@@ -363,6 +394,9 @@ def resolve_config(
         if name == "randomize":
             config.update(randomize_entries(name, value))
             continue
+        if name == FRAME_KEY:
+            config.update(frame_entry(name, value))
+            continue
         for core, v in zip(arg.core, arg.convert(name, value), strict=True):
             config[core] = v
     extra = dict(model_params or {})
@@ -412,15 +446,15 @@ def parameter_error(spec: TaskSpec, message: str) -> SitlParameterError:
 
 
 def to_toml(config: Mapping[str, Any]) -> str:
-    """The SITL's --config file: a flat TOML table, and the randomisation ranges in its
-    [randomize] table."""
+    """The SITL's --config file: a flat TOML table, the randomisation ranges in its
+    [randomize] table and the frame in its [frame] table."""
     lines = []
     ranges = [
         f"{k[len(RANGE_PREFIX) :]} = [{float(lo)!r}, {float(hi)!r}]"
         for k, (lo, hi) in ((k, v) for k, v in config.items() if k.startswith(RANGE_PREFIX))
     ]
     for name, v in config.items():
-        if name.startswith(RANGE_PREFIX):
+        if name.startswith(RANGE_PREFIX) or name == FRAME_KEY:
             continue
         if isinstance(v, bool):
             text = "true" if v else "false"
@@ -431,4 +465,6 @@ def to_toml(config: Mapping[str, Any]) -> str:
         lines.append(f"{name} = {text}")
     if ranges:
         lines += ["", "[randomize]", *ranges]
+    if FRAME_KEY in config:
+        lines += ["", f"[{FRAME_KEY}]", f'name = "{config[FRAME_KEY]}"']
     return "\n".join(lines) + "\n"

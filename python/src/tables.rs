@@ -7,7 +7,9 @@ use flyloop_core::quadrotor::frame::shipped_names;
 use flyloop_core::tasks::InfoValue;
 use flyloop_core::tasks::randomization::ParamRange;
 use flyloop_core::tasks::registry::param_rows;
-use flyloop_core::tasks::registry::{TaskConfig, TaskInstance, TaskKind, from_values_and_ranges};
+use flyloop_core::tasks::registry::{
+    ModelKind, TaskConfig, TaskInstance, TaskKind, from_values_and_ranges,
+};
 use numpy::PyArray1;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -33,11 +35,16 @@ const RANGE_PREFIX: &str = "randomize.";
 pub fn task_config(task: TaskKind, params: Option<&Bound<'_, PyDict>>) -> PyResult<TaskConfig> {
     let mut pairs: Vec<(String, f64)> = Vec::new();
     let mut ranges = Vec::new();
+    let mut frame = None;
     if let Some(params) = params {
         for (key, value) in params.iter() {
             let name: String = key.extract().map_err(|_| {
                 PyTypeError::new_err(format!("parameter names are strings, got {key}"))
             })?;
+            if name == FRAME_KEY {
+                frame = Some(frame_named(&value)?);
+                continue;
+            }
             if let Some(param) = name.strip_prefix(RANGE_PREFIX) {
                 let (low, high): (f64, f64) = value.extract().map_err(|_| {
                     PyTypeError::new_err(format!(
@@ -59,8 +66,29 @@ pub fn task_config(task: TaskKind, params: Option<&Bound<'_, PyDict>>) -> PyResu
             pairs.push((name, number));
         }
     }
-    from_values_and_ranges(task, pairs.iter().map(|(k, v)| (k.as_str(), *v)), ranges)
-        .map_err(|e| PyValueError::new_err(e.to_string()))
+    from_values_and_ranges(
+        task,
+        pairs.iter().map(|(k, v)| (k.as_str(), *v)),
+        ranges,
+        frame,
+    )
+    .map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// The config key that names the flight tasks' frame: `"frame": "hexa_x"` (the SITL's config
+/// file has it as its `[frame]` table).
+const FRAME_KEY: &str = "frame";
+
+/// The shipped frame named by `value`; the error lists the names.
+fn frame_named(value: &Bound<'_, PyAny>) -> PyResult<Frame> {
+    let names = shipped_names().collect::<Vec<_>>().join("', '");
+    let name: String = value.extract().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "frame must be a frame name ('{names}'), got {value}"
+        ))
+    })?;
+    Frame::named(&name)
+        .map_err(|_| PyValueError::new_err(format!("frame must be one of '{names}', got {name:?}")))
 }
 
 fn kind_name(kind: ValueKind) -> &'static str {
@@ -89,7 +117,8 @@ pub fn info_layout(task: &TaskInstance) -> Vec<(&'static str, &'static str, usiz
 /// `observation_low`/`observation_high` (float32 arrays), `observation` (its layout: list of
 /// (name, count)), `action_low`/`action_high` (float64), `dt` (s), `info` (list of (name,
 /// kind, count)), `parameters` (list of dicts: name, id, group, kind, unit, min, max,
-/// default, value, description), `model`, `task`.
+/// default, value, description), `model`, `task`, and for the flight tasks `frame` (its name)
+/// and `rotors` (its rotor count).
 #[pyfunction]
 #[pyo3(signature = (task, params=None))]
 pub fn describe<'py>(
@@ -113,6 +142,10 @@ pub fn describe<'py>(
     out.set_item("observation", instance.observation_layout())?;
     out.set_item("dt", instance.dt())?;
     out.set_item("info", info_layout(&instance))?;
+    if kind.model() == ModelKind::Quadrotor {
+        out.set_item("frame", config.frame.name())?;
+        out.set_item("rotors", config.frame.rotor_count())?;
+    }
     let defaults = TaskConfig::default();
     let rows = PyList::empty(py);
     for e in param_rows::entries(kind) {

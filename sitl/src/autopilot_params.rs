@@ -3,13 +3,15 @@
 //! autopilot always agree on where each motor is and which way it turns.
 //!
 //! PX4 takes any multirotor as a table (`CA_ROTORn_PX/PY/KM/CT`, body FRD, metres): the
-//! frame's rotors are written out, motor n on output n (`PWM_MAIN_FUNCn = 100 + n`, which
+//! core's [`px4_rotors`] of the frame (what the rate-loop model mixes for too; the quad X's are
+//! PX4's stock none_iris values, which PX4 flies it with), motor n on output n (`PWM_MAIN_FUNCn = 100 + n`, which
 //! PX4's simulator link sends as HIL_ACTUATOR_CONTROLS controls[n − 1]). ArduPilot mixes only
 //! its own frame classes (AP_MotorsMatrix): the shipped frames are its quad X and plus, hexa X
 //! and octo X, whose motor order is the table's (checked against AP_MotorsMatrix's motor
 //! angles in this module's tests), and a frame it has no class for is refused.
 
 use flyloop_core::quadrotor::{Frame, QuadrotorParams};
+use flyloop_core::rate_loop::px4_rotors;
 use std::fmt::Write;
 
 /// Which autopilot's parameters to print.
@@ -42,17 +44,12 @@ pub fn px4(frame: &Frame, params: &QuadrotorParams) -> String {
         px4_mav_type(frame.rotor_count()).to_string(),
     );
     line("CA_ROTOR_COUNT".into(), frame.rotor_count().to_string());
-    for (i, r) in frame.rotors().iter().enumerate() {
-        // Body FRD: x forward as FLU's, y right = −FLU's y.
-        line(format!("CA_ROTOR{i}_PX"), round(params.arm_length * r.x));
-        line(format!("CA_ROTOR{i}_PY"), round(-params.arm_length * r.y));
-        // KM: torque per thrust, positive for a counter-clockwise rotor.
-        let km = r
-            .torque_coefficient
-            .unwrap_or(params.yaw_torque_coefficient);
-        line(format!("CA_ROTOR{i}_KM"), round(-r.spin.sign() * km));
-        let ct = r.thrust_coefficient.unwrap_or(params.thrust_coefficient);
-        line(format!("CA_ROTOR{i}_CT"), round(ct));
+    // The same rotors the core's rate-loop model mixes for (the quad X: PX4's stock none_iris).
+    for (i, r) in px4_rotors(frame, params).iter().enumerate() {
+        line(format!("CA_ROTOR{i}_PX"), round(r.px));
+        line(format!("CA_ROTOR{i}_PY"), round(r.py));
+        line(format!("CA_ROTOR{i}_KM"), round(r.km));
+        line(format!("CA_ROTOR{i}_CT"), round(r.ct));
     }
     for n in 1..=frame.rotor_count() {
         line(format!("PWM_MAIN_FUNC{n}"), (100 + n).to_string());
@@ -152,6 +149,24 @@ mod tests {
         );
         assert!(octo.contains("MAV_TYPE 14\n") && octo.contains("PWM_MAIN_FUNC8 108\n"));
         assert!(hexa.contains("CA_ROTOR_COUNT 6\n") && hexa.contains("CA_ROTOR5_CT 10\n"));
+    }
+
+    /// The quad X is what PX4 flies it with: its stock none_iris rotors (the numbers the
+    /// core's rate-loop model mixes for).
+    #[test]
+    fn the_quad_x_prints_px4s_none_iris_rotors() {
+        let text = px4(&Frame::quad_x(), &QuadrotorParams::default());
+        for line in [
+            "CA_ROTOR_COUNT 4",
+            "CA_ROTOR0_PX 0.1515",
+            "CA_ROTOR0_PY 0.245",
+            "CA_ROTOR0_KM 0.05",
+            "CA_ROTOR1_PY -0.1875",
+            "CA_ROTOR3_KM -0.05",
+            "CA_ROTOR3_CT 6.5",
+        ] {
+            assert!(text.contains(&format!("{line}\n")), "{line} in {text}");
+        }
     }
 
     fn check(text: &str, expected: &[(f64, f64, f64)]) {

@@ -1,6 +1,7 @@
 //! The vehicle a flight task flies, and how actions reach it.
 //!
-//! **Motor interface** (the default): the action is the four motor commands in [0, 1].
+//! **Motor interface** (the default): the action is the motor commands in [0, 1], one per
+//! rotor of the vehicle's frame in its motor order (four on the quad X, six on `hexa_x`).
 //!
 //! **Rates interface** (`rates_action`): the action is what a policy sends PX4 in offboard
 //! mode — [collective thrust in [0, 1] (PX4's normalised thrust), roll, pitch, yaw rate in
@@ -9,7 +10,9 @@
 //! (ticks at k·period from the episode start), each tick reading the gyro (the true body
 //! rates) and the setpoint in effect; an action takes effect `action_latency` after its
 //! step starts; the motors hold their outputs between ticks. The rate loop assumes the
-//! vehicle is flying (integrator on), as PX4's land detector says once airborne.
+//! vehicle is flying (integrator on), as PX4's land detector says once airborne. It mixes for
+//! the frame as PX4 would ([`crate::rate_loop::px4_rotors`]), so the rates action has four
+//! values on every frame.
 //!
 //! The rates interface observes what an autopilot's estimator gives (16 × f32), in PX4's
 //! frames turned by the vehicle's heading: the *heading frame* is world NED rotated by the
@@ -19,12 +22,13 @@
 //! applied (clipped). Optional Gaussian noise (`obs_noise_*`) is drawn from a generator of
 //! the episode's own, so the same seed gives the same noise.
 
-use super::flight::{BASE_OBSERVATION, BASE_OBSERVATION_SIZE, base_bounds, write_base_observation};
+use super::flight::{base_bounds, base_observation, write_base_observation};
 use super::randomization::{Randomization, VehicleParams};
 use crate::error::ParamError;
 use crate::frames::{attitude_ned, enu_to_ned, flu_to_frd};
 use crate::params::Parameters;
-use crate::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
+use crate::quadrotor::model::hover_motor_state;
+use crate::quadrotor::{BodyState, Quadrotor};
 use crate::rate_loop::{RateLoop, RatesSetpoint};
 use crate::rng::SimRng;
 use crate::tasks::{ActionError, InfoRef, InfoVisitor, check_action};
@@ -48,7 +52,7 @@ const NOISE_STREAM: u64 = 0x0b5e_7e57_1a7e_0002;
 /// Times closer than this are the same instant on the rate loop's grid, s.
 const TIME_TOLERANCE: f64 = 1e-9;
 
-/// A quadrotor with its action interface and per-episode randomisation.
+/// A multirotor with its action interface and per-episode randomisation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FlightVehicle {
     nominal: VehicleParams,
@@ -97,10 +101,11 @@ impl FlightVehicle {
         nominal.flight.validate()?;
         randomization.check(&nominal)?;
         let body = BodyState::at_rest(Vector3::zeros(), 0.0, 0.0, 0.0, 0.0);
-        let quad = Quadrotor::new(nominal.quadrotor.clone(), body, SimRng::new(0))?;
+        let quad = Quadrotor::new(nominal.quadrotor.clone(), body, SimRng::new(0))?
+            .with_frame(nominal.frame.clone());
         let rates = if nominal.flight.rates_action {
             Some(RatesLink {
-                rate_loop: RateLoop::new(nominal.rate_loop.clone())?,
+                rate_loop: RateLoop::new(nominal.rate_loop.clone(), &nominal.mixer())?,
                 pending: VecDeque::new(),
                 current: RatesSetpoint::default(),
                 last_action: [0.0; 4],
@@ -129,29 +134,50 @@ impl FlightVehicle {
     }
 
     /// Draws the vehicle of the episode with `seed` (nominal when randomisation is off) and
-    /// returns its quadrotor parameters, for the task to sample its start from.
-    pub fn draw(&mut self, seed: u64) -> &QuadrotorParams {
+    /// returns its hover motor state (0 if it cannot hover), for the task's start.
+    pub fn draw(&mut self, seed: u64) -> f64 {
         let (params, drawn) = self.randomization.draw(&self.nominal, seed);
         self.drawn = drawn;
         self.quad.params = params.quadrotor;
         self.flight = params.flight;
         if let Some(link) = &mut self.rates {
-            // Both corners of every range build (checked in `new`); a draw between them
-            // that did not would keep the nominal loop.
-            if let Ok(rate_loop) = RateLoop::new(params.rate_loop) {
+            // PX4's mixer is set up for the nominal vehicle (its CA_ROTOR* do not follow
+            // a drawn arm length). Both corners of every range build (checked in `new`); a
+            // draw between them that did not would keep the nominal loop.
+            let mixer = self.nominal.mixer();
+            if let Ok(rate_loop) = RateLoop::new(params.rate_loop, &mixer) {
                 link.rate_loop = rate_loop;
-            } else if let Ok(rate_loop) = RateLoop::new(self.nominal.rate_loop.clone()) {
+            } else if let Ok(rate_loop) = RateLoop::new(self.nominal.rate_loop.clone(), &mixer) {
                 link.rate_loop = rate_loop;
             }
         }
-        &self.quad.params
+        self.hover_motor_state()
+    }
+
+    /// Motor state at which the vehicle of this episode hovers (0 if it cannot).
+    fn hover_motor_state(&self) -> f64 {
+        hover_motor_state(&self.quad.params, self.quad.frame()).unwrap_or(0.0)
+    }
+
+    /// Number of rotors (motor commands of the motor interface).
+    pub fn rotor_count(&self) -> usize {
+        self.quad.frame().rotor_count()
+    }
+
+    /// Number of action values: one per rotor (motor interface) or four (rates interface).
+    pub fn action_size(&self) -> usize {
+        if self.rates.is_some() {
+            4
+        } else {
+            self.rotor_count()
+        }
     }
 
     /// Starts the episode (after [`FlightVehicle::draw`]) at `body` with the episode's
     /// generator `rng`; `seed` seeds the observation noise.
     pub fn restart(&mut self, body: BodyState, rng: SimRng, seed: u64) {
         self.quad.restart(body, rng);
-        let hover = self.quad.params.hover_motor_state().unwrap_or(0.0);
+        let hover = self.hover_motor_state();
         if let Some(link) = &mut self.rates {
             link.rate_loop
                 .reset(&flu_to_frd(&self.quad.body.body_rates));
@@ -188,21 +214,25 @@ impl FlightVehicle {
             let (rp, y) = (p.roll_pitch_rate_max, p.yaw_rate_max);
             (vec![0.0, -rp, -rp, -y], vec![1.0, rp, rp, y])
         } else {
-            (vec![0.0; 4], vec![1.0; 4])
+            let n = self.rotor_count();
+            (vec![0.0; n], vec![1.0; n])
         }
     }
 
-    /// Applies a 4-value action (clipped into the bounds) for `dt` seconds.
+    /// Applies an action of [`FlightVehicle::action_size`] values (clipped into the bounds)
+    /// for `dt` seconds.
     pub fn apply(&mut self, action: &[f64], dt: f64) -> Result<(), ActionError> {
-        check_action(action, 4)?;
-        let (lo, hi) = self.action_bounds();
-        let a: [f64; 4] = std::array::from_fn(|i| action[i].clamp(lo[i], hi[i]));
+        check_action(action, self.action_size())?;
         let Some(link) = &mut self.rates else {
-            // Finite and clipped, so the motors accept it.
-            let _ = self.quad.set_command(a);
+            // Finite and clipped into [0, 1] by the motors, as the bounds say.
+            let _ = self.quad.set_command(action);
             self.quad.step(dt);
             return Ok(());
         };
+        let p = &self.nominal.rate_loop;
+        let (rp, y) = (p.roll_pitch_rate_max, p.yaw_rate_max);
+        let (lo, hi) = ([0.0, -rp, -rp, -y], [1.0, rp, rp, y]);
+        let a: [f64; 4] = std::array::from_fn(|i| action[i].clamp(lo[i], hi[i]));
         let period = link.rate_loop.params().rate_loop_period;
         let start = link.steps as f64 * dt;
         let end = (link.steps + 1) as f64 * dt;
@@ -232,7 +262,7 @@ impl FlightVehicle {
             }
             let gyro = flu_to_frd(&self.quad.body.body_rates);
             let motors = link.rate_loop.step(&link.current, &gyro, false);
-            let _ = self.quad.set_command(motors);
+            let _ = self.quad.set_command(&motors[..]);
             link.ticks += 1;
         }
         if end > now {
@@ -257,11 +287,7 @@ impl FlightVehicle {
 
     /// Number of values of the interface's observation.
     pub fn observation_size(&self) -> usize {
-        if self.rates.is_some() {
-            ESTIMATE_OBSERVATION_SIZE
-        } else {
-            BASE_OBSERVATION_SIZE
-        }
+        self.observation_layout().iter().map(|(_, n)| n).sum()
     }
 
     /// The interface's observation groups: (name, number of values), in order.
@@ -269,7 +295,7 @@ impl FlightVehicle {
         if self.rates.is_some() {
             ESTIMATE_OBSERVATION.to_vec()
         } else {
-            BASE_OBSERVATION.to_vec()
+            base_observation(self.rotor_count()).to_vec()
         }
     }
 
@@ -280,13 +306,12 @@ impl FlightVehicle {
             return self.estimate_bounds(position_bound);
         }
         let (upper, _) = self.randomization.corner(&self.nominal, 1.0);
-        let (lo, hi) = base_bounds(&upper.quadrotor, position_bound);
-        (lo.to_vec(), hi.to_vec())
+        base_bounds(&upper.quadrotor, self.rotor_count(), position_bound)
     }
 
     /// Writes the interface's observation for `target` (world ENU) into `out`, each value
-    /// clipped into `lo..=hi`: the 33 base values (motor interface) or the 16 estimator
-    /// values (rates interface, see the module docs).
+    /// clipped into `lo..=hi`: the base values (motor interface: 25 + 2 per rotor, 33 on a
+    /// quad) or the 16 estimator values (rates interface, see the module docs).
     pub fn write_observation(
         &self,
         target: &Vector3<f64>,

@@ -195,3 +195,30 @@ fn a_bad_frame_table_names_the_rotor_and_field() {
         "{e}"
     );
 }
+
+/// The task modes fly the file's `[frame]` too (the gym's SITL backend writes it), with the
+/// lander refusing one; no `[frame]` is the quad X.
+#[test]
+fn a_task_config_flies_its_frame_table() {
+    let c = parse(TaskKind::Hover, "mass = 1.2\n[frame]\nname = \"hexa_x\"").unwrap();
+    assert_eq!((c.frame.rotor_count(), c.quadrotor.mass), (6, 1.2));
+    let c = parse(
+        TaskKind::Waypoints,
+        "[randomize]\nmass = [1, 2]\n[frame]\nname = \"octo_x\"",
+    );
+    assert_eq!(c.unwrap().frame.rotor_count(), 8);
+    assert!(
+        parse(TaskKind::Hover, "mass = 1.2")
+            .unwrap()
+            .frame
+            .is_quad_x()
+    );
+    let e = parse(TaskKind::Hover, "[frame]\nname = \"tri\"").unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("unknown frame `tri`: the shipped frames are"),
+        "{e}"
+    );
+    let e = parse(TaskKind::Landing, "[frame]\nname = \"hexa_x\"").unwrap_err();
+    assert!(e.to_string().contains("takes no frame"), "{e}");
+}

@@ -5,6 +5,7 @@ use super::param_rows::{self, Group, ParamEntry};
 use super::{ModelKind, TaskConfig, TaskInstance, TaskKind};
 use crate::ParamError;
 use crate::params::Parameters;
+use crate::quadrotor::Frame;
 use crate::tasks::randomization::{ParamRange, Randomization};
 
 /// The parameter sets of `task` from `(name or short id, value)` pairs (other parameters keep
@@ -15,15 +16,16 @@ pub fn from_values<'a>(
     task: TaskKind,
     pairs: impl IntoIterator<Item = (&'a str, f64)>,
 ) -> Result<TaskConfig, ParamError> {
-    from_values_and_ranges(task, pairs, Vec::new())
+    from_values_and_ranges(task, pairs, Vec::new(), None)
 }
 
-/// [`from_values`] with randomisation ranges (flight tasks only; checked against the
-/// parameter sets by the core).
+/// [`from_values`] with randomisation ranges and a frame (flight tasks only; checked
+/// against the parameter sets by the core). No frame: the quad X.
 pub fn from_values_and_ranges<'a>(
     task: TaskKind,
     pairs: impl IntoIterator<Item = (&'a str, f64)>,
     ranges: Vec<ParamRange>,
+    frame: Option<Frame>,
 ) -> Result<TaskConfig, ParamError> {
     let entries = param_rows::entries(task);
     let mut values: Vec<(ParamEntry, f64)> = Vec::new();
@@ -56,6 +58,18 @@ pub fn from_values_and_ranges<'a>(
         }
         config.randomize = Randomization::new(ranges)?;
     }
+    if let Some(frame) = frame {
+        if task.model() != ModelKind::Quadrotor {
+            return Err(ParamError::Relation {
+                name: "frame",
+                requirement: format!(
+                    "task `{}` flies no multirotor, so it takes no frame; the flight tasks (hover, waypoints) do",
+                    task.frame_name()
+                ),
+            });
+        }
+        config.frame = frame;
+    }
     TaskInstance::build(task, &config)?;
     Ok(config)
 }
@@ -85,9 +99,19 @@ mod tests {
             low: 1.0,
             high: 2.0,
         };
-        let err = from_values_and_ranges(TaskKind::Landing, [], vec![range.clone()]).unwrap_err();
+        let err =
+            from_values_and_ranges(TaskKind::Landing, [], vec![range.clone()], None).unwrap_err();
         assert!(err.to_string().contains("no randomisation"), "{err}");
-        let c = from_values_and_ranges(TaskKind::Hover, [], vec![range]).unwrap();
+        let c = from_values_and_ranges(TaskKind::Hover, [], vec![range], None).unwrap();
         assert_eq!(c.randomize.ranges().len(), 1);
+    }
+
+    #[test]
+    fn a_frame_is_taken_by_the_flight_tasks_and_refused_by_the_lander() {
+        let hexa = || Some(Frame::named("hexa_x").unwrap());
+        let c = from_values_and_ranges(TaskKind::Waypoints, [], Vec::new(), hexa()).unwrap();
+        assert_eq!(c.frame.rotor_count(), 6);
+        let err = from_values_and_ranges(TaskKind::Landing, [], Vec::new(), hexa()).unwrap_err();
+        assert!(err.to_string().contains("takes no frame"), "{err}");
     }
 }
