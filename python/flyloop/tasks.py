@@ -162,6 +162,7 @@ def randomize_entries(arg: str, v: Any) -> dict[str, tuple[float, float]]:
 # The config key naming the flight tasks' rotor table (a shipped frame of the core's): the
 # native extension reads it so, and to_toml writes it as the SITL's [frame] table.
 FRAME_KEY = "frame"
+DEFAULT_FRAME = "quad_x"
 
 
 def _frame_names() -> tuple[str, ...]:
@@ -215,7 +216,7 @@ FLIGHT_RENAMED = (
         "domain randomisation: {core parameter: (low, high)} drawn per episode from its seed",
     ),
     _renamed(
-        "frame", (), frame_entry, lambda d: "quad_x", str,
+        "frame", (), frame_entry, lambda d: DEFAULT_FRAME, str,
         "the multirotor's rotor table: 'quad_x', 'quad_plus', 'hexa_x' or 'octo_x' (the "
         "motor interface takes one command per rotor)",
     ),
@@ -395,7 +396,10 @@ def resolve_config(
             config.update(randomize_entries(name, value))
             continue
         if name == FRAME_KEY:
-            config.update(frame_entry(name, value))
+            # The quad X is the core's default: its config stays as it was before frames.
+            entry = frame_entry(name, value)
+            if value != DEFAULT_FRAME:
+                config.update(entry)
             continue
         for core, v in zip(arg.core, arg.convert(name, value), strict=True):
             config[core] = v

@@ -163,3 +163,21 @@ def test_bad_frames_and_wrong_length_actions_say_what_is_wanted(make_env):
     with pytest.raises(ValueError, match=r"shape \(2, 6\), got \(2, 4\)"):
         venv.step(np.zeros((2, 4), np.float32))
     venv.close()
+
+
+def test_a_hexa_renders_its_six_rotors_from_the_cores_table():
+    from flyloop.rendering.quadrotor import frame_rotors
+
+    hexa = frame_rotors("hexa_x")
+    # PX4's 6001 order: right, left, front-left, rear-right, front-right, rear-left.
+    assert hexa.names == ("R", "L", "FL", "RR", "FR", "RL")
+    assert hexa.spins == ("CW", "CCW", "CW", "CCW", "CCW", "CW")
+    assert len(frame_rotors("octo_x").names) == 8
+    assert frame_rotors("quad_x").names == ("FR", "RL", "FL", "RR")
+    env = gym.make(
+        "flyloop/QuadHover-v0", frame="hexa_x", backend="native", render_mode="rgb_array"
+    )
+    env.reset(seed=1)
+    env.step(np.full(6, 0.45, np.float32))
+    assert env.render().shape == (720, 960, 3)
+    env.close()

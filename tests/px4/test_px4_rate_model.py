@@ -20,8 +20,8 @@ from pathlib import Path
 import flyloop as _registers_envs  # noqa: F401
 import gymnasium as gym
 import numpy as np
-import tomllib
 import pytest
+import tomllib
 from px4_support import TAKEOFF_ALT, autopilot_params, collect, settle
 from pymavlink import mavutil
 
