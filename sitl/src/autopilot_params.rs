@@ -212,8 +212,10 @@ mod tests {
             &QuadrotorParams::default(),
         );
         assert!(plus.contains("CA_ROTOR2_PY 0.000001\n"), "{plus}");
-        let mut km = QuadrotorParams::default();
-        km.yaw_torque_coefficient = 0.05;
+        let km = QuadrotorParams {
+            yaw_torque_coefficient: 0.05,
+            ..QuadrotorParams::default()
+        };
         let hexa = px4(&Frame::named("hexa_x").unwrap(), &km);
         // Rotor 1 turns counter-clockwise: KM 0.05 is the default and none_iris's rotor 1 too.
         assert!(hexa.contains("CA_ROTOR1_KM 0.05\n") && hexa.contains("CA_ROTOR3_KM 0.050001\n"));

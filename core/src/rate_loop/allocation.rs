@@ -131,41 +131,48 @@ impl Allocation {
     /// with airmode off: thrust is only ever reduced to make room for roll and pitch, which
     /// are scaled back before yaw is mixed in with its own headroom.
     pub fn allocate(&self, torque: &Vector3<f64>, thrust: f64) -> Allocated {
-        let n = self.count;
-        let control = [torque.x, torque.y, torque.z, -thrust];
-        let [roll, pitch, yaw, thrust_z] = &self.mix;
-        let (roll, pitch, yaw, thrust_z) = (&roll[..n], &pitch[..n], &yaw[..n], &thrust_z[..n]);
-        let mut outputs = [0.0; MAX_ROTORS];
-        let sp = &mut outputs[..n];
-        for i in 0..n {
-            sp[i] = roll[i] * control[0] + pitch[i] * control[1] + thrust_z[i] * control[3];
+        // Fixed sizes for the shipped frames (as fast as the quad's own [f64; 4] code was);
+        // any other count in MAX_ROTORS slots, whose zero entries change no sum and take part
+        // in no desaturation.
+        match self.count {
+            4 => self.allocate_in::<4>(torque, thrust),
+            6 => self.allocate_in::<6>(torque, thrust),
+            8 => self.allocate_in::<8>(torque, thrust),
+            _ => self.allocate_in::<MAX_ROTORS>(torque, thrust),
         }
+    }
+
+    fn allocate_in<const N: usize>(&self, torque: &Vector3<f64>, thrust: f64) -> Allocated {
+        let control = [torque.x, torque.y, torque.z, -thrust];
+        let column = |c: usize| -> [f64; N] { std::array::from_fn(|i| self.mix[c][i]) };
+        let (roll, pitch, yaw, thrust_z) = (column(0), column(1), column(2), column(3));
+        let mut sp: [f64; N] = std::array::from_fn(|i| {
+            roll[i] * control[0] + pitch[i] * control[1] + thrust_z[i] * control[3]
+        });
         let (min, max) = (0.0, 1.0);
-        desaturate(sp, thrust_z, min, max, true);
-        desaturate(sp, roll, min, max, false);
-        desaturate(sp, pitch, min, max, false);
-        for i in 0..n {
+        desaturate(&mut sp, &thrust_z, min, max, true);
+        desaturate(&mut sp, &roll, min, max, false);
+        desaturate(&mut sp, &pitch, min, max, false);
+        for i in 0..N {
             sp[i] += yaw[i] * control[2];
         }
         let yaw_max = max + (max - 0.0) * MINIMUM_YAW_MARGIN;
-        desaturate(sp, yaw, min, yaw_max, false);
-        desaturate(sp, thrust_z, min, max, true);
+        desaturate(&mut sp, &yaw, min, yaw_max, false);
+        desaturate(&mut sp, &thrust_z, min, max, true);
 
-        for u in sp.iter_mut() {
-            *u = u.clamp(0.0, 1.0);
-        }
+        let clipped = sp.map(|u| u.clamp(0.0, 1.0));
         // What the clipped outputs produce, summed in motor order.
         let produced: [f64; 4] = std::array::from_fn(|axis| {
             let row = &self.effectiveness[axis];
-            (1..n).fold(row[0] * sp[0], |acc, i| row[i] * sp[i] + acc)
+            (1..N).fold(row[0] * clipped[0], |acc, i| row[i] * clipped[i] + acc)
         });
         let unallocated_torque = Vector3::new(
             control[0] - produced[0],
             control[1] - produced[1],
             control[2] - produced[2],
         );
-        let mut motors = Outputs::zeros(n);
-        for (m, &u) in motors.iter_mut().zip(sp.iter()) {
+        let mut motors = Outputs::zeros(self.count);
+        for (m, &u) in motors.iter_mut().zip(clipped.iter()) {
             *m = thrust_model(u, self.thrust_model_factor);
         }
         Allocated {
@@ -192,36 +199,47 @@ fn pseudo_inverse(e: &DMatrix<f64>) -> Option<DMatrix<f64>> {
 /// brings it inside [min, max] as far as one gain can, then half of the remaining gain.
 /// With `reduce_only`, a move that would add thrust (a negative gain along the thrust
 /// column, whose entries are negative) is skipped.
-fn desaturate(sp: &mut [f64], direction: &[f64], min: f64, max: f64, reduce_only: bool) {
+fn desaturate<const N: usize>(
+    sp: &mut [f64; N],
+    direction: &[f64; N],
+    min: f64,
+    max: f64,
+    reduce_only: bool,
+) {
     let gain = desaturation_gain(sp, direction, min, max);
     if reduce_only && gain < 0.0 {
         return;
     }
-    for (s, d) in sp.iter_mut().zip(direction) {
-        *s += gain * d;
+    for i in 0..N {
+        sp[i] += gain * direction[i];
     }
     let gain = 0.5 * desaturation_gain(sp, direction, min, max);
-    for (s, d) in sp.iter_mut().zip(direction) {
-        *s += gain * d;
+    for i in 0..N {
+        sp[i] += gain * direction[i];
     }
 }
 
 /// PX4's `computeDesaturationGain`: the smallest and largest gains that bring each
 /// saturated output to its bound, added.
-fn desaturation_gain(sp: &[f64], direction: &[f64], min: f64, max: f64) -> f64 {
+fn desaturation_gain<const N: usize>(
+    sp: &[f64; N],
+    direction: &[f64; N],
+    min: f64,
+    max: f64,
+) -> f64 {
     let (mut k_min, mut k_max) = (0.0f64, 0.0f64);
-    for (&s, &d) in sp.iter().zip(direction) {
-        if d.abs() < DESATURATION_MIN_ENTRY {
+    for i in 0..N {
+        if direction[i].abs() < DESATURATION_MIN_ENTRY {
             continue;
         }
-        let bound = if s < min {
+        let bound = if sp[i] < min {
             min
-        } else if s > max {
+        } else if sp[i] > max {
             max
         } else {
             continue;
         };
-        let k = (bound - s) / d;
+        let k = (bound - sp[i]) / direction[i];
         k_min = k_min.min(k);
         k_max = k_max.max(k);
     }
