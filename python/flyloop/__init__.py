@@ -7,8 +7,8 @@ Importing the package registers the envs with gymnasium:
     envs = gymnasium.make_vec("flyloop/QuadHover-v0", num_envs=16)  # one SITL, 16 vehicles
 
 `flyloop.parallel_env("flyloop/Swap-v0", num_agents=4)` is a PettingZoo multi-agent env
-(flyloop.multi_agent). `gymnasium.make("flyloop:flyloop/QuadHover-v0")` imports the package itself. Rendering lives
-in `flyloop.rendering` (pygame is imported only when a view is made).
+(flyloop.multi_agent). `gymnasium.make("flyloop:flyloop/QuadHover-v0")` imports the package
+itself. Rendering lives in `flyloop.rendering` (pygame is imported only when a view is made).
 """
 
 from .errors import SitlError, SitlNotFoundError, SitlParameterError

@@ -58,7 +58,6 @@ nothing.
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Mapping
 from typing import Any
 
@@ -175,11 +174,10 @@ def _parallel_env_class():
             self.agents: list[str] = []
             self._seeds = np.random.default_rng()
 
-        @functools.lru_cache(maxsize=None)  # noqa: B019  (one space for every agent)
         def observation_space(self, agent: str) -> gymnasium.spaces.Box:
+            # One space object for every agent (pettingzoo's seed test seeds it per agent).
             return self._obs_space
 
-        @functools.lru_cache(maxsize=None)  # noqa: B019
         def action_space(self, agent: str) -> gymnasium.spaces.Box:
             return self._act_space
 
