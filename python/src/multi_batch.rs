@@ -20,6 +20,9 @@ use rayon::prelude::*;
 /// Prefix of a key that holds a randomisation range (as the single-agent tasks').
 const RANGE_PREFIX: &str = "randomize.";
 
+/// A flat float64 array handed to Python.
+type Flat<'py> = Bound<'py, PyArray1<f64>>;
+
 /// W worlds of one multi-agent task with one parameter set.
 #[pyclass(module = "flyloop._native")]
 pub struct MultiBatch {
@@ -232,11 +235,7 @@ impl MultiBatch {
     }
 
     /// Agent positions and targets of world `w` (ENU, m): two (N, 3) arrays, for rendering.
-    fn positions<'py>(
-        &self,
-        py: Python<'py>,
-        w: usize,
-    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    fn positions<'py>(&self, py: Python<'py>, w: usize) -> PyResult<(Flat<'py>, Flat<'py>)> {
         let world = self.worlds.get(w).ok_or_else(|| {
             PyValueError::new_err(format!(
                 "world {w} out of range: {} worlds",
