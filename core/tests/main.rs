@@ -8,6 +8,7 @@ mod lander2d_grid;
 mod lander2d_landing;
 mod lander2d_model;
 mod lander2d_reward;
+mod multi_agent;
 mod multirotor_frames;
 mod parameter_reference;
 mod quadrotor_golden;

@@ -40,6 +40,12 @@ def hover_success(terminated: bool, truncated: bool, info: Mapping[str, Any]) ->
     )
 
 
+def swap_success(terminated: bool, truncated: bool, info: Mapping[str, Any]) -> bool:
+    """Swap: every agent within its arrival radius at the end, no agent collided or crashed
+    (the core's info['success'], the same for every agent of a world)."""
+    return bool(info["success"])
+
+
 def lander_success(terminated: bool, truncated: bool, info: Mapping[str, Any]) -> bool:
     return bool(info["landed"])
 
@@ -126,6 +132,19 @@ OFFBOARD_RANDOMIZE = {
 }
 
 PRESETS: dict[str, Preset] = {
+    # Four agents exchange places across a 2 m circle (flyloop.parallel_env's Swap-v0), one
+    # policy for all: 5 s episodes (250 steps of 20 ms), no wind. Trained through
+    # flyloop.MultiAgentVectorEnv (one sub-env per agent; `multi_agent` marks it).
+    "swap": Preset(
+        name="swap",
+        env_id="flyloop/Swap-v0",
+        env_kwargs={"num_agents": 4, "max_steps": 250, "dt": 0.02},
+        actions=None,
+        success=swap_success,
+        success_text="every agent within 0.5 m of the opposite point at the time limit, "
+        "no collision or crash",
+        outcomes=("all four swapped places", "the swap failed"),
+    ),
     "hover": Preset(
         name="hover",
         env_id="flyloop/QuadHover-v0",
