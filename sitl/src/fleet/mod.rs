@@ -350,7 +350,7 @@ impl Fleet {
         for c in self.world.take_collisions() {
             self.collisions += 1;
             let text = format!(
-                "collision: {} and {} at t={:.3} s, closing at {:.2} m/s",
+                "collision {} {} at t={:.3} s, closing at {:.2} m/s",
                 self.members[c.a].name, self.members[c.b].name, c.time, c.speed
             );
             self.notice(MavSeverity::MAV_SEVERITY_CRITICAL, text);
