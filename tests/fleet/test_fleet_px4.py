@@ -66,3 +66,38 @@ def test_two_px4s_share_one_world_each_with_its_own_sysid(started, sitl_binary, 
     counters = sitl.counters()
     assert counters["collisions"] == "0", counters
     assert "silent" not in sitl.stderr()
+
+
+def test_a_silent_px4_does_not_hang_the_others_and_rejoins(started, sitl_binary, px4_dir):
+    sitl, px4s = start_fleet(started, sitl_binary, px4_dir, 2, "--autopilot-timeout", "1")
+    flying, stalled = px4s
+    _, target = launch(flying)
+    stalled.proc.send_signal(signal.SIGSTOP)
+    text = sitl.statustext("silent", 30)
+    assert text.startswith("px4-001: px4 silent for 1."), text
+    # The world goes on without it: the other one climbs and holds.
+    settle(flying, target, 0.3, 60)
+    horizontal, vertical = collect(flying, 2.0).worst(target)
+    assert vertical < 0.3 and horizontal < 0.3, (horizontal, vertical)
+    stalled.proc.send_signal(signal.SIGCONT)
+    sitl.statustext("px4-001: answers again", 30)
+    land_all([flying])
+    assert stalled.proc.poll() is None
+
+
+def test_two_px4s_sent_into_each_other_collide_and_flyloop_says_so(
+    started, sitl_binary, px4_dir
+):
+    sitl, (a, b) = start_fleet(started, sitl_binary, px4_dir, 2)
+    frame_a, target_a = launch(a)
+    frame_b, target_b = launch(b)
+    settle(a, target_a, 0.3, 90)
+    settle(b, target_b, 0.3, 90)
+    # b flies to where a hovers.
+    b.goto(frame_b, frame_b.from_global(*frame_a.to_global(target_a)))
+    text = sitl.statustext("collision px4-000 px4-001", 60)
+    assert "closing at" in text or text.startswith("collision px4-000 px4-001")
+    deadline = time.monotonic() + 5
+    while "collision px4-000 px4-001" not in sitl.stderr() and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert "collision px4-000 px4-001" in sitl.stderr()
