@@ -28,9 +28,23 @@ def _free(kind: int, port: int) -> bool:
     return True
 
 
+def _px4_server_running(i: int) -> bool:
+    """Whether PX4 instance i's server socket answers (a killed PX4 leaves the file behind;
+    a new PX4 of that instance starts over a stale one)."""
+    path = Path(f"/tmp/px4-sock-{i}")
+    if not path.exists():
+        return False
+    with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as s:
+        try:
+            s.connect(str(path))
+        except OSError:
+            return False
+    return True
+
+
 def px4_ports_free(i: int) -> bool:
     return (
-        not Path(f"/tmp/px4-sock-{i}").exists()
+        not _px4_server_running(i)
         and _free(socket.SOCK_STREAM, 4560 + i)
         and all(_free(socket.SOCK_DGRAM, p) for p in (14580 + i, 18570 + i, 14280 + i, 13030 + i))
     )

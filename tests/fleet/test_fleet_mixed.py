@@ -72,13 +72,13 @@ def test_two_px4s_and_two_ardupilots_fly_in_one_world(started, sitl_binary, px4_
         ap.mode(GUIDED)
         ap.arm()
         ap.takeoff(ALT)
-    for p, target in zip(px4s, targets):
+    for p, target in zip(px4s, targets, strict=False):
         settle(p, target, 0.3, 90)
     for ap in aps:
         origin = ap.estimate().position
         ap_settle(ap, origin[0], origin[1], ALT, 0.3, 90)
     # All four hold at once.
-    for p, target in zip(px4s, targets):
+    for p, target in zip(px4s, targets, strict=False):
         horizontal, vertical = collect(p, 2.0).worst(target)
         assert vertical < 0.3 and horizontal < 0.3, (p.instance, horizontal, vertical)
     for ap in aps:

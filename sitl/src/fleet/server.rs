@@ -391,7 +391,7 @@ impl Serving {
                 }
                 if let Some((_, w)) = &mut self.writers[i] {
                     if let Err(e) = w.write_all(&member.out) {
-                        tracing::debug!(vehicle = %member.name, error = %e, "write to PX4 failed: bytes dropped");
+                        tracing::warn!(vehicle = %member.name, error = %e, "write to PX4 failed: bytes dropped");
                     }
                 }
                 member.out.clear();

@@ -1,12 +1,10 @@
 use super::*;
 
-/// Runs the barrier until it holds, answering from `answers` (autopilot, command) in the
-/// order given whenever it waits; returns every step taken (time after it, due list).
-fn drive(
-    l: &mut Lockstep,
-    script: &[usize],
-    steps: usize,
-) -> Vec<(u64, Vec<usize>, Vec<(usize, Vec<f64>)>)> {
+/// A step taken: the time after it, who was due, the commands set.
+type Taken = (u64, Vec<usize>, Vec<(usize, Vec<f64>)>);
+
+/// Runs the barrier for `steps` steps, answering in `script`'s order whenever it waits.
+fn drive(l: &mut Lockstep, script: &[usize], steps: usize) -> Vec<Taken> {
     let mut taken = Vec::new();
     let mut next = script.iter().cycle();
     let mut k = 0.0;
@@ -79,9 +77,7 @@ fn the_order_answers_arrive_in_changes_no_step() {
     let a = run(&[0, 1, 2, 3]);
     let b = run(&[3, 2, 1, 0]);
     let c = run(&[2, 0, 3, 1, 1, 2]);
-    let times = |r: &Vec<(u64, Vec<usize>, Vec<(usize, Vec<f64>)>)>| {
-        r.iter().map(|s| (s.0, s.1.clone())).collect::<Vec<_>>()
-    };
+    let times = |r: &Vec<Taken>| r.iter().map(|s| (s.0, s.1.clone())).collect::<Vec<_>>();
     assert_eq!(times(&a), times(&b));
     assert_eq!(times(&a), times(&c));
     // Every grid time of every autopilot is a world time.
