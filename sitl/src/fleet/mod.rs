@@ -77,6 +77,8 @@ pub struct Fleet {
     notices: Vec<Notice>,
     /// Contacts reported.
     pub collisions: u64,
+    /// PX4 controls that answered older sensors (dropped; see `is_stale`).
+    pub stale_controls: u64,
     /// UNIX time of world time 0 (HIL_GPS stamps), µs.
     pub gps_epoch_us: u64,
 }
@@ -136,6 +138,7 @@ impl Fleet {
             start,
             notices: Vec::new(),
             collisions: 0,
+            stale_controls: 0,
             gps_epoch_us: 0,
         })
     }
@@ -231,16 +234,32 @@ impl Fleet {
             Link::ArduPilot(_) => return,
         };
         for s in said {
-            let command = match s {
-                Said::Controls(c) => c,
-                Said::BadControls => self.world.vehicle(i).command().to_vec(),
+            let (command, time_usec) = match s {
+                Said::Controls(c, t) => (c, t),
+                Said::BadControls(t) => (self.world.vehicle(i).command().to_vec(), t),
                 Said::Heartbeat(sysid) => {
                     self.check_sysid(i, sysid);
                     continue;
                 }
             };
+            if self.is_stale(i, time_usec) {
+                self.stale_controls += 1;
+                continue;
+            }
             self.answer(i, command);
         }
+    }
+
+    /// Whether PX4 i's controls stamped `time_usec` answer a HIL_SENSOR older than the last
+    /// one it was sent, or one already answered. PX4 answers every HIL_SENSOR it gets, and a
+    /// PX4 that starts up free gets many before its first controls: counting each of those
+    /// answers as a step would keep that many steps in flight for good, every command
+    /// applied that many steps late (enough to flip a vehicle on takeoff). In lockstep only
+    /// the answer to the last sensors is a step.
+    fn is_stale(&self, i: usize, time_usec: u64) -> bool {
+        let s = self.lockstep.slot(i);
+        s.phase == Phase::Lockstep
+            && (time_usec < s.time_us.max(1) || s.next_us.is_some() || !s.answers.is_empty())
     }
 
     fn check_sysid(&mut self, i: usize, sysid: u8) {

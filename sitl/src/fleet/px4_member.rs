@@ -14,11 +14,12 @@ const SIMULATOR_SYSTEM: u8 = 1;
 /// What PX4 said on its stream.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Said {
-    /// HIL_ACTUATOR_CONTROLS: controls[0..n] (n rotors), each finite.
-    Controls(Vec<f64>),
+    /// HIL_ACTUATOR_CONTROLS: controls[0..n] (n rotors), each finite, and its `time_usec`
+    /// (PX4's time: the HIL_SENSOR it answers).
+    Controls(Vec<f64>, u64),
     /// HIL_ACTUATOR_CONTROLS with a non-finite control (counted): answered with the
     /// command in effect.
-    BadControls,
+    BadControls(u64),
     /// A HEARTBEAT from this system id.
     Heartbeat(u8),
 }
@@ -79,10 +80,10 @@ impl Px4Member {
                     let command: Vec<f64> =
                         c.controls[..rotors].iter().map(|&x| f64::from(x)).collect();
                     if command.iter().all(|x| x.is_finite()) {
-                        said.push(Said::Controls(command));
+                        said.push(Said::Controls(command, c.time_usec));
                     } else {
                         self.stats.refused_controls += 1;
-                        said.push(Said::BadControls);
+                        said.push(Said::BadControls(c.time_usec));
                     }
                 }
                 MavMessage::HEARTBEAT(_) => said.push(Said::Heartbeat(incoming.header.system_id)),

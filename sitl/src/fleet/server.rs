@@ -477,10 +477,11 @@ impl Serving {
         let t = self.fleet.lockstep().now_us() as f64 * 1e-6;
         let wall = self.started.elapsed().as_secs_f64();
         format!(
-            "world_steps={} time_s={t:.3} wall_s={wall:.3} real_time_factor={:.3} collisions={}",
+            "world_steps={} time_s={t:.3} wall_s={wall:.3} real_time_factor={:.3} collisions={} stale_controls={}",
             self.steps,
             t / wall.max(1e-9),
-            self.fleet.collisions
+            self.fleet.collisions,
+            self.fleet.stale_controls
         )
     }
 }

@@ -22,6 +22,12 @@ fn spec(positions: &[[f64; 2]]) -> FleetSpec {
     s
 }
 
+/// Controls answering PX4 i's last sensors.
+fn answer(f: &mut Fleet, i: usize, value: f32) {
+    let t = f.lockstep().slot(i).time_us.max(1);
+    f.px4_bytes(i, &controls(value, t));
+}
+
 fn controls(value: f32, t: u64) -> Vec<u8> {
     let mut out = Vec::new();
     let mut c = [0.0f32; 16];
@@ -51,10 +57,13 @@ fn fly(order: impl Fn(u64) -> Vec<usize>) -> Vec<u8> {
             let m = &mut f.members[i];
             let mut d = StreamDecoder::default();
             d.push(&m.out);
-            while let Some(Ok(_)) = d.next_frame() {
+            while let Some(Ok(frame)) = d.next_frame() {
+                let MavMessage::HIL_SENSOR(h) = frame.message else {
+                    continue;
+                };
                 sensors[i] += 1;
                 let value = 0.55 + 0.01 * i as f32 + if sensors[i] % 50 < 25 { 0.1 } else { 0.0 };
-                let bytes = controls(value, sensors[i]);
+                let bytes = controls(value, h.time_usec);
                 f.member_mut(i).out.clear();
                 f.px4_bytes(i, &bytes);
             }
@@ -105,10 +114,10 @@ fn a_silent_px4_stops_its_motors_and_the_others_fly_on() {
     let mut f = Fleet::new(&spec(&[[0.0, 0.0], [5.0, 0.0]]), 0, PX4_STEP_US).unwrap();
     f.px4_connected(0);
     f.px4_connected(1);
-    f.px4_bytes(0, &controls(0.7, 1));
-    f.px4_bytes(1, &controls(0.7, 1));
+    answer(&mut f, 0, 0.7);
+    answer(&mut f, 1, 0.7);
     while f.advance(false).is_ok() {}
-    f.px4_bytes(0, &controls(0.7, 2));
+    answer(&mut f, 0, 0.7);
     assert_eq!(f.advance(false), Err(Hold::Waiting(1)));
     f.silence(1, std::time::Duration::from_secs(3));
     assert!(f.world().vehicle(1).command().iter().all(|&c| c == 0.0));
@@ -121,7 +130,7 @@ fn a_silent_px4_stops_its_motors_and_the_others_fly_on() {
     );
     for k in 0..10 {
         f.advance(false).unwrap();
-        f.px4_bytes(0, &controls(0.7, 3 + k));
+        answer(&mut f, 0, 0.7);
     }
     assert_eq!(f.lockstep().now_us(), 44_000);
 }
@@ -131,14 +140,14 @@ fn two_vehicles_flown_into_each_other_are_reported() {
     let mut f = Fleet::new(&spec(&[[0.0, 0.0], [0.8, 0.0]]), 0, PX4_STEP_US).unwrap();
     f.px4_connected(0);
     f.px4_connected(1);
-    f.px4_bytes(0, &controls(0.0, 1));
-    f.px4_bytes(1, &controls(0.0, 1));
+    answer(&mut f, 0, 0.0);
+    answer(&mut f, 1, 0.0);
     // Push vehicle 1 toward vehicle 0.
     f.world.vehicle_mut(1).body.velocity.x = -2.0;
     for k in 0..200 {
         let _ = f.advance(false);
-        f.px4_bytes(0, &controls(0.0, 2 + k));
-        f.px4_bytes(1, &controls(0.0, 2 + k));
+        answer(&mut f, 0, 0.0);
+        answer(&mut f, 1, 0.0);
     }
     assert!(f.collisions >= 1);
     let notices = f.take_notices();
@@ -147,5 +156,33 @@ fn two_vehicles_flown_into_each_other_are_reported() {
             .iter()
             .any(|n| n.text.starts_with("collision px4-000 px4-001")),
         "{notices:?}"
+    );
+}
+
+#[test]
+fn only_the_answer_to_the_last_sensors_is_a_step() {
+    let mut f = Fleet::new(&spec(&[[0.0, 0.0]]), 0, PX4_STEP_US).unwrap();
+    f.px4_connected(0);
+    // Free: the world gives it sensors at 4, 8, 12 ms before its first controls.
+    for _ in 0..3 {
+        f.advance(true).unwrap();
+    }
+    f.px4_bytes(0, &controls(0.5, 1)); // answers the first sensors: joins the lockstep
+    f.advance(false).unwrap(); // its step under way ends at 16 ms
+    assert_eq!(f.lockstep().now_us(), 16_000);
+    // The answers to 4, 8, 12 ms arrive late: stale, no steps in flight from them.
+    for t in [4000, 8000, 12_000] {
+        f.px4_bytes(0, &controls(0.5, t));
+    }
+    assert_eq!(f.stale_controls, 3);
+    assert_eq!(f.advance(false), Err(Hold::Waiting(0)));
+    f.px4_bytes(0, &controls(0.6, 16_000));
+    f.px4_bytes(0, &controls(0.6, 16_000)); // the same answer again: stale
+    assert_eq!(f.stale_controls, 4);
+    f.advance(false).unwrap();
+    assert_eq!(
+        f.advance(false),
+        Err(Hold::Waiting(0)),
+        "one step per answer"
     );
 }
