@@ -59,7 +59,7 @@ fn gym(seed: u64) -> (FlightVehicle, f64) {
     // 50 Hz policy steps: five ticks each (the policies in policies/ act at 50 Hz).
     nominal.flight.dt = DT;
     let mut gym = FlightVehicle::new(nominal, Randomization::none()).unwrap();
-    let hover = gym.draw(seed).hover_motor_state().unwrap();
+    let hover = gym.draw(seed);
     let start = BodyState::at_rest(Vector3::new(0.5, -1.0, 1.5), 0.0, 0.0, 0.3, hover);
     gym.restart(start, SimRng::new(seed), seed);
     (gym, hover)

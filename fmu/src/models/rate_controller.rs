@@ -16,6 +16,8 @@
 use crate::model::{FmuModel, Table};
 use crate::table::{Array, ModelInfo};
 use flyloop_core::params::{ParamSpec, Parameters};
+use flyloop_core::quadrotor::{Frame, QuadrotorParams};
+use flyloop_core::rate_loop::px4_rotors::{Px4Rotor, px4_rotors};
 use flyloop_core::rate_loop::{RateLoop, RateLoopParams, RatesSetpoint};
 use flyloop_core::snapshot;
 use flyloop_core::variables::{InputRow, OutputRow, Rows, VariableTable};
@@ -62,10 +64,15 @@ impl Parameters for NoStartValues {
     }
 }
 
+/// PX4's rotors for the quad X (the none_iris mixer the gym's rates interface mixes for).
+fn quad_x_rotors() -> Vec<Px4Rotor> {
+    px4_rotors(&Frame::quad_x(), &QuadrotorParams::default())
+}
+
 impl RateController {
     pub fn new(params: RateLoopParams) -> Result<Self, ParamError> {
         Ok(RateController {
-            rate_loop: RateLoop::new(params)?,
+            rate_loop: RateLoop::new(params, &quad_x_rotors())?,
             ticks: 0,
             now: 0.0,
             setpoint: [0.0; 4],
@@ -104,7 +111,7 @@ impl RateController {
         }
         let motors = rate_loop.step(&self.clipped_setpoint(), &gyro, false);
         // The allocator's outputs are in [0, 1]; a non-finite gyro is refused as an input.
-        motors.map(|m| m.clamp(0.0, 1.0))
+        std::array::from_fn(|i| motors.get(i).copied().unwrap_or(0.0).clamp(0.0, 1.0))
     }
 
     fn tick_is_due(&self) -> bool {
@@ -260,7 +267,7 @@ impl VariableTable for RateController {
     fn set_parameter(&mut self, name: &'static str, value: f64) -> Result<(), ParamError> {
         let mut params = self.rate_loop.params().clone();
         params.set(name, value)?;
-        self.rate_loop = RateLoop::new(params)?;
+        self.rate_loop = RateLoop::new(params, &quad_x_rotors())?;
         self.due.set(None);
         Ok(())
     }

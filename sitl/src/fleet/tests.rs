@@ -128,7 +128,7 @@ fn a_silent_px4_stops_its_motors_and_the_others_fly_on() {
             .any(|n| n.text.starts_with("px4-001: px4 silent for 3.0 s")),
         "{notices:?}"
     );
-    for k in 0..10 {
+    for _ in 0..10 {
         f.advance(false).unwrap();
         answer(&mut f, 0, 0.7);
     }
@@ -144,7 +144,7 @@ fn two_vehicles_flown_into_each_other_are_reported() {
     answer(&mut f, 1, 0.0);
     // Push vehicle 1 toward vehicle 0.
     f.world.vehicle_mut(1).body.velocity.x = -2.0;
-    for k in 0..200 {
+    for _ in 0..200 {
         let _ = f.advance(false);
         answer(&mut f, 0, 0.0);
         answer(&mut f, 1, 0.0);
