@@ -19,4 +19,5 @@ mod quadrotor_rates;
 mod quadrotor_tasks;
 mod quadrotor_wind_grid;
 mod trace_hash;
+mod vehicle_seam;
 mod world;
