@@ -138,7 +138,7 @@ fn start_px4(args: Args) -> Result<(), StartError> {
         step_us,
         seed: args.seed,
     })?;
-    if let Some(track) = track(&args, session.quadrotor().frame().rotor_count())? {
+    if let Some(track) = track(&args, session.vehicle().actuator_count())? {
         session.track.set(track);
     }
     if let Some(view) = view_stream(&args)? {
@@ -349,7 +349,7 @@ fn start_ardupilot(args: Args) -> Result<(), StartError> {
         vehicle,
         seed: args.seed,
     })?;
-    if let Some(track) = track(&args, session.quadrotor().frame().rotor_count())? {
+    if let Some(track) = track(&args, session.vehicle().actuator_count())? {
         session.track.set(track);
     }
     if let Some(view) = view_stream(&args)? {

@@ -30,6 +30,12 @@ impl Vehicle for Lander2d {
         self.command().to_vec()
     }
 
+    /// Each engine's thrust over its full thrust.
+    fn actuator_states(&self) -> Vec<f64> {
+        let full = self.params().max_thrust;
+        self.thrust().iter().map(|t| t / full).collect()
+    }
+
     /// To `dt` seconds from now on the physics grid ([`Lander2d::advance_to`]).
     fn advance(&mut self, dt: f64) {
         self.advance_to(self.time() + dt);
