@@ -21,6 +21,8 @@ ROOT = Path(__file__).resolve().parent
 GROUPS = {
     "tests/px4/": "px4",
     "tests/ardupilot/": "ardupilot",
+    # Fleets start PX4s (and ArduPilots) in blocks of instance numbers: after the PX4 tests.
+    "tests/fleet/": "px4",
     "tests/fmu/": "fmu",
     "tests/readme/": "fmu",
     "tests/training/test_training_rllib": "ray",

@@ -43,15 +43,22 @@ def cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / TICK
 
 
-def fly_and_time(seconds: float) -> tuple[float, float, float, float, dict]:
+def fly_and_time(
+    seconds: float, preset: Path | None = None
+) -> tuple[float, float, float, float, dict]:
     """Takes ArduPilot off over flyloop (--speed-factor 0) and times `seconds` of the hover:
-    (simulated s, wall s, flyloop CPU s, ArduPilot CPU s, flyloop's counters)."""
+    (simulated s, wall s, flyloop CPU s, ArduPilot CPU s, flyloop's counters). `preset`: a
+    frame preset flown with its .parm beside it (as tests/ardupilot/test_ardupilot_frames.py)."""
     build = aps.ardupilot_build(aps.fresh_dir("ardupilot-build-"))
     work = aps.fresh_dir("ardupilot-bench-")
-    flyloop = aps.Flyloop(find_sitl_binary(), work, speed=0)
+    preset_args = [] if preset is None else ["--config", str(preset)]
+    parm = aps.PARM if preset is None else preset.resolve().with_suffix(".parm")
+    flyloop = aps.Flyloop(find_sitl_binary(), work, *preset_args, speed=0)
     ap = None
     try:
-        ap = aps.ArduPilot(build, aps.free_instance(), flyloop.port, aps.fresh_dir("apw-"))
+        ap = aps.ArduPilot(
+            build, aps.free_instance(), flyloop.port, aps.fresh_dir("apw-"), parm=parm
+        )
         ap.connect()
         ap.wait_for_gps(120)
         ap.mode(aps.GUIDED)
@@ -80,9 +87,13 @@ def main() -> None:
     parser.add_argument("--speedup", type=int, default=100)
     parser.add_argument("--px4", action="store_true", help="then run benchmarks/px4_speed.py")
     parser.add_argument("--px4-speed", type=int, default=20)
+    parser.add_argument(
+        "--config", type=Path, help="a preset (e.g. sitl/presets/ardupilot_octo_x.toml): its frame"
+    )
     args = parser.parse_args()
     aps.SPEEDUP = args.speedup
-    sim, wall, fly_cpu, ap_cpu, counters = fly_and_time(args.seconds)
+    sim, wall, fly_cpu, ap_cpu, counters = fly_and_time(args.seconds, args.config)
+    print(f"preset: {args.config or 'the default quad X'}")
     frames = sim * 1200  # SIM_RATE_HZ 1200: one frame per 833 us
     print(f"ArduPilot --speedup {args.speedup}, flyloop --speed-factor 0, load {os.getloadavg()}")
     print(f"real-time factor: {sim / wall:.1f}x ({sim:.1f} simulated s in {wall:.1f} wall s)")

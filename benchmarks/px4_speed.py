@@ -10,7 +10,7 @@ PX4 SITL build from $FLYLOOP_PX4 (PX4_SIM_SPEED_FACTOR=--px4-speed), arms it, ta
   its counters: no socket calls).
 
     FLYLOOP_PX4=... .venv/bin/python benchmarks/px4_speed.py [--seconds 10] [--px4-speed 10] \
-        [--view]
+        [--view] [--config sitl/presets/px4_hexa_x.toml]
 
 `--view`: the same with the live view connected (flyloop-sitl --view, `python -m flyloop.view`
 talking to PX4's ground-station port for its estimate: docs/view.md), to measure its cost.
@@ -60,6 +60,9 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=10.0)
     parser.add_argument("--px4-speed", type=int, default=10)
     parser.add_argument("--view", action="store_true", help="with the live view connected")
+    parser.add_argument(
+        "--config", type=Path, help="a preset (e.g. sitl/presets/px4_hexa_x.toml): its frame"
+    )
     args = parser.parse_args()
     px4_support.SPEED = args.px4_speed
     root = px4_support.px4_root(px4_support.fresh_dir("px4-build-"))
@@ -70,10 +73,17 @@ def main() -> None:
     if args.view:
         truth = _free_port(socket.SOCK_DGRAM)
         view_args = ["--view", f"127.0.0.1:{truth}"]
-    flyloop = px4_support.Flyloop(find_sitl_binary(), instance, work, *(view_args or []), speed=0)
+    preset_args, mixer = [], {}
+    if args.config is not None:
+        # The autopilot's mixer for the preset's frame (as tests/px4/test_px4_frames.py).
+        preset_args = ["--config", str(args.config)]
+        mixer = px4_support.autopilot_params(find_sitl_binary(), args.config, "px4")
+    flyloop = px4_support.Flyloop(
+        find_sitl_binary(), instance, work, *preset_args, *(view_args or []), speed=0
+    )
     px4 = None
     try:
-        px4 = px4_support.Px4(root, instance, px4_support.fresh_dir("px4-work-"))
+        px4 = px4_support.Px4(root, instance, px4_support.fresh_dir("px4-work-"), **mixer)
         if args.view:
             view = subprocess.Popen(
                 [
@@ -109,7 +119,8 @@ def main() -> None:
     steps = sim / 0.004
     stats = flyloop.stderr().split("stopped: ", 1)[1].split()
     counters = dict(kv.split("=") for kv in stats)
-    print(f"with the live view: {args.view}; load {os.getloadavg()[0]:.2f}")
+    print(f"preset: {args.config or 'the default quad X'}; with the live view: {args.view}")
+    print(f"load {os.getloadavg()[0]:.2f}")
     print(f"real-time factor: {sim / wall:.1f}x ({sim:.1f} simulated s in {wall:.1f} wall s)")
     share = 100 * fly_cpu / px4_cpu
     print(f"CPU: flyloop {fly_cpu:.2f} s, PX4 {px4_cpu:.2f} s, flyloop/PX4 = {share:.1f} %")

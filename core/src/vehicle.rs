@@ -68,6 +68,9 @@ pub trait Vehicle {
     fn set_actuators(&mut self, commands: &[f64]) -> Result<(), CommandError>;
     /// The actuator commands in effect.
     fn actuators(&self) -> Vec<f64>;
+    /// What each actuator delivers now, as a fraction of its full output (a multirotor's
+    /// motor states, which lag its commands).
+    fn actuator_states(&self) -> Vec<f64>;
     /// Advances the vehicle by `dt` seconds on its physics grid.
     fn advance(&mut self, dt: f64);
     /// The state in the core's frames.
@@ -78,4 +81,36 @@ pub trait Vehicle {
     fn is_finite(&self) -> bool;
     /// The whole state as bytes; a restored vehicle continues bit for bit.
     fn save(&self) -> Result<Vec<u8>, SnapshotError>;
+}
+
+impl std::fmt::Debug for dyn Vehicle + Send {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Vehicle")
+            .field("actuators", &self.actuators())
+            .field("kinematics", &self.kinematics())
+            .finish()
+    }
+}
+
+/// A vehicle's start state, to take again and again: every [`VehicleStart::take`] is the same
+/// vehicle, bit for bit. An autopilot session goes back to it at each new connection, without
+/// knowing which model it flies.
+pub struct VehicleStart(Box<dyn Fn() -> Box<dyn Vehicle + Send> + Send + Sync>);
+
+impl VehicleStart {
+    /// Starts from a copy of `vehicle`'s state.
+    pub fn new<V: Vehicle + Clone + Send + Sync + 'static>(vehicle: V) -> Self {
+        VehicleStart(Box::new(move || Box::new(vehicle.clone())))
+    }
+
+    /// A new vehicle in the start state.
+    pub fn take(&self) -> Box<dyn Vehicle + Send> {
+        (self.0)()
+    }
+}
+
+impl std::fmt::Debug for VehicleStart {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_tuple("VehicleStart").field(&self.take()).finish()
+    }
 }

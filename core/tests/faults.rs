@@ -32,9 +32,17 @@ fn calm_quad(plan: &str) -> (Quadrotor, FlightFaults) {
 fn fly(quad: &mut Quadrotor, faults: &mut FlightFaults, command: [f64; 4], seconds: f64) {
     for _ in 0..(seconds / DT).round() as usize {
         faults.begin_step(quad, DT);
-        faults.drive(quad, &command, DT);
+        drive(quad, faults, &command, DT);
         faults.end_step();
     }
+}
+
+/// Commands `command` and advances `dt` through the actuator fault path, as a flight link does.
+fn drive(quad: &mut Quadrotor, faults: &mut FlightFaults, command: &[f64], dt: f64) {
+    quad.set_command(command).unwrap();
+    faults.before_advance(quad, dt);
+    quad.step(dt);
+    faults.after_advance(quad);
 }
 
 /// Thrust of rotor `i` now, N.
@@ -126,7 +134,7 @@ fn a_damaged_propeller_shakes_the_accelerometer_at_the_rotor_frequency() {
     let mut last = faults.state().imu_vibration(&quad.body.motors, 1.0).x;
     let dt = 1e-4;
     for _ in 0..10_000 {
-        faults.drive(&mut quad, &[0.5; 4], dt);
+        drive(&mut quad, &mut faults, &[0.5; 4], dt);
         let a = faults
             .state()
             .imu_vibration(&quad.body.motors, quad.params.mass);
@@ -266,7 +274,7 @@ fn bad_faults_are_refused_naming_the_field_and_its_bound() {
         let plan = FaultPlan::from_toml_str(text);
         let e = match plan {
             Err(e) => e,
-            Ok(plan) => from_values_ranges_and_faults(task, [], vec![], plan).unwrap_err(),
+            Ok(plan) => from_values_ranges_and_faults(task, [], vec![], None, plan).unwrap_err(),
         };
         e.to_string()
     };
@@ -322,6 +330,7 @@ fn bad_faults_are_refused_naming_the_field_and_its_bound() {
             TaskKind::Waypoints,
             [],
             vec![],
+            None,
             FaultPlan::from_toml_str("[[faults]]\nkind = 'motor_off'\nat_waypoint = 14").unwrap()
         )
         .is_ok()

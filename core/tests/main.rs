@@ -3,11 +3,13 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod faults;
+mod frame_tasks;
 mod lander2d_golden;
 mod lander2d_grid;
 mod lander2d_landing;
 mod lander2d_model;
 mod lander2d_reward;
+mod multi_agent;
 mod multirotor_frames;
 mod parameter_reference;
 mod quadrotor_golden;
@@ -18,4 +20,5 @@ mod quadrotor_rates;
 mod quadrotor_tasks;
 mod quadrotor_wind_grid;
 mod trace_hash;
+mod vehicle_seam;
 mod world;

@@ -17,7 +17,7 @@ RLlib (train_rllib.py), so a model is always evaluated on the env it was trained
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -38,6 +38,12 @@ def hover_success(terminated: bool, truncated: bool, info: Mapping[str, Any]) ->
         and not terminated
         and float(info["distance_to_target"]) < HOVER_SUCCESS_DISTANCE_M
     )
+
+
+def swap_success(terminated: bool, truncated: bool, info: Mapping[str, Any]) -> bool:
+    """Swap: every agent within its arrival radius at the end, no agent collided or crashed
+    (the core's info['success'], the same for every agent of a world)."""
+    return bool(info["success"])
 
 
 def lander_success(terminated: bool, truncated: bool, info: Mapping[str, Any]) -> bool:
@@ -126,6 +132,19 @@ OFFBOARD_RANDOMIZE = {
 }
 
 PRESETS: dict[str, Preset] = {
+    # Four agents exchange places across a 2 m circle (flyloop.parallel_env's Swap-v0), one
+    # policy for all: 5 s episodes (250 steps of 20 ms), no wind. Trained through
+    # flyloop.MultiAgentVectorEnv (one sub-env per agent; `multi_agent` marks it).
+    "swap": Preset(
+        name="swap",
+        env_id="flyloop/Swap-v0",
+        env_kwargs={"num_agents": 4, "max_steps": 250, "dt": 0.02},
+        actions=None,
+        success=swap_success,
+        success_text="every agent within 0.5 m of the opposite point at the time limit, "
+        "no collision or crash",
+        outcomes=("all four swapped places", "the swap failed"),
+    ),
     "hover": Preset(
         name="hover",
         env_id="flyloop/QuadHover-v0",
@@ -169,6 +188,17 @@ PRESETS: dict[str, Preset] = {
         success_text="landed on the platform (info['landed'])",
     ),
 }
+
+
+# QuadHover on another of the core's frames (fast_ppo.py --frame): the hover preset with the
+# env's `frame`, one motor command per rotor. The quad X is "hover" itself.
+FRAMES = ("quad_plus", "hexa_x", "octo_x")
+for _frame in FRAMES:
+    PRESETS[f"hover_{_frame}"] = replace(
+        PRESETS["hover"],
+        name=f"hover_{_frame}",
+        env_kwargs={**PRESETS["hover"].env_kwargs, "frame": _frame},
+    )
 
 
 def offboard_preset() -> Preset:

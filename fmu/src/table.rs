@@ -264,7 +264,7 @@ mod tests {
 
     #[test]
     fn motor_commands_are_one_array_and_every_model_value_has_one_home() {
-        let [quad, lander, hexa] = tables();
+        let [quad, lander, hexa, rates] = tables();
         let command = by_name(quad, "motor_command");
         assert_eq!(command.value_reference, 0);
         assert_eq!(command.dimension, Some(4));
@@ -294,7 +294,7 @@ mod tests {
         assert_eq!(by_name(hexa, "wind_input_x").value_reference, 6);
         let me = hexa.model_exchange.as_ref().unwrap();
         assert_eq!((me.states.len(), me.derivatives.len()), (27, 27));
-        for table in [quad, lander, hexa] {
+        for table in [quad, lander, hexa, rates] {
             assert_eq!(table.fmi3[0].source, Source::Time);
             // Every model variable in exactly one FMI 3.0 variable, in table order.
             let elements: Vec<usize> = table.fmi3.iter().flat_map(|v| v.elements()).collect();

@@ -186,13 +186,27 @@ fn fmi2_outputs(model: Model) -> Vec<u32> {
 #[test]
 fn fmi3_co_simulation_equals_fmi2_bit_for_bit_with_wind_and_arrays() {
     for model in Model::ALL {
-        let fmu2 = Fmu::started(model, 0.0, &[("seed", 11.0), ("wind_enabled", 1.0)]);
-        let fmu3 = Fmu3::started(model, false, |f| f.seed_and_wind(11));
+        // The rate controller has no weather: its inputs are the setpoint and the body rates.
+        let controller = model == Model::RateController;
+        let weather: &[(&str, f64)] = if controller {
+            &[]
+        } else {
+            &[("seed", 11.0), ("wind_enabled", 1.0)]
+        };
+        let fmu2 = Fmu::started(model, 0.0, weather);
+        let fmu3 = Fmu3::started(model, false, |f| {
+            if !controller {
+                f.seed_and_wind(11)
+            }
+        });
         let inputs2: Vec<u32> = model
             .table()
             .variables
             .iter()
-            .filter(|v| v.name.starts_with("motor_command"))
+            .filter(|v| {
+                let input = v.causality == flyloop_core::variables::Causality::Input;
+                input && (controller || v.name.starts_with("motor_command"))
+            })
             .map(|v| v.value_reference)
             .collect();
         // An array is named by its first element's value reference.
@@ -213,7 +227,12 @@ fn fmi3_co_simulation_equals_fmi2_bit_for_bit_with_wind_and_arrays() {
             let commands: Vec<f64> = (0..inputs2.len())
                 .map(|i| 0.55 + 0.1 * ((k as f64) * 0.05 + i as f64).sin())
                 .collect();
-            assert_eq!(fmu2.set_reals(&inputs2, &commands), fmi2Status::fmi2OK);
+            assert_eq!(
+                fmu2.set_reals(&inputs2, &commands),
+                fmi2Status::fmi2OK,
+                "{}",
+                fmu2.last_message()
+            );
             assert_eq!(fmu3.set(&inputs3, &commands), fmi3OK);
             let h = if k < 200 { 0.01 } else { 0.0123 };
             assert_eq!(fmu2.do_step(t, h), fmi2Status::fmi2OK);

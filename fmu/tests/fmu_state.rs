@@ -14,6 +14,7 @@ fn run(fmu: &Fmu, t: &mut f64, end: f64, h: f64) -> Vec<Vec<u64>> {
     let input = match fmu.model {
         Model::Quadrotor | Model::Hexacopter => "motor_command_1",
         Model::Lander2D => "motor_command_right",
+        Model::RateController => "roll_rate",
     };
     let mut outputs = Vec::new();
     while *t < end - 1e-9 {
@@ -30,11 +31,20 @@ fn started(model: Model) -> Fmu {
     // Wind and noise on (the defaults), a seed, and a moving platform for the lander: every
     // random draw and every rapier body is part of the state.
     let fmu = Fmu::new(model);
-    assert_eq!(fmu.set("seed", 21.0), fmi2OK);
-    if model == Model::Lander2D {
-        assert_eq!(fmu.set("moving_platform", 1.0), fmi2OK);
-    } else {
-        assert_eq!(fmu.set("initial_motor", 0.5), fmi2OK);
+    match model {
+        Model::Lander2D => {
+            assert_eq!(fmu.set("seed", 21.0), fmi2OK);
+            assert_eq!(fmu.set("moving_platform", 1.0), fmi2OK);
+        }
+        Model::RateController => {
+            // A thrust the allocator passes on; the roll rate setpoint moves the motors.
+            assert_eq!(fmu.set("thrust", 0.6), fmi2OK);
+            assert_eq!(fmu.set("wx", 0.3), fmi2OK);
+        }
+        _ => {
+            assert_eq!(fmu.set("seed", 21.0), fmi2OK);
+            assert_eq!(fmu.set("initial_motor", 0.5), fmi2OK);
+        }
     }
     assert_eq!(fmu.enter_init(), fmi2OK);
     assert_eq!(fmu.exit_init(), fmi2OK);

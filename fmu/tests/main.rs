@@ -11,4 +11,5 @@ mod lifecycle;
 mod misuse;
 mod model_description;
 mod model_exchange;
+mod rate_controller;
 mod stepping;

@@ -27,7 +27,16 @@ from .protocol import (
     mavlink2,
 )
 from .sitl_process import SitlProcess, find_sitl_binary
-from .tasks import FLAG, INTEGER, RANGE_PREFIX, REAL, TaskSpec, parameter_error, to_toml
+from .tasks import (
+    FLAG,
+    FRAME_KEY,
+    INTEGER,
+    RANGE_PREFIX,
+    REAL,
+    TaskSpec,
+    parameter_error,
+    to_toml,
+)
 
 _HIL_STATE_QUATERNION = mavlink2.MAVLINK_MSG_ID_HIL_STATE_QUATERNION
 MAX_VEHICLES = 254  # MAVLink system ids 1..254
@@ -140,6 +149,10 @@ def configure_attached(link: SitlLink, encoder: Encoder, spec: TaskSpec, config,
             "takes its faults from its --config file's [[faults]] tables"
         )
     for name, value in config.items():
+        if name == FRAME_KEY:
+            # A running SITL flies the frame of its own --config ([frame]); a motor interface
+            # sized for another frame is caught by the size check of its first frame.
+            continue
         param_id = ids[name]
         sent = float(value)
         d = link.exchange(

@@ -160,6 +160,27 @@ def randomize_entries(arg: str, v: Any) -> dict[str, tuple[float, float]]:
     return out
 
 
+# The config key naming the flight tasks' rotor table (a shipped frame of the core's): the
+# native extension reads it so, and to_toml writes it as the SITL's [frame] table.
+FRAME_KEY = "frame"
+DEFAULT_FRAME = "quad_x"
+
+
+def _frame_names() -> tuple[str, ...]:
+    return tuple(_native.frames())
+
+
+def frame_entry(arg: str, v: Any) -> dict[str, str]:
+    """`frame="hexa_x"` as a config entry; an unknown name raises ValueError listing the
+    core's shipped frames."""
+    names = _frame_names()
+    if not isinstance(v, str):
+        raise TypeError(f"{arg} must be a frame name, one of {list(names)}, got {v!r}")
+    if v not in names:
+        raise ValueError(f"{arg} must be one of {list(names)}, got {v!r}")
+    return {FRAME_KEY: v}
+
+
 # The seeds' arguments whose name or form differs from the core's parameters, mapped by
 # hand; every other argument is a core parameter under its own name (`own_argument`).
 _USE_WIND = _renamed(
@@ -205,6 +226,11 @@ FLIGHT_RENAMED = (
         Mapping[str, Any] | Sequence[Mapping[str, Any]] | None,
         "faults drawn per episode from its seed: kinds, probability, at, motor, sensors, "
         "duration and (low, high) ranges of the kinds' parameters",
+    ),
+    _renamed(
+        "frame", (), frame_entry, lambda d: DEFAULT_FRAME, str,
+        "the multirotor's rotor table: 'quad_x', 'quad_plus', 'hexa_x' or 'octo_x' (the "
+        "motor interface takes one command per rotor)",
     ),
 )  # fmt: skip
 LANDING_RENAMED = (
@@ -315,7 +341,7 @@ class TaskSpec:
         values = {
             k: (
                 v
-                if k == FAULTS_KEY
+                if k in (FAULTS_KEY, FRAME_KEY)
                 else tuple(map(float, v))
                 if k.startswith(RANGE_PREFIX)
                 else float(v)
@@ -383,6 +409,12 @@ def resolve_config(
             continue
         if name in ("faults", "fault_randomization"):
             continue
+        if name == FRAME_KEY:
+            # The quad X is the core's default: its config stays as it was before frames.
+            entry = frame_entry(name, value)
+            if value != DEFAULT_FRAME:
+                config.update(entry)
+            continue
         for core, v in zip(arg.core, arg.convert(name, value), strict=True):
             config[core] = v
     text = plan_text(arguments.get("faults"), arguments.get("fault_randomization"))
@@ -437,15 +469,15 @@ def parameter_error(spec: TaskSpec, message: str) -> SitlParameterError:
 
 
 def to_toml(config: Mapping[str, Any]) -> str:
-    """The SITL's --config file: a flat TOML table, and the randomisation ranges in its
-    [randomize] table."""
+    """The SITL's --config file: a flat TOML table, the randomisation ranges in its
+    [randomize] table and the frame in its [frame] table."""
     lines = []
     ranges = [
         f"{k[len(RANGE_PREFIX) :]} = [{float(lo)!r}, {float(hi)!r}]"
         for k, (lo, hi) in ((k, v) for k, v in config.items() if k.startswith(RANGE_PREFIX))
     ]
     for name, v in config.items():
-        if name.startswith(RANGE_PREFIX) or name == FAULTS_KEY:
+        if name.startswith(RANGE_PREFIX) or name in (FAULTS_KEY, FRAME_KEY):
             continue
         if isinstance(v, bool):
             text = "true" if v else "false"
@@ -458,4 +490,6 @@ def to_toml(config: Mapping[str, Any]) -> str:
         lines += ["", "[randomize]", *ranges]
     if FAULTS_KEY in config:
         lines += ["", config[FAULTS_KEY]]
+    if FRAME_KEY in config:
+        lines += ["", f"[{FRAME_KEY}]", f'name = "{config[FRAME_KEY]}"']
     return "\n".join(lines) + "\n"

@@ -182,7 +182,7 @@ fn shape_error(what: &str, expected: &[usize], got: &[usize]) -> PyErr {
     PyValueError::new_err(format!("{what} must have shape {expected:?}, got {got:?}"))
 }
 
-fn slice_of<'a, T: numpy::Element>(
+pub(crate) fn slice_of<'a, T: numpy::Element>(
     what: &str,
     array: &'a PyReadonlyArray2<'_, T>,
     expected: [usize; 2],
@@ -196,7 +196,7 @@ fn slice_of<'a, T: numpy::Element>(
         .map_err(|_| PyValueError::new_err(format!("{what} must be a C-contiguous array")))
 }
 
-fn slice_of1<'a, T: numpy::Element>(
+pub(crate) fn slice_of1<'a, T: numpy::Element>(
     what: &str,
     array: &'a PyReadonlyArray1<'_, T>,
     n: usize,
@@ -210,7 +210,7 @@ fn slice_of1<'a, T: numpy::Element>(
         .map_err(|_| PyValueError::new_err(format!("{what} must be a C-contiguous array")))
 }
 
-fn mut_of<'a, T: numpy::Element>(
+pub(crate) fn mut_of<'a, T: numpy::Element>(
     what: &str,
     array: &'a mut PyReadwriteArray2<'_, T>,
     expected: [usize; 2],
@@ -224,7 +224,7 @@ fn mut_of<'a, T: numpy::Element>(
         .map_err(|_| PyValueError::new_err(format!("{what} must be a C-contiguous array")))
 }
 
-fn mut_of1<'a, T: numpy::Element>(
+pub(crate) fn mut_of1<'a, T: numpy::Element>(
     what: &str,
     array: &'a mut PyReadwriteArray1<'_, T>,
     n: usize,

@@ -3,6 +3,7 @@
 //! - [`batch::Batch`]: N task instances stepped in one call (the GIL released, split over a
 //!   thread pool), writing into numpy arrays the caller preallocated; N = 1 serves the
 //!   single env.
+//! - [`multi_batch::MultiBatch`]: W worlds × N agents of a multi-agent task in one call.
 //! - [`tables::describe`]: a task's observation bounds, action bounds, control period, info
 //!   layout and parameter table, straight from the core, so Python keeps no copy;
 //!   [`tables::frames`] the shipped frames' rotor tables.
@@ -17,6 +18,7 @@
 //! linked for the `flyloop-sitl` command alone ([`sitl_command`]).
 
 mod batch;
+mod multi_batch;
 mod sitl_command;
 mod tables;
 
@@ -32,6 +34,7 @@ fn _panic_for_test(message: &str) {
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<batch::Batch>()?;
+    m.add_class::<multi_batch::MultiBatch>()?;
     m.add_function(wrap_pyfunction!(tables::describe, m)?)?;
     m.add_function(wrap_pyfunction!(tables::frames, m)?)?;
     m.add_function(wrap_pyfunction!(tables::fault_catalogue, m)?)?;

@@ -9,7 +9,7 @@ use flyloop_core::tasks::InfoValue;
 use flyloop_core::tasks::randomization::ParamRange;
 use flyloop_core::tasks::registry::param_rows;
 use flyloop_core::tasks::registry::{
-    TaskConfig, TaskInstance, TaskKind, from_values_ranges_and_faults,
+    ModelKind, TaskConfig, TaskInstance, TaskKind, from_values_ranges_and_faults,
 };
 use numpy::PyArray1;
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -41,6 +41,7 @@ pub fn task_config(task: TaskKind, params: Option<&Bound<'_, PyDict>>) -> PyResu
     let mut pairs: Vec<(String, f64)> = Vec::new();
     let mut ranges = Vec::new();
     let mut faults = FaultPlan::default();
+    let mut frame = None;
     if let Some(params) = params {
         for (key, value) in params.iter() {
             let name: String = key.extract().map_err(|_| {
@@ -54,6 +55,10 @@ pub fn task_config(task: TaskKind, params: Option<&Bound<'_, PyDict>>) -> PyResu
                 })?;
                 faults = FaultPlan::from_toml_str(&text)
                     .map_err(|e| PyValueError::new_err(e.to_string()))?;
+                continue;
+            }
+            if name == FRAME_KEY {
+                frame = Some(frame_named(&value)?);
                 continue;
             }
             if let Some(param) = name.strip_prefix(RANGE_PREFIX) {
@@ -77,9 +82,30 @@ pub fn task_config(task: TaskKind, params: Option<&Bound<'_, PyDict>>) -> PyResu
             pairs.push((name, number));
         }
     }
-    let pairs = pairs.iter().map(|(k, v)| (k.as_str(), *v));
-    from_values_ranges_and_faults(task, pairs, ranges, faults)
-        .map_err(|e| PyValueError::new_err(e.to_string()))
+    from_values_ranges_and_faults(
+        task,
+        pairs.iter().map(|(k, v)| (k.as_str(), *v)),
+        ranges,
+        frame,
+        faults,
+    )
+    .map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// The config key that names the flight tasks' frame: `"frame": "hexa_x"` (the SITL's config
+/// file has it as its `[frame]` table).
+const FRAME_KEY: &str = "frame";
+
+/// The shipped frame named by `value`; the error lists the names.
+fn frame_named(value: &Bound<'_, PyAny>) -> PyResult<Frame> {
+    let names = shipped_names().collect::<Vec<_>>().join("', '");
+    let name: String = value.extract().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "frame must be a frame name ('{names}'), got {value}"
+        ))
+    })?;
+    Frame::named(&name)
+        .map_err(|_| PyValueError::new_err(format!("frame must be one of '{names}', got {name:?}")))
 }
 
 fn kind_name(kind: ValueKind) -> &'static str {
@@ -108,7 +134,8 @@ pub fn info_layout(task: &TaskInstance) -> Vec<(&'static str, &'static str, usiz
 /// `observation_low`/`observation_high` (float32 arrays), `observation` (its layout: list of
 /// (name, count)), `action_low`/`action_high` (float64), `dt` (s), `info` (list of (name,
 /// kind, count)), `parameters` (list of dicts: name, id, group, kind, unit, min, max,
-/// default, value, description), `model`, `task`.
+/// default, value, description), `model`, `task`, and for the flight tasks `frame` (its name)
+/// and `rotors` (its rotor count).
 #[pyfunction]
 #[pyo3(signature = (task, params=None))]
 pub fn describe<'py>(
@@ -132,6 +159,10 @@ pub fn describe<'py>(
     out.set_item("observation", instance.observation_layout())?;
     out.set_item("dt", instance.dt())?;
     out.set_item("info", info_layout(&instance))?;
+    if kind.model() == ModelKind::Quadrotor {
+        out.set_item("frame", config.frame.name())?;
+        out.set_item("rotors", config.frame.rotor_count())?;
+    }
     let defaults = TaskConfig::default();
     let rows = PyList::empty(py);
     for e in param_rows::entries(kind) {

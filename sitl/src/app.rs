@@ -48,6 +48,21 @@ enum StartError {
         path: std::path::PathBuf,
         source: std::io::Error,
     },
+    #[error("fleet file {path}: {source}")]
+    FleetFile {
+        path: std::path::PathBuf,
+        source: crate::fleet::file::FleetError,
+    },
+    #[error("{0}")]
+    Fleet(#[from] crate::fleet::file::FleetError),
+    #[error("{0}")]
+    FleetStart(#[from] crate::fleet::FleetStartError),
+    #[error("vehicle `{name}`: cannot bind its autopilot's port {addr}: {source}")]
+    FleetBind {
+        name: String,
+        addr: SocketAddr,
+        source: std::io::Error,
+    },
     #[error("cannot start the runtime: {0}")]
     Runtime(#[from] std::io::Error),
 }
@@ -123,7 +138,7 @@ fn start_px4(args: Args) -> Result<(), StartError> {
         step_us,
         seed: args.seed,
     })?;
-    if let Some(track) = track(&args, session.quadrotor().frame().rotor_count())? {
+    if let Some(track) = track(&args, session.vehicle().actuator_count())? {
         session.track.set(track);
     }
     if let Some(view) = view_stream(&args)? {
@@ -156,6 +171,100 @@ fn start_px4(args: Args) -> Result<(), StartError> {
         || {
             println!("{ready}");
             tracing::info!(%listen, speed_factor = speed, "flyloop-sitl waiting for PX4");
+        },
+    )
+}
+
+/// Fleet mode: the fleet (file or row), its world, a socket per autopilot, then the
+/// lockstep until a signal.
+fn start_fleet(args: Args) -> Result<(), StartError> {
+    use crate::fleet::{self, file};
+    if args.track.is_some() || args.view.is_some() {
+        return Err(StartError::Options(
+            "--track and --view fly one autopilot; fleet mode has neither yet".to_string(),
+        ));
+    }
+    let mut spec = match &args.fleet {
+        Some(path) => {
+            let fleet_err = |source| StartError::FleetFile {
+                path: path.clone(),
+                source,
+            };
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| fleet_err(file::FleetError(format!("cannot read it: {e}"))))?;
+            let dir = path.parent().unwrap_or(std::path::Path::new("."));
+            file::parse(&text, dir).map_err(fleet_err)?
+        }
+        None => {
+            let (autopilot, base) = if args.px4 {
+                (file::Autopilot::Px4, args.px4_listen)
+            } else {
+                (file::Autopilot::Ardupilot, args.ardupilot_listen)
+            };
+            quadrotor_only(&args, if args.px4 { "--px4" } else { "--ardupilot" })?;
+            let vehicle = vehicle_config(&args)?;
+            file::row(
+                autopilot,
+                usize::from(args.vehicles),
+                base,
+                args.spacing,
+                &vehicle,
+            )?
+        }
+    };
+    for v in &mut spec.vehicles {
+        v.vehicle.sensors.home_latitude = args.home.latitude_deg;
+        v.vehicle.sensors.home_longitude = args.home.longitude_deg;
+        v.vehicle.sensors.home_altitude = args.home.altitude_m;
+    }
+    let step_us = (args.px4_step * 1e6).round() as u64;
+    let fleet = fleet::Fleet::new(&spec, args.seed, step_us)?;
+    let sockets = fleet::server::bind(&fleet)
+        .map_err(|(name, addr, source)| StartError::FleetBind { name, addr, source })?;
+    let ports: Vec<String> = (fleet.members().iter())
+        .map(|m| {
+            format!(
+                "{}:{}:{}:{}",
+                m.name,
+                m.autopilot.name(),
+                m.listen.port(),
+                m.sysid
+            )
+        })
+        .collect();
+    let gcs = match args.gcs {
+        GcsTarget::Off => None,
+        GcsTarget::At(target) => Some(target),
+    };
+    let speed = args.speed_factor;
+    let ready = format!(
+        "flyloop-sitl ready mode=fleet vehicles={} members={} speed_factor={speed} seed={}",
+        fleet.members().len(),
+        ports.join(","),
+        args.seed
+    );
+    let options = fleet::server::FleetOptions {
+        pacing: Pacing {
+            speed_factor: speed,
+        },
+        timeout: std::time::Duration::from_secs_f64(args.autopilot_timeout),
+        gcs,
+    };
+    let n = fleet.members().len();
+    serve_until_signal(
+        |shutdown| {
+            Ok(async move {
+                let (_, summary) = fleet::server::run(fleet, sockets, options, shutdown).await?;
+                Ok(summary)
+            })
+        },
+        || {
+            println!("{ready}");
+            tracing::info!(
+                vehicles = n,
+                speed_factor = speed,
+                "flyloop-sitl waiting for the fleet's autopilots"
+            );
         },
     )
 }
@@ -240,7 +349,7 @@ fn start_ardupilot(args: Args) -> Result<(), StartError> {
         vehicle,
         seed: args.seed,
     })?;
-    if let Some(track) = track(&args, session.quadrotor().frame().rotor_count())? {
+    if let Some(track) = track(&args, session.vehicle().actuator_count())? {
         session.track.set(track);
     }
     if let Some(view) = view_stream(&args)? {
@@ -293,6 +402,9 @@ fn start(args: Args) -> Result<(), StartError> {
         };
         print!("{text}");
         return Ok(());
+    }
+    if args.fleet.is_some() || ((args.px4 || args.ardupilot) && args.vehicles > 1) {
+        return start_fleet(args);
     }
     if args.px4 {
         return start_px4(args);

@@ -3,13 +3,15 @@
 //! autopilot always agree on where each motor is and which way it turns.
 //!
 //! PX4 takes any multirotor as a table (`CA_ROTORn_PX/PY/KM/CT`, body FRD, metres): the
-//! frame's rotors are written out, motor n on output n (`PWM_MAIN_FUNCn = 100 + n`, which
+//! core's [`px4_rotors`] of the frame (what the rate-loop model mixes for too; the quad X's are
+//! PX4's stock none_iris values, which PX4 flies it with), motor n on output n (`PWM_MAIN_FUNCn = 100 + n`, which
 //! PX4's simulator link sends as HIL_ACTUATOR_CONTROLS controls[n − 1]). ArduPilot mixes only
 //! its own frame classes (AP_MotorsMatrix): the shipped frames are its quad X and plus, hexa X
 //! and octo X, whose motor order is the table's (checked against AP_MotorsMatrix's motor
 //! angles in this module's tests), and a frame it has no class for is refused.
 
 use flyloop_core::quadrotor::{Frame, QuadrotorParams};
+use flyloop_core::rate_loop::px4_rotors::{NONE_IRIS, px4_rotors};
 use std::fmt::Write;
 
 /// Which autopilot's parameters to print.
@@ -42,22 +44,42 @@ pub fn px4(frame: &Frame, params: &QuadrotorParams) -> String {
         px4_mav_type(frame.rotor_count()).to_string(),
     );
     line("CA_ROTOR_COUNT".into(), frame.rotor_count().to_string());
-    for (i, r) in frame.rotors().iter().enumerate() {
-        // Body FRD: x forward as FLU's, y right = −FLU's y.
-        line(format!("CA_ROTOR{i}_PX"), round(params.arm_length * r.x));
-        line(format!("CA_ROTOR{i}_PY"), round(-params.arm_length * r.y));
-        // KM: torque per thrust, positive for a counter-clockwise rotor.
-        let km = r
-            .torque_coefficient
-            .unwrap_or(params.yaw_torque_coefficient);
-        line(format!("CA_ROTOR{i}_KM"), round(-r.spin.sign() * km));
-        let ct = r.thrust_coefficient.unwrap_or(params.thrust_coefficient);
-        line(format!("CA_ROTOR{i}_CT"), round(ct));
+    // The same rotors the core's rate-loop model mixes for (the quad X: PX4's stock none_iris).
+    for (i, r) in px4_rotors(frame, params).iter().enumerate() {
+        let iris = NONE_IRIS.get(i);
+        let kept = |value: f64, iris: Option<f64>, default: f64| kept_by_px4(value, iris, default);
+        line(
+            format!("CA_ROTOR{i}_PX"),
+            kept(r.px, iris.map(|s| s.px), 0.0),
+        );
+        line(
+            format!("CA_ROTOR{i}_PY"),
+            kept(r.py, iris.map(|s| s.py), 0.0),
+        );
+        line(
+            format!("CA_ROTOR{i}_KM"),
+            kept(r.km, iris.map(|s| s.km), 0.05),
+        );
+        line(format!("CA_ROTOR{i}_CT"), round(r.ct));
     }
     for n in 1..=frame.rotor_count() {
         line(format!("PWM_MAIN_FUNC{n}"), (100 + n).to_string());
     }
     out
+}
+
+/// `value` as printed so that PX4 keeps it. PX4 SITL applies its `PX4_PARAM_*` variables
+/// before the airframe script and drops one equal to the firmware's default (`default`:
+/// nothing to store); none_iris's `param set-default` then puts the Iris's value (`iris`) in
+/// its place. Measured: a hexa's `CA_ROTOR0_PX 0` became 0.1515 and PX4 pitched on every roll
+/// step. Such a value is printed one step (1e-6) off the default, which PX4 keeps; the model
+/// mixes for the exact table (a 1e-6 m difference).
+fn kept_by_px4(value: f64, iris: Option<f64>, default: f64) -> String {
+    let printed = round(value);
+    match iris {
+        Some(iris) if printed == round(default) && printed != round(iris) => round(value + 1e-6),
+        _ => printed,
+    }
 }
 
 /// A number as PX4's float parameters print it: six decimals at most, no trailing zeros.
@@ -152,6 +174,52 @@ mod tests {
         );
         assert!(octo.contains("MAV_TYPE 14\n") && octo.contains("PWM_MAIN_FUNC8 108\n"));
         assert!(hexa.contains("CA_ROTOR_COUNT 6\n") && hexa.contains("CA_ROTOR5_CT 10\n"));
+    }
+
+    /// The quad X is what PX4 flies it with: its stock none_iris rotors (the numbers the
+    /// core's rate-loop model mixes for).
+    #[test]
+    fn the_quad_x_prints_px4s_none_iris_rotors() {
+        let text = px4(&Frame::quad_x(), &QuadrotorParams::default());
+        for line in [
+            "CA_ROTOR_COUNT 4",
+            "CA_ROTOR0_PX 0.1515",
+            "CA_ROTOR0_PY 0.245",
+            "CA_ROTOR0_KM 0.05",
+            "CA_ROTOR1_PY -0.1875",
+            "CA_ROTOR3_KM -0.05",
+            "CA_ROTOR3_CT 6.5",
+        ] {
+            assert!(text.contains(&format!("{line}\n")), "{line} in {text}");
+        }
+    }
+
+    /// Regression (issue 33): PX4 drops a `PX4_PARAM_` value equal to its firmware default
+    /// and none_iris then re-defaults it (a hexa's rotor 0 flew with the Iris's x = 0.1515 m):
+    /// such values print one step off the default; values none_iris shares stay as they are.
+    #[test]
+    fn values_px4_would_drop_for_none_iris_defaults_print_one_step_off() {
+        let hexa = px4(
+            &Frame::named("hexa_x").unwrap(),
+            &QuadrotorParams::default(),
+        );
+        assert!(
+            hexa.contains("CA_ROTOR0_PX 0.000001\n") && hexa.contains("CA_ROTOR1_PX 0.000001\n")
+        );
+        // Rotors past none_iris's four keep their exact values.
+        let plus = px4(
+            &Frame::named("quad_plus").unwrap(),
+            &QuadrotorParams::default(),
+        );
+        assert!(plus.contains("CA_ROTOR2_PY 0.000001\n"), "{plus}");
+        let km = QuadrotorParams {
+            yaw_torque_coefficient: 0.05,
+            ..QuadrotorParams::default()
+        };
+        let hexa = px4(&Frame::named("hexa_x").unwrap(), &km);
+        // Rotor 1 turns counter-clockwise: KM 0.05 is the default and none_iris's rotor 1 too.
+        assert!(hexa.contains("CA_ROTOR1_KM 0.05\n") && hexa.contains("CA_ROTOR3_KM 0.050001\n"));
+        assert!(hexa.contains("CA_ROTOR4_KM 0.05\n"), "{hexa}");
     }
 
     fn check(text: &str, expected: &[(f64, f64, f64)]) {

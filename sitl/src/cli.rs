@@ -135,6 +135,22 @@ pub struct Args {
     #[arg(long, default_value_t = crate::track::TRACK_INTERVAL_US, value_parser = clap::value_parser!(u64).range(1..))]
     pub track_interval_us: u64,
 
+    /// Fleet mode: a fleet file (TOML: `[world]`, one `[[vehicle]]` per autopilot) of PX4
+    /// and ArduPilot vehicles sharing one world (docs/fleet.md). `--px4 --vehicles N` and
+    /// `--ardupilot --vehicles N` make a row of N without a file.
+    #[arg(long, conflicts_with_all = ["px4", "ardupilot"])]
+    pub fleet: Option<PathBuf>,
+
+    /// Fleet mode (`--vehicles N`): metres between neighbours of the row, going east.
+    #[arg(long, default_value_t = 3.0, value_parser = parse_spacing)]
+    pub spacing: f64,
+
+    /// Fleet mode: wall seconds an autopilot may keep the world waiting before its
+    /// vehicle's motors stop and the others go on (it takes its vehicle back when it
+    /// answers again or restarts).
+    #[arg(long, default_value_t = 3.0, value_parser = parse_seconds)]
+    pub autopilot_timeout: f64,
+
     /// Print the task's parameters and exit: `table` (MAVLink ids, names, ranges, defaults;
     /// the default) or `toml` (a starter file for --config, with --config's values if given).
     #[arg(long, value_enum, num_args = 0..=1, default_missing_value = "table")]
@@ -149,6 +165,13 @@ pub struct Args {
     /// or `ardupilot` (a .parm file).
     #[arg(long, value_enum)]
     pub print_autopilot_params: Option<crate::autopilot_params::Autopilot>,
+}
+
+fn parse_spacing(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x.is_finite() && (0.5..=1000.0).contains(&x) => Ok(x),
+        _ => Err(format!("`{s}`: the spacing must be 0.5 to 1000 m")),
+    }
 }
 
 /// `--model`'s values: the core's model names.

@@ -29,7 +29,7 @@ pub enum ConfigError {
     Invalid { path: PathBuf, source: ParamError },
 }
 
-/// The autopilot modes' table of the vehicle's rotors (`core/src/quadrotor/frame.rs`).
+/// The table of the vehicle's rotors (`core/src/quadrotor/frame.rs`), in every mode.
 pub const FRAME_TABLE: &str = "frame";
 
 /// The config file's table of randomisation ranges: `[randomize]` with `name = [low, high]`.
@@ -114,15 +114,28 @@ fn toml_number(value: &toml::Value) -> Option<f64> {
 /// Parses `text` into the parameter sets of `task` (other sets keep their defaults) and
 /// checks that the task builds from them.
 pub fn parse(task: TaskKind, text: &str) -> Result<TaskConfig, ParamError> {
-    let table: toml::Table = toml::from_str(text)?;
+    let mut table: toml::Table = toml::from_str(text)?;
+    let frame = take_frame(&mut table)?;
     let rows = param_rows::entries(task);
     let file = walk(&table, |key| Ok(param_rows::find(&rows, task, key)?.name))?;
     from_values_ranges_and_faults(
         task,
         file.values,
         file.ranges.unwrap_or_default(),
+        frame,
         file.faults,
     )
+}
+
+/// The file's `[frame]` table as a frame (taken out of `table`), if it has one.
+fn take_frame(table: &mut toml::Table) -> Result<Option<Frame>, ParamError> {
+    match table.remove(FRAME_TABLE) {
+        None => Ok(None),
+        Some(toml::Value::Table(t)) => Ok(Some(Frame::from_toml_table(t)?)),
+        Some(_) => Err(ParamError::Parse(format!(
+            "`{FRAME_TABLE}` must be a table: `name = \"hexa_x\"`, or `name` and one `[[{FRAME_TABLE}.rotor]]` per rotor"
+        ))),
+    }
 }
 
 /// The preset the autopilot modes fly by default (sitl/presets/px4_iris.toml, built in).
@@ -148,15 +161,7 @@ impl AutopilotVehicle {
     /// frame in its own `[frame]` table; no randomisation.
     pub fn parse(text: &str) -> Result<Self, ParamError> {
         let mut table: toml::Table = toml::from_str(text)?;
-        let frame = match table.remove(FRAME_TABLE) {
-            None => Frame::quad_x(),
-            Some(toml::Value::Table(t)) => Frame::from_toml_table(t)?,
-            Some(_) => {
-                return Err(ParamError::Parse(format!(
-                    "`{FRAME_TABLE}` must be a table: `name = \"hexa_x\"`, or `name` and one `[[{FRAME_TABLE}.rotor]]` per rotor"
-                )));
-            }
-        };
+        let frame = take_frame(&mut table)?.unwrap_or_default();
         let file = walk(&table, autopilot_name)?;
         if !file.faults.is_empty() {
             return Err(ParamError::Parse(format!(

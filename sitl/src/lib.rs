@@ -12,6 +12,7 @@
 //! - [`config`]: the parameter file of every mode (the task's, or the autopilot modes' vehicle),
 //! - [`px4`]: PX4 mode, flyloop as PX4's simulator over TCP,
 //! - [`ardupilot`]: ArduPilot mode, flyloop as ArduPilot's JSON physics backend over UDP,
+//! - [`fleet`]: fleet mode, PX4s and ArduPilots flying the vehicles of one world,
 //! - [`pacer`]: the wall-clock pacer of both autopilot modes,
 //! - [`track`]: their ground-truth track file (`--track`),
 //! - [`speed`]: their simulated time and real-time factor in the log.
@@ -22,6 +23,7 @@ pub mod autopilot_params;
 pub mod cli;
 pub mod commands;
 pub mod config;
+pub mod fleet;
 pub mod fuzz;
 pub mod gcs_streams;
 pub mod kinematics;

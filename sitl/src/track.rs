@@ -8,8 +8,8 @@
 //! `grounded` (0/1),
 //! `p,q,r` (body rates, rad/s, FRD).
 
-use crate::kinematics::{attitude_ned, enu_to_ned, flu_to_frd};
-use flyloop_core::quadrotor::Quadrotor;
+use crate::kinematics::attitude_ned;
+use flyloop_core::vehicle::Vehicle;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
@@ -56,29 +56,29 @@ impl Track {
         self.out.flush()
     }
 
-    /// Appends a row for `quad` at `time_us` when one is due.
-    pub fn record(&mut self, time_us: u64, quad: &Quadrotor) -> io::Result<()> {
+    /// Appends a row for `vehicle` at `time_us` when one is due.
+    pub fn record(&mut self, time_us: u64, vehicle: &dyn Vehicle) -> io::Result<()> {
         if time_us < self.next_us {
             return Ok(());
         }
         self.next_us = time_us + self.interval_us;
-        let b = &quad.body;
-        let p = enu_to_ned(&b.position);
-        let v = enu_to_ned(&b.velocity);
-        let (roll, pitch, yaw) = attitude_ned(&quad.attitude()).euler_angles();
-        let w = flu_to_frd(&b.body_rates);
+        let k = vehicle.kinematics();
+        let p = k.position_ned();
+        let v = k.velocity_ned();
+        let (roll, pitch, yaw) = attitude_ned(&k.attitude).euler_angles();
+        let w = k.body_rates_frd();
         write!(
             self.out,
             "{},{time_us},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.5},{:.5},{:.5}",
             self.connection, p.x, p.y, p.z, v.x, v.y, v.z, roll, pitch, yaw,
         )?;
-        for m in b.motors {
+        for m in vehicle.actuator_states() {
             write!(self.out, ",{m:.4}")?;
         }
         writeln!(
             self.out,
             ",{},{:.5},{:.5},{:.5}",
-            u8::from(quad.is_grounded()),
+            u8::from(vehicle.is_grounded()),
             w.x,
             w.y,
             w.z
@@ -115,11 +115,11 @@ impl SessionTrack {
         }
     }
 
-    /// A row for `quad` at `time_us` when one is due (and the view's state).
-    pub fn record(&mut self, time_us: u64, quad: &Quadrotor) {
-        self.write(|track| track.record(time_us, quad));
+    /// A row for `vehicle` at `time_us` when one is due (and the view's state).
+    pub fn record(&mut self, time_us: u64, vehicle: &dyn Vehicle) {
+        self.write(|track| track.record(time_us, vehicle));
         if let Some(view) = &mut self.1 {
-            view.send(time_us, quad);
+            view.send(time_us, vehicle);
         }
     }
 

@@ -7,7 +7,6 @@
 use crate::kinematics::Home;
 use crate::telemetry::hil_state_quaternion_of;
 use crate::wire::Encoder;
-use flyloop_core::quadrotor::Quadrotor;
 use flyloop_core::vehicle::Vehicle;
 use mavlink::dialects::common::*;
 use std::io;
@@ -55,9 +54,9 @@ impl ViewStream {
         self.next_heartbeat_us = 0;
     }
 
-    /// Sends `quad`'s state at `time_us` when one is due (a lost or refused datagram is
+    /// Sends `vehicle`'s state at `time_us` when one is due (a lost or refused datagram is
     /// not an error: nobody may be watching).
-    pub fn send(&mut self, time_us: u64, quad: &Quadrotor) {
+    pub fn send(&mut self, time_us: u64, vehicle: &dyn Vehicle) {
         if time_us < self.next_us {
             return;
         }
@@ -79,7 +78,7 @@ impl ViewStream {
             let home = crate::telemetry::home_position_of(&self.home, time_us);
             self.encoder.push(&mut self.out, 1, &home);
         }
-        let k = quad.kinematics();
+        let k = vehicle.kinematics();
         let state = hil_state_quaternion_of(&k, &self.home, time_us);
         self.encoder.push(&mut self.out, 1, &state);
         let _ = self.socket.send_to(&self.out, self.target);

@@ -2,10 +2,13 @@
 steps flown once through PX4 in OFFBOARD (SET_ATTITUDE_TARGET, body rates + thrust) on
 flyloop's Iris, and once through the model (the gym env's rates interface, in-process, one
 rate-loop tick per step) on the same vehicle; the body-rate responses agree within 10 % of
-the step size (RMS).
+the step size (RMS). The same for the hexacopter X preset, PX4 started with the mixer
+`--print-autopilot-params px4` prints and the model mixing for the same rotor table
+(`frame="hexa_x"`).
 
 With FLYLOOP_RATE_MODEL_OUT=DIR the test also writes DIR/rate_model.png (the responses side
-by side) and DIR/rate_model.json (the figures); docs/px4.md's plot is made so."""
+by side) and DIR/rate_model.json (the figures) for the quad, DIR/rate_model_hexa_x.* for the
+hexa; docs/px4.md's plot is made so."""
 
 from __future__ import annotations
 
@@ -17,13 +20,25 @@ from pathlib import Path
 import flyloop as _registers_envs  # noqa: F401
 import gymnasium as gym
 import numpy as np
+import pytest
 import tomllib
-from px4_support import TAKEOFF_ALT, collect, settle
+from px4_support import TAKEOFF_ALT, autopilot_params, collect, settle
 from pymavlink import mavutil
 
 ROOT = Path(__file__).resolve().parents[2]
-IRIS = tomllib.loads((ROOT / "sitl" / "presets" / "px4_iris.toml").read_text())
-IRIS.pop("wind_enabled")
+PRESETS = ROOT / "sitl" / "presets"
+
+
+def vehicle(preset: str) -> tuple[dict, str]:
+    """A PX4 preset's quadrotor parameters (its wind switch is the env's use_wind) and its
+    frame's name (the quad X when it has no [frame])."""
+    params = tomllib.loads((PRESETS / f"{preset}.toml").read_text())
+    params.pop("wind_enabled")
+    frame = params.pop("frame", {"name": "quad_x"})["name"]
+    return params, frame
+
+
+IRIS, _ = vehicle("px4_iris")
 TICK_MS = 4
 STEP = 0.8  # rad/s
 # (seconds, thrust offset from hover, roll, pitch, yaw rate): the steps of the comparison.
@@ -91,9 +106,9 @@ def fly_sequence(px4, hover: float) -> tuple[list[tuple[int, tuple]], int]:
     return sent, start
 
 
-def model_rates(sent, start, hover, lag_ms, ticks) -> np.ndarray:
+def model_rates(sent, start, hover, lag_ms, ticks, params=IRIS, frame="quad_x") -> np.ndarray:
     """The model's body rates (FRD) at each 4 ms tick from `start`, the setpoint applied
-    `lag_ms` after it was sent."""
+    `lag_ms` after it was sent, on the vehicle `params` with the rotor table `frame`."""
     env = gym.make(
         "flyloop/QuadHover-v0",
         backend="native",
@@ -104,7 +119,8 @@ def model_rates(sent, start, hover, lag_ms, ticks) -> np.ndarray:
         start_attitude_range=0.0,
         start_height=10.0,
         space_side_length=20.0,
-        model_params=IRIS,
+        model_params=params,
+        frame=frame,
     )
     try:
         obs, _ = env.reset(seed=0)
@@ -121,9 +137,18 @@ def model_rates(sent, start, hover, lag_ms, ticks) -> np.ndarray:
     return rates
 
 
-def test_the_rate_loop_model_follows_px4s_body_rate_responses(pair):
-    flyloop = pair.flyloop("--track-interval-us", str(TICK_MS * 1000))
-    px4 = pair.px4()
+@pytest.mark.parametrize("preset", ["px4_iris", "px4_hexa_x"], ids=["quad_x", "hexa_x"])
+def test_the_rate_loop_model_follows_px4s_body_rate_responses(pair, sitl_binary, preset):
+    params, frame = vehicle(preset)
+    rotors = {"quad_x": 4, "hexa_x": 6}[frame]
+    if frame == "quad_x":
+        # PX4's stock none_iris mixer, as every quad test flies it.
+        flyloop = pair.flyloop("--track-interval-us", str(TICK_MS * 1000))
+        px4 = pair.px4()
+    else:
+        config = PRESETS / f"{preset}.toml"
+        flyloop = pair.flyloop("--config", str(config), "--track-interval-us", str(TICK_MS * 1000))
+        px4 = pair.px4(**autopilot_params(sitl_binary, config, "px4"))
     px4.heartbeat(60)
     for message in ("ATTITUDE_QUATERNION", "LOCAL_POSITION_NED"):
         message_id = getattr(mavutil.mavlink, f"MAVLINK_MSG_ID_{message}")
@@ -133,7 +158,7 @@ def test_the_rate_loop_model_follows_px4s_body_rate_responses(pair):
     home = px4.home()
     settle(px4, (home[0], home[1], home[2] - TAKEOFF_ALT), 0.3, 60)
     collect(px4, 2.0)
-    hover = math.sqrt(IRIS["mass"] * 9.81 / (4 * IRIS["thrust_coefficient"]))
+    hover = math.sqrt(params["mass"] * 9.81 / (rotors * params["thrust_coefficient"]))
     sent, start = fly_sequence(px4, hover)
     loiter = mavutil.mavlink.MAV_CMD_DO_SET_MODE
     px4.accepted(loiter, lambda: px4.command(loiter, 1, 4, 3), 10)
@@ -150,12 +175,13 @@ def test_the_rate_loop_model_follows_px4s_body_rate_responses(pair):
     # at: the best lag in whole ticks, searched over 0..60 ms.
     fits = {}
     for lag in range(0, 64, TICK_MS):
-        model = model_rates(sent, start, hover, lag, total)
+        model = model_rates(sent, start, hover, lag, total, params, frame)
         fits[lag] = (np.sqrt(np.mean((model - px4_rates) ** 2, axis=0)), model)
     lag = min(fits, key=lambda k: fits[k][0].sum())
     rms, model = fits[lag]
     relative = rms / STEP
     figures = dict(
+        frame=frame,
         lag_ms=lag,
         rms_rad_s=dict(zip("pqr", rms.tolist(), strict=True)),
         rms_of_step=dict(zip("pqr", relative.tolist(), strict=True)),
@@ -163,17 +189,18 @@ def test_the_rate_loop_model_follows_px4s_body_rate_responses(pair):
     )
     out = os.environ.get("FLYLOOP_RATE_MODEL_OUT")
     if out:
-        write(
-            Path(out), figures, t_ms[first : first + total] - start, px4_rates, model, sent, start
-        )
+        name = "rate_model" if frame == "quad_x" else f"rate_model_{frame}"
+        t = t_ms[first : first + total] - start
+        write(Path(out), name, figures, t, px4_rates, model, sent, start)
+    print(figures)
     assert (relative < 0.10).all(), figures
 
 
-def write(out: Path, figures, t, px4_rates, model, sent, start) -> None:
+def write(out: Path, stem: str, figures, t, px4_rates, model, sent, start) -> None:
     from matplotlib.figure import Figure
 
     out.mkdir(parents=True, exist_ok=True)
-    (out / "rate_model.json").write_text(json.dumps(figures, indent=2) + "\n")
+    (out / f"{stem}.json").write_text(json.dumps(figures, indent=2) + "\n")
     fig = Figure(figsize=(9, 6), layout="constrained")
     axes = fig.subplots(3, 1, sharex=True)
     st = np.array([t for t, _ in sent]) - start
@@ -188,4 +215,4 @@ def write(out: Path, figures, t, px4_rates, model, sent, start) -> None:
         ax.grid(alpha=0.3)
     axes[0].legend(loc="upper right", fontsize=8)
     axes[-1].set_xlabel(f"seconds (model lag {figures['lag_ms']} ms)")
-    fig.savefig(out / "rate_model.png", dpi=100)
+    fig.savefig(out / f"{stem}.png", dpi=100)

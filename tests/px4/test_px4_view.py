@@ -1,6 +1,6 @@
 """docs/view.md's PX4 flight in the live view: flyloop-sitl --px4 --view sends the truth,
 `python -m flyloop.view` talks to PX4's ground-station port for its estimate; PX4 takes off.
-The view's recording must hold both, the estimate beside the truth (within 0.5 m once
+The view's recording must hold both, the estimate beside the truth (within 0.3 m once
 airborne), and the browser must draw the vehicle."""
 
 from __future__ import annotations
@@ -68,7 +68,9 @@ def test_px4_takeoff_in_the_live_view_with_the_estimate_beside_the_truth(pair, t
     assert len(up) > 50
     truth_at = np.interp(up, t_true, d_true)
     gap = np.abs(np.interp(up, t_est, d_est) - truth_at)
-    assert gap.max() < 0.5, gap.max()
+    # 0.06-0.09 m measured once PX4 answers the view's commands; regression: addressed to
+    # system 0, PX4 ignored them, the origin never came and the gap was 0.1-0.57 m by run.
+    assert gap.max() < 0.3, gap.max()
     assert -d_true.min() > TAKEOFF_ALT - 0.5
     _, n_estimate = series["/position/vehicle1/N/estimate"]
     assert np.isfinite(n_estimate).all()

@@ -74,8 +74,8 @@ def test_listings_print_and_exit(sitl_binary):
     rows = [ln for ln in params.stdout.splitlines() if ln.startswith("| `")]
     ids = [r.split("`")[1] for r in rows]
     # 30 quadrotor parameters (22 + the 7 of the landing gear + turbulence_dt), 18 flight
-    # (12 + the rates interface's 6), 4 waypoints, 39 of PX4's rate loop.
-    assert len(ids) == 91 and len(set(ids)) == 91 and max(map(len, ids)) <= 16
+    # (12 + the rates interface's 6), 4 waypoints, 27 of PX4's rate loop.
+    assert len(ids) == 79 and len(set(ids)) == 79 and max(map(len, ids)) <= 16
     assert "| `en_oob_det` | `enable_out_of_bounds_detection` |" in params.stdout
     frame = run(sitl_binary, "--task", "hover", "--describe-frame")
     assert frame.returncode == 0

@@ -24,8 +24,8 @@ def test_the_list_serves_every_model_and_task_parameter_with_unique_short_ids(
     values = param_list(client)
     ids = [v.param_id for v in values]
     # 30 quadrotor parameters (22 + 7 of the landing gear + turbulence_dt), 18 flight (12 +
-    # the rates interface's 6), 4 waypoints, 39 of PX4's rate loop.
-    assert len(values) == values[0].param_count == 30 + 18 + 4 + 39
+    # the rates interface's 6), 4 waypoints, 27 of PX4's rate loop (its rotors are the frame's).
+    assert len(values) == values[0].param_count == 30 + 18 + 4 + 27
     assert [v.param_index for v in values] == list(range(len(values)))
     assert len(set(ids)) == len(ids) and all(len(i) <= 16 for i in ids)
     by_id = {v.param_id: v for v in values}

@@ -75,6 +75,25 @@ def test_fast_ppo_learns_the_same_over_the_sitl_as_in_process(tmp_path, sitl_bin
 
 
 @pytest.mark.training
+def test_fast_ppo_flies_another_frame_the_same_over_the_sitl_as_in_process(tmp_path, sitl_binary):
+    """--frame hexa_x: QuadHover on the hexacopter X (six motor commands), both backends
+    learning exactly the same; --frame on a task that is not hover is refused."""
+    done = run_script(
+        TRAIN / "fast_ppo.py", "--frame", "hexa_x",
+        *("--backend", "native", "sitl", "--timesteps", "8192", "--num-envs", "16"),
+        *("--eval-episodes", "4", "--out", str(tmp_path), "--no-progress-bar"),
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr[-3000:]
+    native, sitl = summary(tmp_path, "native"), summary(tmp_path, "sitl")
+    assert native["env"] == "hover_hexa_x" and native["env_kwargs"]["frame"] == "hexa_x"
+    strip = [{k: v for k, v in r.items() if k != "wall_s"} for r in native["rows"]]
+    assert strip == [{k: v for k, v in r.items() if k != "wall_s"} for r in sitl["rows"]]
+    assert native["evaluation"] == sitl["evaluation"]
+    refused = run_script(TRAIN / "fast_ppo.py", "--env", "lander", "--frame", "hexa_x")
+    assert refused.returncode == 2 and "--frame hexa_x flies --env hover only" in refused.stderr
+
+
+@pytest.mark.training
 def test_fast_ppo_short_lander_run_beats_random_actions(tmp_path):
     """A short run on Lander2D-v1 (static pad) with the lander's settings: on the same
     held-out episodes the deterministic policy's return and episode length clearly beat

@@ -41,6 +41,25 @@ def test_a_shipped_lander_policy_lands_on_held_back_seeds(name, episodes, requir
     assert result["landing_speed_max_m_s"] < 1.5 and result["landing_angle_max_rad"] < 0.2
 
 
+def test_the_shipped_hexa_hover_policy_holds_its_targets_on_held_back_seeds():
+    """policies/hexa_hover: fast_ppo.py --frame hexa_x (seed 0, 2M env steps), QuadHover on
+    the hexacopter X with six motor commands. Shipped for 97 % held-out (100 episodes from
+    1,000,000); measured 48 of 50 here. A policy meeting 95 % holds >= 43 of 50 with
+    probability 0.99."""
+    import evaluate
+
+    folder = POLICIES / "hexa_hover"
+    summary = json.loads((folder / "summary.json").read_text())
+    assert summary["algo"] == "fast_ppo" and summary["env_kwargs"]["frame"] == "hexa_x"
+    held_out = summary["evaluation"]
+    assert held_out["episodes"] == 100 and held_out["seed"] == 1_000_000
+    assert held_out["success_rate"] >= 0.95, held_out
+    result = evaluate.evaluate(folder, 50, HELD_BACK_SEEDS)
+    print(result)
+    assert result["env_id"] == "flyloop/QuadHover-v0"
+    assert result["success_rate"] >= 0.86, result
+
+
 def test_evaluate_records_the_evaluated_episode_as_a_gif(tmp_path):
     """--gif records the first evaluation episode, acting exactly as the evaluation does: the
     recording's ending (landed or not) and length agree with a one-episode evaluation."""

@@ -13,6 +13,7 @@ mod kinematics;
 pub mod model;
 pub mod params;
 pub(crate) mod scene;
+mod seam;
 pub mod variables;
 pub mod world;
 

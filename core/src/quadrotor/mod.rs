@@ -20,4 +20,5 @@ pub mod wind;
 pub use frame::{Frame, FrameError, FrameTable, Rotor, Spin};
 pub use model::Quadrotor;
 pub use params::{QuadrotorInitial, QuadrotorParams};
+pub use seam::standing_multirotor;
 pub use state::{BodyState, Motors, WindState};

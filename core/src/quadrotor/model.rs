@@ -95,12 +95,7 @@ impl Quadrotor {
     /// (the quad X's is [`QuadrotorParams::hover_motor_state`]). `None` when no motor state
     /// in [0, 1] can hover.
     pub fn hover_motor_state(&self) -> Option<f64> {
-        let p = &self.params;
-        let total: f64 = (self.frame.rotors().iter())
-            .map(|r| r.thrust_coefficient.unwrap_or(p.thrust_coefficient))
-            .sum();
-        let m = (p.mass * p.gravity / total).sqrt();
-        (m.is_finite() && m <= 1.0).then_some(m)
+        hover_motor_state(&self.params, &self.frame)
     }
 
     /// The vehicle standing level on its landing gear at the origin, facing north, with the
@@ -350,6 +345,23 @@ impl Quadrotor {
         }
         Ok(quad)
     }
+}
+
+/// Motor state at which every rotor of `frame` at the same state carries the weight of the
+/// vehicle `params`: √(m g / Σ kᵢ), the rotors that take the vehicle's coefficient counted as
+/// one product (n·k, so a quad X's is bit for bit [`QuadrotorParams::hover_motor_state`]).
+/// `None` when no motor state in [0, 1] can hover.
+pub fn hover_motor_state(params: &QuadrotorParams, frame: &Frame) -> Option<f64> {
+    let (mut shared, mut own) = (0u32, 0.0);
+    for r in frame.rotors() {
+        match r.thrust_coefficient {
+            Some(k) => own += k,
+            None => shared += 1,
+        }
+    }
+    let total = f64::from(shared) * params.thrust_coefficient + own;
+    let m = (params.mass * params.gravity / total).sqrt();
+    (m.is_finite() && m <= 1.0).then_some(m)
 }
 
 /// Format tag of a Quadrotor snapshot (name and version; 02 added the gear's bristles, 03 the

@@ -1,9 +1,23 @@
 //! The multirotor behind the vehicle seam ([`crate::vehicle`]).
 
+use super::frame::Frame;
 use super::model::Quadrotor;
-use crate::error::CommandError;
+use super::params::QuadrotorParams;
+use crate::error::{CommandError, ParamError};
 use crate::snapshot::SnapshotError;
-use crate::vehicle::{Kinematics, Vehicle};
+use crate::vehicle::{Kinematics, Vehicle, VehicleStart};
+
+/// A multirotor of `frame` with `params` standing on its landing gear at the origin, facing
+/// north, motors off, its wind drawn from `seed`: what an autopilot session starts from.
+pub fn standing_multirotor(
+    params: QuadrotorParams,
+    frame: Frame,
+    seed: u64,
+) -> Result<VehicleStart, ParamError> {
+    Ok(VehicleStart::new(
+        Quadrotor::standing(params, seed)?.with_frame(frame),
+    ))
+}
 
 impl Vehicle for Quadrotor {
     fn actuator_count(&self) -> usize {
@@ -16,6 +30,10 @@ impl Vehicle for Quadrotor {
 
     fn actuators(&self) -> Vec<f64> {
         self.command().to_vec()
+    }
+
+    fn actuator_states(&self) -> Vec<f64> {
+        self.body.motors.to_vec()
     }
 
     fn advance(&mut self, dt: f64) {

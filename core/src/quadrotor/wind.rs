@@ -70,13 +70,7 @@ impl OuTransition {
     /// The exact transition x ← x e^(−θ dt) + σ √((1 − e^(−2θ dt)) / 2θ) ξ (for θ → 0,
     /// Brownian motion σ √dt ξ), σ on x and y, σ · turbulence_vertical_ratio on z.
     pub fn new(params: &QuadrotorParams, dt: f64) -> Self {
-        let theta = params.turbulence_theta;
-        let decay = (-theta * dt).exp();
-        let spread = if theta * dt > 1e-12 {
-            ((1.0 - decay * decay) / (2.0 * theta)).sqrt()
-        } else {
-            dt.sqrt()
-        };
+        let (decay, spread) = ou_decay_and_spread(params.turbulence_theta, dt);
         let sigma = params.turbulence_sigma * spread;
         OuTransition {
             key: Self::key(params, dt),
@@ -99,6 +93,19 @@ impl OuTransition {
     pub fn is_for(&self, params: &QuadrotorParams, dt: f64) -> bool {
         self.key == Self::key(params, dt)
     }
+}
+
+/// The exact OU transition over `dt` at rate `theta` for unit diffusion: (e^(−θ dt),
+/// √((1 − e^(−2θ dt)) / 2θ)), the spread √dt as θ → 0. Shared by a vehicle's turbulence and
+/// the world's wind field.
+pub fn ou_decay_and_spread(theta: f64, dt: f64) -> (f64, f64) {
+    let decay = (-theta * dt).exp();
+    let spread = if theta * dt > 1e-12 {
+        ((1.0 - decay * decay) / (2.0 * theta)).sqrt()
+    } else {
+        dt.sqrt()
+    };
+    (decay, spread)
 }
 
 /// The last [`OuTransition`] used, so a run at a fixed step pays for exp and sqrt once.

@@ -3,21 +3,17 @@
 //! desaturation with airmode off, and the motors' thrust model.
 //!
 //! Control vector: [roll, pitch, yaw torque (normalised, body FRD), thrust x, y, z
-//! (normalised, body FRD: a collective thrust T is z = −T)]; actuators: the motors in the
-//! core's order (front-right, rear-left, front-left, rear-right), each in [0, 1].
+//! (normalised, body FRD: a collective thrust T is z = −T)]; actuators: the frame's motors in
+//! its motor order (PX4's outputs), each in [0, 1]. The rotors are PX4's `CA_ROTORn_*`
+//! ([`super::px4_rotors`]).
 
-use nalgebra::{Matrix4, SMatrix, Vector3};
+use super::px4_rotors::Px4Rotor;
+use crate::quadrotor::frame::MAX_ROTORS;
+use nalgebra::{DMatrix, Matrix4, Vector3};
 use serde::{Deserialize, Serialize};
 
-/// One rotor as PX4's `CA_ROTORn_*` parameters describe it (body FRD).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Rotor {
-    /// Position relative to the centre of mass, m (`CA_ROTORn_PX/PY/PZ`).
-    pub position: Vector3<f64>,
-    /// Moment ratio: yaw torque per unit thrust, m, positive for a counter-clockwise rotor
-    /// (`CA_ROTORn_KM`).
-    pub moment_ratio: f64,
-}
+/// Motor outputs of one allocation: the first `len` of `MAX_ROTORS` slots.
+pub type Outputs = crate::quadrotor::Motors;
 
 /// Yaw's share of headroom above full thrust (PX4's `MINIMUM_YAW_MARGIN`).
 const MINIMUM_YAW_MARGIN: f64 = 0.15;
@@ -26,14 +22,17 @@ const FLT_EPSILON: f64 = f32::EPSILON as f64;
 /// Mixer entries smaller than this do not take part in a desaturation (PX4: 0.2).
 const DESATURATION_MIN_ENTRY: f64 = 0.2;
 
-/// The normalised mixer of four rotors and what it saturated last.
+/// The normalised mixer of a frame's rotors and what it saturated last.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Allocation {
-    /// Normalised pseudo-inverse: motor = mix · [roll, pitch, yaw, thrust_z].
-    mix: SMatrix<f64, 4, 4>,
-    /// Effectiveness rows [roll, pitch, yaw, thrust_z] per motor, in normalised units
-    /// (PX4's effectiveness times its normalisation scale), to tell what was allocated.
-    effectiveness: SMatrix<f64, 4, 4>,
+    /// Number of motors (the slots past it are zero).
+    count: usize,
+    /// Normalised pseudo-inverse by axis [roll, pitch, yaw, thrust_z], one entry per motor:
+    /// motor i = Σ_axis mix[axis][i] · control[axis].
+    mix: [[f64; MAX_ROTORS]; 4],
+    /// Effectiveness rows [roll, pitch, yaw, thrust_z], one entry per motor, in normalised
+    /// units (PX4's effectiveness times its normalisation scale), to tell what was allocated.
+    effectiveness: [[f64; MAX_ROTORS]; 4],
     /// Thrust model factor (`THR_MDL_FAC`): rel. thrust = f·u² + (1 − f)·u.
     thrust_model_factor: f64,
 }
@@ -41,37 +40,49 @@ pub struct Allocation {
 /// What the allocator did with one control setpoint.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Allocated {
-    /// Motor outputs in [0, 1] after the thrust model, before PX4's PWM step of 0.001.
-    pub motors: [f64; 4],
+    /// Motor outputs in [0, 1] after the thrust model, before PX4's PWM step of 0.001, one
+    /// per rotor.
+    pub motors: Outputs,
     /// Setpoint minus what the motors produce, per torque axis (roll, pitch, yaw).
     pub unallocated_torque: Vector3<f64>,
 }
 
 impl Allocation {
-    /// The allocation of `rotors` (each pushing along body −z with the same thrust
-    /// coefficient, which cancels in the normalisation). `None` if the rotors cannot
-    /// control roll, pitch, yaw and thrust independently.
-    pub fn new(rotors: &[Rotor; 4], thrust_model_factor: f64) -> Option<Self> {
-        // Effectiveness of rotor i: moment = p × a − km·a, thrust = a, with a = (0, 0, −1).
+    /// The allocation of `rotors` (4 to [`MAX_ROTORS`], each pushing along body −z). Thrust
+    /// coefficients count relative to the largest (a common one cancels in the
+    /// normalisation). `None` if the rotors cannot control roll, pitch, yaw and thrust
+    /// independently.
+    pub fn new(rotors: &[Px4Rotor], thrust_model_factor: f64) -> Option<Self> {
+        let n = rotors.len();
+        if !(4..=MAX_ROTORS).contains(&n) {
+            return None;
+        }
+        let ct_max = rotors.iter().map(|r| r.ct).fold(0.0, f64::max);
+        if !(ct_max.is_finite() && ct_max > 0.0) {
+            return None;
+        }
+        // Effectiveness of rotor i: moment = ct·(p × a − km·a), thrust = ct·a, a = (0, 0, −1).
         let axis = Vector3::new(0.0, 0.0, -1.0);
-        let mut e = Matrix4::zeros();
+        let mut e = DMatrix::zeros(4, n);
         for (i, r) in rotors.iter().enumerate() {
-            let moment = r.position.cross(&axis) - r.moment_ratio * axis;
+            let ct = r.ct / ct_max;
+            let position = Vector3::new(r.px, r.py, 0.0);
+            let moment = (position.cross(&axis) - r.km * axis) * ct;
             e[(0, i)] = moment.x;
             e[(1, i)] = moment.y;
             e[(2, i)] = moment.z;
-            e[(3, i)] = axis.z;
+            e[(3, i)] = axis.z * ct;
         }
-        let mix = e.try_inverse()?;
+        let mut mix = pseudo_inverse(&e)?;
         // PX4's normalisation: roll and pitch share one scale (the larger RMS column over
         // half its non-zero entries), yaw by its column's largest entry, thrust by its mean
         // |entry|.
         let rms = |c: usize| {
-            let n = mix.column(c).iter().filter(|v| v.abs() > 1e-3).count();
-            if n == 0 {
+            let count = mix.column(c).iter().filter(|v| v.abs() > 1e-3).count();
+            if count == 0 {
                 1.0
             } else {
-                (mix.column(c).norm_squared() / (n as f64 / 2.0)).sqrt()
+                (mix.column(c).norm_squared() / (count as f64 / 2.0)).sqrt()
             }
         };
         let roll_pitch = rms(0).max(rms(1));
@@ -86,90 +97,145 @@ impl Allocation {
         if scale.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
             return None;
         }
-        let mut mix_n = mix;
-        let mut e_n = e;
         for (c, s) in scale.iter().enumerate() {
-            mix_n.column_mut(c).scale_mut(1.0 / s);
-            e_n.row_mut(c).scale_mut(*s);
+            mix.column_mut(c).scale_mut(1.0 / s);
+            e.row_mut(c).scale_mut(*s);
         }
-        Some(Allocation {
-            mix: mix_n,
-            effectiveness: e_n,
+        // PX4 then zeroes the mixer's tiny entries (a hexa's side rotors do not pitch).
+        mix.apply(|v| {
+            if v.abs() < 1e-3 {
+                *v = 0.0;
+            }
+        });
+        let mut out = Allocation {
+            count: n,
+            mix: [[0.0; MAX_ROTORS]; 4],
+            effectiveness: [[0.0; MAX_ROTORS]; 4],
             thrust_model_factor,
-        })
+        };
+        for axis in 0..4 {
+            for i in 0..n {
+                out.mix[axis][i] = mix[(i, axis)];
+                out.effectiveness[axis][i] = e[(axis, i)];
+            }
+        }
+        Some(out)
+    }
+
+    /// Number of motors.
+    pub fn motor_count(&self) -> usize {
+        self.count
     }
 
     /// Motor outputs for normalised `torque` (body FRD) and collective `thrust` in [0, 1],
     /// with airmode off: thrust is only ever reduced to make room for roll and pitch, which
     /// are scaled back before yaw is mixed in with its own headroom.
     pub fn allocate(&self, torque: &Vector3<f64>, thrust: f64) -> Allocated {
+        // Fixed sizes for the shipped frames (as fast as the quad's own [f64; 4] code was);
+        // any other count in MAX_ROTORS slots, whose zero entries change no sum and take part
+        // in no desaturation.
+        match self.count {
+            4 => self.allocate_in::<4>(torque, thrust),
+            6 => self.allocate_in::<6>(torque, thrust),
+            8 => self.allocate_in::<8>(torque, thrust),
+            _ => self.allocate_in::<MAX_ROTORS>(torque, thrust),
+        }
+    }
+
+    fn allocate_in<const N: usize>(&self, torque: &Vector3<f64>, thrust: f64) -> Allocated {
         let control = [torque.x, torque.y, torque.z, -thrust];
-        let column = |c: usize| -> [f64; 4] { std::array::from_fn(|i| self.mix[(i, c)]) };
+        let column = |c: usize| -> [f64; N] { std::array::from_fn(|i| self.mix[c][i]) };
         let (roll, pitch, yaw, thrust_z) = (column(0), column(1), column(2), column(3));
-        let mut sp: [f64; 4] = std::array::from_fn(|i| {
+        let mut sp: [f64; N] = std::array::from_fn(|i| {
             roll[i] * control[0] + pitch[i] * control[1] + thrust_z[i] * control[3]
         });
-        let (min, max) = ([0.0; 4], [1.0; 4]);
-        desaturate(&mut sp, &thrust_z, &min, &max, true);
-        desaturate(&mut sp, &roll, &min, &max, false);
-        desaturate(&mut sp, &pitch, &min, &max, false);
-        for i in 0..4 {
+        let (min, max) = (0.0, 1.0);
+        desaturate(&mut sp, &thrust_z, min, max, true);
+        desaturate(&mut sp, &roll, min, max, false);
+        desaturate(&mut sp, &pitch, min, max, false);
+        for i in 0..N {
             sp[i] += yaw[i] * control[2];
         }
-        let yaw_max = max.map(|m| m + (m - 0.0) * MINIMUM_YAW_MARGIN);
-        desaturate(&mut sp, &yaw, &min, &yaw_max, false);
-        desaturate(&mut sp, &thrust_z, &min, &max, true);
+        let yaw_max = max + (max - 0.0) * MINIMUM_YAW_MARGIN;
+        desaturate(&mut sp, &yaw, min, yaw_max, false);
+        desaturate(&mut sp, &thrust_z, min, max, true);
 
         let clipped = sp.map(|u| u.clamp(0.0, 1.0));
-        let produced = self.effectiveness * nalgebra::Vector4::from(clipped);
+        // What the clipped outputs produce, summed in motor order.
+        let produced: [f64; 4] = std::array::from_fn(|axis| {
+            let row = &self.effectiveness[axis];
+            (1..N).fold(row[0] * clipped[0], |acc, i| row[i] * clipped[i] + acc)
+        });
         let unallocated_torque = Vector3::new(
             control[0] - produced[0],
             control[1] - produced[1],
             control[2] - produced[2],
         );
+        let mut motors = Outputs::zeros(self.count);
+        for (m, &u) in motors.iter_mut().zip(clipped.iter()) {
+            *m = thrust_model(u, self.thrust_model_factor);
+        }
         Allocated {
-            motors: clipped.map(|u| thrust_model(u, self.thrust_model_factor)),
+            motors,
             unallocated_torque,
         }
     }
+}
+
+/// The pseudo-inverse (n × 4) of the 4 × n effectiveness `e`: its inverse for four rotors,
+/// eᵀ (e eᵀ)⁻¹ for more (full row rank: every axis controllable). `None` when rank-deficient.
+fn pseudo_inverse(e: &DMatrix<f64>) -> Option<DMatrix<f64>> {
+    if e.ncols() == 4 {
+        let inverse = Matrix4::from_iterator(e.iter().copied()).try_inverse()?;
+        return Some(DMatrix::from_iterator(4, 4, inverse.iter().copied()));
+    }
+    let gram = Matrix4::from_iterator((e * e.transpose()).iter().copied());
+    let inverse = DMatrix::from_iterator(4, 4, gram.try_inverse()?.iter().copied());
+    let mix = e.transpose() * inverse;
+    mix.iter().all(|v| v.is_finite()).then_some(mix)
 }
 
 /// PX4's sequential desaturation step: moves `sp` along `direction` by the gain that
 /// brings it inside [min, max] as far as one gain can, then half of the remaining gain.
 /// With `reduce_only`, a move that would add thrust (a negative gain along the thrust
 /// column, whose entries are negative) is skipped.
-fn desaturate(
-    sp: &mut [f64; 4],
-    direction: &[f64; 4],
-    min: &[f64; 4],
-    max: &[f64; 4],
+fn desaturate<const N: usize>(
+    sp: &mut [f64; N],
+    direction: &[f64; N],
+    min: f64,
+    max: f64,
     reduce_only: bool,
 ) {
     let gain = desaturation_gain(sp, direction, min, max);
     if reduce_only && gain < 0.0 {
         return;
     }
-    for i in 0..4 {
+    for i in 0..N {
         sp[i] += gain * direction[i];
     }
     let gain = 0.5 * desaturation_gain(sp, direction, min, max);
-    for i in 0..4 {
+    for i in 0..N {
         sp[i] += gain * direction[i];
     }
 }
 
 /// PX4's `computeDesaturationGain`: the smallest and largest gains that bring each
 /// saturated output to its bound, added.
-fn desaturation_gain(sp: &[f64; 4], direction: &[f64; 4], min: &[f64; 4], max: &[f64; 4]) -> f64 {
+fn desaturation_gain<const N: usize>(
+    sp: &[f64; N],
+    direction: &[f64; N],
+    min: f64,
+    max: f64,
+) -> f64 {
     let (mut k_min, mut k_max) = (0.0f64, 0.0f64);
-    for i in 0..4 {
+    for i in 0..N {
         if direction[i].abs() < DESATURATION_MIN_ENTRY {
             continue;
         }
-        let bound = if sp[i] < min[i] {
-            min[i]
-        } else if sp[i] > max[i] {
-            max[i]
+        let bound = if sp[i] < min {
+            min
+        } else if sp[i] > max {
+            max
         } else {
             continue;
         };
@@ -198,11 +264,11 @@ pub fn thrust_model(control: f64, factor: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rate_loop::RateLoopParams;
+    use crate::quadrotor::{Frame, QuadrotorParams};
+    use crate::rate_loop::px4_rotors::{NONE_IRIS, px4_rotors};
 
     fn iris() -> Allocation {
-        let p = RateLoopParams::default();
-        Allocation::new(&p.rotors(), 0.0).unwrap()
+        Allocation::new(&NONE_IRIS, 0.0).unwrap()
     }
 
     #[test]
@@ -221,9 +287,9 @@ mod tests {
         for (i, row) in expected.iter().enumerate() {
             for (j, v) in row.iter().enumerate() {
                 assert!(
-                    (a.mix[(i, j)] - v).abs() < 1e-6,
+                    (a.mix[j][i] - v).abs() < 1e-6,
                     "mix[{i}][{j}] = {}",
-                    a.mix[(i, j)]
+                    a.mix[j][i]
                 );
             }
         }
@@ -234,13 +300,9 @@ mod tests {
         let a = iris();
         let out = a.allocate(&Vector3::new(0.1, -0.05, 0.02), 0.5);
         let m = &a.mix;
-        for i in 0..4 {
-            let u = 0.5 + m[(i, 0)] * 0.1 + m[(i, 1)] * -0.05 + m[(i, 2)] * 0.02;
-            assert!(
-                (out.motors[i] - u).abs() < 1e-12,
-                "{i}: {} vs {u}",
-                out.motors[i]
-            );
+        for (i, motor) in out.motors.iter().enumerate() {
+            let u = 0.5 + m[0][i] * 0.1 + m[1][i] * -0.05 + m[2][i] * 0.02;
+            assert!((motor - u).abs() < 1e-12, "{i}: {motor} vs {u}");
         }
         assert!(
             out.unallocated_torque.norm() < 1e-12,
@@ -298,8 +360,35 @@ mod tests {
 
     #[test]
     fn rotors_on_a_line_cannot_be_allocated() {
-        let mut p = RateLoopParams::default();
-        (p.rotor0_y, p.rotor1_y, p.rotor2_y, p.rotor3_y) = (0.0, 0.0, 0.0, 0.0);
-        assert!(Allocation::new(&p.rotors(), 0.0).is_none());
+        let mut rotors = NONE_IRIS;
+        rotors.iter_mut().for_each(|r| r.py = 0.0);
+        assert!(Allocation::new(&rotors, 0.0).is_none());
+        assert!(Allocation::new(&NONE_IRIS[..3], 0.0).is_none());
+    }
+
+    #[test]
+    fn a_hexa_mixes_every_axis_and_its_side_rotors_do_not_pitch() {
+        let p = QuadrotorParams::default();
+        let a = Allocation::new(&px4_rotors(&Frame::named("hexa_x").unwrap(), &p), 0.0).unwrap();
+        assert_eq!(a.motor_count(), 6);
+        // PX4 6001's rotors 0 and 1 sit on the roll axis: no pitch entry, zeroed exactly.
+        assert_eq!((a.mix[1][0], a.mix[1][1]), (0.0, 0.0));
+        assert!(a.mix[3][..6].iter().all(|&t| (t + 1.0).abs() < 1e-12));
+        // Unsaturated: the outputs produce exactly the torque asked for.
+        let torque = Vector3::new(0.05, -0.04, 0.03);
+        let out = a.allocate(&torque, 0.5);
+        assert_eq!(out.motors.len(), 6);
+        assert!(
+            out.unallocated_torque.norm() < 1e-12,
+            "{}",
+            out.unallocated_torque
+        );
+        // Roll right (FRD +x): the left rotors (FRD y < 0) push harder.
+        let right = a.allocate(&Vector3::new(0.1, 0.0, 0.0), 0.5);
+        assert!(
+            right.motors[1] > 0.5 && right.motors[0] < 0.5,
+            "{:?}",
+            right.motors
+        );
     }
 }

@@ -12,13 +12,15 @@
 pub mod allocation;
 pub mod filter;
 pub mod params;
+pub mod px4_rotors;
 pub mod rate_control;
 
 pub use params::RateLoopParams;
+pub use px4_rotors::{Px4Rotor, px4_rotors};
 
 use crate::error::ParamError;
 use crate::params::Parameters;
-use allocation::Allocation;
+use allocation::{Allocation, Outputs};
 use filter::{LowPass1p, LowPass2p};
 use nalgebra::Vector3;
 use rate_control::{RateControl, RateGains, Saturation};
@@ -53,14 +55,19 @@ pub struct RateLoop {
 const STATUS_INTERVAL: f64 = 0.005;
 
 impl RateLoop {
-    /// A rate loop from checked parameters, at rest (filters settled on zero rates).
-    pub fn new(params: RateLoopParams) -> Result<Self, ParamError> {
+    /// A rate loop from checked parameters mixing for `rotors` (PX4's `CA_ROTOR*` of the
+    /// frame, [`px4_rotors`]), at rest (filters settled on zero rates).
+    pub fn new(params: RateLoopParams, rotors: &[Px4Rotor]) -> Result<Self, ParamError> {
         params.validate()?;
         let allocation =
-            Allocation::new(&params.rotors(), params.thrust_model_factor).ok_or_else(|| {
+            Allocation::new(rotors, params.thrust_model_factor).ok_or_else(|| {
                 ParamError::Relation {
-                    name: "rotor0_x",
-                    requirement: "the rotors must control roll, pitch, yaw and thrust".into(),
+                    name: "frame",
+                    requirement: format!(
+                        "PX4's allocator needs 4 to {} rotors with positive thrust that control roll, pitch, yaw and thrust independently; got {} rotors",
+                        crate::quadrotor::frame::MAX_ROTORS,
+                        rotors.len()
+                    ),
                 }
             })?;
         let p = &params;
@@ -125,14 +132,9 @@ impl RateLoop {
     }
 
     /// One period: the gyro sample `gyro` (body FRD, rad/s) and the `setpoint` in effect give
-    /// the four motor outputs in [0, 1] (core motor order). `landed` freezes the integrator,
+    /// the motor outputs in [0, 1], one per rotor in the frame's motor order. `landed` freezes the integrator,
     /// as PX4's land detector does on the ground.
-    pub fn step(
-        &mut self,
-        setpoint: &RatesSetpoint,
-        gyro: &Vector3<f64>,
-        landed: bool,
-    ) -> [f64; 4] {
+    pub fn step(&mut self, setpoint: &RatesSetpoint, gyro: &Vector3<f64>, landed: bool) -> Outputs {
         let dt = self.params.rate_loop_period;
         let gyro = self.quantized(gyro);
         let mut rate = Vector3::zeros();
@@ -155,11 +157,11 @@ impl RateLoop {
                 .set_saturation(saturation(&out.unallocated_torque));
         }
         let q = self.params.output_quantum;
+        let mut motors = out.motors;
         if q > 0.0 {
-            out.motors.map(|u| (u / q).round() * q)
-        } else {
-            out.motors
+            motors.iter_mut().for_each(|u| *u = (*u / q).round() * q);
         }
+        motors
     }
 }
 

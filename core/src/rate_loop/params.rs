@@ -1,7 +1,7 @@
 //! Parameters of PX4's inner loop as the model flies it: PX4's names in each field's
-//! documentation, PX4 v1.16.0's values for airframe 10016 `none_iris` as defaults.
+//! documentation, PX4 v1.16.0's values for airframe 10016 `none_iris` as defaults. The rotor
+//! geometry is not here: the allocator mixes for the vehicle's frame ([`super::px4_rotors`]).
 
-use crate::error::ParamError;
 use crate::param;
 use crate::params::{ParamSpec, Parameters};
 use serde::{Deserialize, Serialize};
@@ -75,30 +75,6 @@ pub struct RateLoopParams {
     pub output_quantum: f64,
     /// Thrust model factor (`THR_MDL_FAC`): relative thrust f·u² + (1 − f)·u. Default 0.
     pub thrust_model_factor: f64,
-    /// Rotor 0 (front right) x, m (`CA_ROTOR0_PX`). Default 0.1515.
-    pub rotor0_x: f64,
-    /// Rotor 0 y, m (`CA_ROTOR0_PY`). Default 0.245.
-    pub rotor0_y: f64,
-    /// Rotor 0 moment ratio, m (`CA_ROTOR0_KM`; > 0 counter-clockwise). Default 0.05.
-    pub rotor0_km: f64,
-    /// Rotor 1 (rear left) x, m (`CA_ROTOR1_PX`). Default −0.1515.
-    pub rotor1_x: f64,
-    /// Rotor 1 y, m (`CA_ROTOR1_PY`). Default −0.1875.
-    pub rotor1_y: f64,
-    /// Rotor 1 moment ratio, m (`CA_ROTOR1_KM`). Default 0.05.
-    pub rotor1_km: f64,
-    /// Rotor 2 (front left) x, m (`CA_ROTOR2_PX`). Default 0.1515.
-    pub rotor2_x: f64,
-    /// Rotor 2 y, m (`CA_ROTOR2_PY`). Default −0.245.
-    pub rotor2_y: f64,
-    /// Rotor 2 moment ratio, m (`CA_ROTOR2_KM`). Default −0.05.
-    pub rotor2_km: f64,
-    /// Rotor 3 (rear right) x, m (`CA_ROTOR3_PX`). Default −0.1515.
-    pub rotor3_x: f64,
-    /// Rotor 3 y, m (`CA_ROTOR3_PY`). Default 0.1875.
-    pub rotor3_y: f64,
-    /// Rotor 3 moment ratio, m (`CA_ROTOR3_KM`). Default −0.05.
-    pub rotor3_km: f64,
 }
 
 impl Default for RateLoopParams {
@@ -131,26 +107,13 @@ impl Default for RateLoopParams {
             gyro_quantum: GYRO_QUANTUM,
             output_quantum: 0.001,
             thrust_model_factor: 0.0,
-            rotor0_x: 0.1515,
-            rotor0_y: 0.245,
-            rotor0_km: 0.05,
-            rotor1_x: -0.1515,
-            rotor1_y: -0.1875,
-            rotor1_km: 0.05,
-            rotor2_x: 0.1515,
-            rotor2_y: -0.245,
-            rotor2_km: -0.05,
-            rotor3_x: -0.1515,
-            rotor3_y: 0.1875,
-            rotor3_km: -0.05,
         }
     }
 }
 
 const GAIN: f64 = 100.0;
-const ARM: f64 = 100.0;
 
-static RATE_LOOP_SPECS: [ParamSpec<RateLoopParams>; 39] = [
+static RATE_LOOP_SPECS: [ParamSpec<RateLoopParams>; 27] = [
     param!(real rate_loop_period, "s", 1e-4, 0.1, "Rate loop period (PX4 SITL: every HIL_SENSOR)"),
     param!(real roll_rate_p, "1", 0.0, GAIN, "Roll rate P gain (MC_ROLLRATE_P)"),
     param!(real roll_rate_i, "1", 0.0, GAIN, "Roll rate I gain (MC_ROLLRATE_I)"),
@@ -178,48 +141,10 @@ static RATE_LOOP_SPECS: [ParamSpec<RateLoopParams>; 39] = [
     param!(real gyro_quantum, "rad/s", 0.0, 0.1, "Gyro sample step of PX4's simulator interface (0 = exact)"),
     param!(real output_quantum, "1", 0.0, 0.1, "Motor output step (PX4 PWM: 0.001; 0 = exact)"),
     param!(real thrust_model_factor, "1", 0.0, 1.0, "Thrust model factor (THR_MDL_FAC)"),
-    param!(real rotor0_x, "m", -ARM, ARM, "Rotor 0 (front right) x, body FRD (CA_ROTOR0_PX)"),
-    param!(real rotor0_y, "m", -ARM, ARM, "Rotor 0 y (CA_ROTOR0_PY)"),
-    param!(real rotor0_km, "m", -1.0, 1.0, "Rotor 0 moment ratio, > 0 counter-clockwise (CA_ROTOR0_KM)"),
-    param!(real rotor1_x, "m", -ARM, ARM, "Rotor 1 (rear left) x (CA_ROTOR1_PX)"),
-    param!(real rotor1_y, "m", -ARM, ARM, "Rotor 1 y (CA_ROTOR1_PY)"),
-    param!(real rotor1_km, "m", -1.0, 1.0, "Rotor 1 moment ratio (CA_ROTOR1_KM)"),
-    param!(real rotor2_x, "m", -ARM, ARM, "Rotor 2 (front left) x (CA_ROTOR2_PX)"),
-    param!(real rotor2_y, "m", -ARM, ARM, "Rotor 2 y (CA_ROTOR2_PY)"),
-    param!(real rotor2_km, "m", -1.0, 1.0, "Rotor 2 moment ratio (CA_ROTOR2_KM)"),
-    param!(real rotor3_x, "m", -ARM, ARM, "Rotor 3 (rear right) x (CA_ROTOR3_PX)"),
-    param!(real rotor3_y, "m", -ARM, ARM, "Rotor 3 y (CA_ROTOR3_PY)"),
-    param!(real rotor3_km, "m", -1.0, 1.0, "Rotor 3 moment ratio (CA_ROTOR3_KM)"),
 ];
 
 impl Parameters for RateLoopParams {
     fn specs() -> &'static [ParamSpec<Self>] {
         &RATE_LOOP_SPECS
-    }
-
-    fn check_relations(&self) -> Result<(), ParamError> {
-        if super::allocation::Allocation::new(&self.rotors(), self.thrust_model_factor).is_none() {
-            return Err(ParamError::Relation {
-                name: "rotor0_x",
-                requirement: "the rotors (rotor0_x .. rotor3_km) must control roll, pitch, yaw and thrust independently".into(),
-            });
-        }
-        Ok(())
-    }
-}
-
-impl RateLoopParams {
-    /// The rotors as the allocator sees them (body FRD, on the rotor plane).
-    pub fn rotors(&self) -> [super::allocation::Rotor; 4] {
-        let r = |x: f64, y: f64, km: f64| super::allocation::Rotor {
-            position: nalgebra::Vector3::new(x, y, 0.0),
-            moment_ratio: km,
-        };
-        [
-            r(self.rotor0_x, self.rotor0_y, self.rotor0_km),
-            r(self.rotor1_x, self.rotor1_y, self.rotor1_km),
-            r(self.rotor2_x, self.rotor2_y, self.rotor2_km),
-            r(self.rotor3_x, self.rotor3_y, self.rotor3_km),
-        ]
     }
 }

@@ -1,5 +1,6 @@
 //! What the quadrotor tasks share: their common parameters (the seed's DroneEnv arguments),
-//! start and target sampling, crash detection and the 33-value base observation.
+//! start and target sampling, crash detection and the base observation (33 values on a quad,
+//! 25 + 2 per rotor on any frame).
 
 use crate::error::ParamError;
 use crate::param;
@@ -132,31 +133,30 @@ impl Parameters for FlightParams {
     }
 }
 
-/// Number of values in the base observation.
-pub const BASE_OBSERVATION_SIZE: usize = 33;
-
-/// The base observation's groups (motor interface): (name, number of values), in order.
-pub const BASE_OBSERVATION: [(&str, usize); 10] = [
-    ("target_offset", 3), // target − position, world ENU
-    ("velocity", 3),
-    ("acceleration", 3),
-    ("quaternion", 4),
-    ("body_rates", 3),
-    ("angular_acceleration", 3),
-    ("body_z_axis", 3),
-    ("wind", 3),
-    ("motor_states", 4),
-    ("motor_commands", 4),
-];
+/// The base observation's groups (motor interface): (name, number of values), in order, for a
+/// frame of `rotors` rotors (the two motor groups have one value per rotor).
+pub fn base_observation(rotors: usize) -> [(&'static str, usize); 10] {
+    [
+        ("target_offset", 3), // target − position, world ENU
+        ("velocity", 3),
+        ("acceleration", 3),
+        ("quaternion", 4),
+        ("body_rates", 3),
+        ("angular_acceleration", 3),
+        ("body_z_axis", 3),
+        ("wind", 3),
+        ("motor_states", rotors),
+        ("motor_commands", rotors),
+    ]
+}
 
 /// Draws the start state: (0, 0, start_height), roll/pitch/yaw uniform in ±range, at rest,
-/// motors at the hover state (0 if the vehicle cannot hover).
-pub fn sample_start(task: &FlightParams, model: &QuadrotorParams, rng: &mut SimRng) -> BodyState {
+/// motors at `hover` (the vehicle's hover state, 0 if it cannot hover).
+pub fn sample_start(task: &FlightParams, hover: f64, rng: &mut SimRng) -> BodyState {
     let r = task.start_attitude_range;
     let roll = rng.uniform(-r, r);
     let pitch = rng.uniform(-r, r);
     let yaw = rng.uniform(-r, r);
-    let hover = model.hover_motor_state().unwrap_or(0.0);
     BodyState::at_rest(
         Vector3::new(0.0, 0.0, task.start_height),
         roll,
@@ -221,10 +221,15 @@ pub fn wind_bound(model: &QuadrotorParams) -> f64 {
     (model.wind_speed_max + 5.0 * stationary_std).max(1.0)
 }
 
-/// Per-value bounds of the base observation; `position_bound` bounds target − position.
-pub fn base_bounds(model: &QuadrotorParams, position_bound: f64) -> ([f32; 33], [f32; 33]) {
+/// Per-value bounds of the base observation of a frame of `rotors` rotors; `position_bound`
+/// bounds target − position.
+pub fn base_bounds(
+    model: &QuadrotorParams,
+    rotors: usize,
+    position_bound: f64,
+) -> (Vec<f32>, Vec<f32>) {
     let wind = wind_bound(model);
-    // In BASE_OBSERVATION's order.
+    // In the base observation's order.
     let bounds: [(f64, f64); 10] = [
         (-position_bound, position_bound),
         (-40.0, 40.0),
@@ -237,20 +242,16 @@ pub fn base_bounds(model: &QuadrotorParams, position_bound: f64) -> ([f32; 33], 
         (0.0, 1.0),
         (0.0, 1.0),
     ];
-    let mut lo = [0.0f32; 33];
-    let mut hi = [0.0f32; 33];
-    let mut i = 0;
-    for ((_, n), (l, h)) in BASE_OBSERVATION.into_iter().zip(bounds) {
-        for _ in 0..n {
-            lo[i] = l as f32;
-            hi[i] = h as f32;
-            i += 1;
-        }
+    let mut lo = Vec::with_capacity(25 + 2 * rotors);
+    let mut hi = Vec::with_capacity(25 + 2 * rotors);
+    for ((_, n), (l, h)) in base_observation(rotors).into_iter().zip(bounds) {
+        lo.extend(std::iter::repeat_n(l as f32, n));
+        hi.extend(std::iter::repeat_n(h as f32, n));
     }
     (lo, hi)
 }
 
-/// Writes the 33 base values into `out[..33]`, each clipped into `lo..=hi`.
+/// Writes the base values (25 + 2 per rotor) into `out`, each clipped into `lo..=hi`.
 pub fn write_base_observation(
     quad: &Quadrotor,
     target: &Vector3<f64>,

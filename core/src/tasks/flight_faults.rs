@@ -5,7 +5,7 @@
 use crate::error::ParamError;
 use crate::faults::catalogue::Target;
 use crate::faults::{Conditions, FaultPlan, FaultState, Reach, SensorId};
-use crate::quadrotor::Quadrotor;
+use crate::quadrotor::{Motors, Quadrotor};
 use crate::tasks::{InfoRef, InfoVisitor};
 use serde::{Deserialize, Serialize};
 
@@ -20,6 +20,8 @@ pub struct FlightFaults {
     /// Per slot, for the info: catalogue index of the kind (−1: none drawn), the motor
     /// number or sensor index, the time it fired (−1: not yet), whether it is active.
     info: [Vec<f64>; 4],
+    /// The command the faulted motors stand in for while the vehicle advances.
+    commanded: Option<Motors>,
 }
 
 impl FlightFaults {
@@ -38,6 +40,7 @@ impl FlightFaults {
             steps: 0,
             waypoint: None,
             info: std::array::from_fn(|_| vec![0.0; slots]),
+            commanded: None,
         })
     }
 
@@ -83,20 +86,29 @@ impl FlightFaults {
         self.steps += 1;
     }
 
-    /// Commands the motors with `command` and advances the vehicle by `dt` through the
-    /// actuator fault path; the vehicle keeps `command` as its command afterwards.
-    pub fn drive(&mut self, quad: &mut Quadrotor, command: &[f64; 4], dt: f64) {
-        let _ = quad.set_command(command);
+    /// Before the vehicle advances by `dt` (its command set): the actuator fault path puts
+    /// what the motors get in place of the command, kept to be restored by
+    /// [`FlightFaults::after_advance`]. Nothing happens while no actuator fault acts.
+    pub fn before_advance(&mut self, quad: &mut Quadrotor, dt: f64) {
         if !self.state.acts_on_motors() {
-            quad.step(dt);
+            self.commanded = None;
             return;
         }
-        let mut motors = [0.0; 4];
+        let commanded = quad.command();
+        let mut motors = commanded;
         self.state
-            .motor_commands(command, &quad.body.motors, dt, &mut motors);
-        let _ = quad.set_command(motors);
-        quad.step(dt);
-        let _ = quad.set_command(command);
+            .motor_commands(&commanded, &quad.body.motors, dt, &mut motors);
+        // Same length as the frame's command, each value in [0, 1].
+        let _ = quad.set_command(&motors[..]);
+        self.commanded = Some(commanded);
+    }
+
+    /// After the vehicle advanced: it holds the commanded values again (what a controller
+    /// reads back), not the faulted ones.
+    pub fn after_advance(&mut self, quad: &mut Quadrotor) {
+        if let Some(commanded) = self.commanded.take() {
+            let _ = quad.set_command(&commanded[..]);
+        }
     }
 
     fn refresh_info(&mut self, _dt: f64) {

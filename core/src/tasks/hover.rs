@@ -120,7 +120,7 @@ pub fn hover_reward(params: &FlightParams, body: &BodyState, target: &Vector3<f6
 
 impl Task for Hover {
     fn action_size(&self) -> usize {
-        4
+        self.vehicle.action_size()
     }
 
     fn action_bounds(&self) -> (Vec<f64>, Vec<f64>) {
@@ -141,8 +141,8 @@ impl Task for Hover {
 
     fn reset(&mut self, seed: u64) {
         let mut rng = SimRng::new(seed);
-        let model = self.vehicle.draw(seed);
-        let body = sample_start(&self.params, model, &mut rng);
+        let hover = self.vehicle.draw(seed);
+        let body = sample_start(&self.params, hover, &mut rng);
         let target = sample_target(&self.params, &body.position, &mut rng);
         self.vehicle.restart(body, rng, seed);
         self.status = FlightStatus::default();

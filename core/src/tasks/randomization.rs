@@ -11,8 +11,8 @@ use crate::error::ParamError;
 use crate::faults::FaultPlan;
 use crate::number::Compact;
 use crate::params::{ParamSpec, Parameters, ValueKind};
-use crate::quadrotor::QuadrotorParams;
-use crate::rate_loop::RateLoopParams;
+use crate::quadrotor::{Frame, QuadrotorParams};
+use crate::rate_loop::{Px4Rotor, RateLoopParams, px4_rotors};
 use crate::rng::SimRng;
 use crate::tasks::flight::FlightParams;
 use serde::{Deserialize, Serialize};
@@ -43,15 +43,25 @@ pub struct Randomization {
     ranges: Vec<ParamRange>,
 }
 
-/// The parameter sets a flight vehicle is built from, as randomisation sees them.
+/// The parameter sets a flight vehicle is built from, as randomisation sees them, and its
+/// frame (the rotor table; not randomised).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct VehicleParams {
     pub quadrotor: QuadrotorParams,
     pub rate_loop: RateLoopParams,
     pub flight: FlightParams,
+    #[serde(default)]
+    pub frame: Frame,
     /// The vehicle's faults (empty: healthy). Not randomised by ranges: its own
     /// `[[fault_randomization]]` draws them ([`crate::faults`]).
     pub faults: FaultPlan,
+}
+
+impl VehicleParams {
+    /// PX4's rotors for this vehicle's frame: what the rate loop's allocator mixes for.
+    pub fn mixer(&self) -> Vec<Px4Rotor> {
+        px4_rotors(&self.frame, &self.quadrotor)
+    }
 }
 
 /// Where a named parameter lives.

@@ -178,7 +178,7 @@ impl Waypoints {
 
 impl Task for Waypoints {
     fn action_size(&self) -> usize {
-        4
+        self.vehicle.action_size()
     }
 
     fn action_bounds(&self) -> (Vec<f64>, Vec<f64>) {
@@ -201,8 +201,8 @@ impl Task for Waypoints {
 
     fn reset(&mut self, seed: u64) {
         let mut rng = SimRng::new(seed);
-        let model = self.vehicle.draw(seed);
-        let body = sample_start(&self.flight, model, &mut rng);
+        let hover = self.vehicle.draw(seed);
+        let body = sample_start(&self.flight, hover, &mut rng);
         let mut from = body.position;
         self.waypoints.clear();
         for _ in 0..self.params.max_num_waypoints {

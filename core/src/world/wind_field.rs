@@ -12,6 +12,7 @@
 
 use super::params::WorldParams;
 use super::trig::sin_cos;
+use crate::quadrotor::wind::ou_decay_and_spread;
 use crate::rng::SimRng;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -76,12 +77,7 @@ impl WindField {
         }
         let dt = params.turbulence_dt;
         let theta = params.turbulence_theta;
-        let decay = (-theta * dt).exp();
-        let spread = if theta * dt > 1e-12 {
-            ((1.0 - decay * decay) / (2.0 * theta)).sqrt()
-        } else {
-            dt.sqrt()
-        };
+        let (decay, spread) = ou_decay_and_spread(theta, dt);
         let sigma = params.turbulence_sigma * spread / (self.modes.len() as f64).sqrt();
         let sigma_z = sigma * params.turbulence_vertical_ratio;
         for m in &mut self.modes {

@@ -1,6 +1,6 @@
-//! flyloop-fmu-pack: writes every FMU of the library — Quadrotor.fmu, Lander2D.fmu and
-//! Hexacopter.fmu (FMI 2.0) and their `-fmi3.fmu` twins (FMI 3.0) — or the checked-in
-//! modelDescription copies of all six.
+//! flyloop-fmu-pack: writes every FMU of the library — Quadrotor.fmu, Lander2D.fmu,
+//! Hexacopter.fmu and RateController.fmu (FMI 2.0) and their `-fmi3.fmu` twins (FMI 3.0) — or
+//! the checked-in modelDescription copies of all eight.
 //!
 //! ```text
 //! flyloop-fmu-pack fmus <libflyloop_fmu.so> <out-dir>

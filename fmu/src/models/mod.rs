@@ -4,8 +4,10 @@
 mod lander2d;
 mod multirotor;
 mod quadrotor;
+mod rate_controller;
 
 pub use multirotor::Multirotor;
+pub use rate_controller::RateController;
 
 use crate::api::Api;
 use crate::engine::{Engine, Simulation};
@@ -46,9 +48,17 @@ static HEXACOPTER: LazyLock<Table<Quadrotor>> = LazyLock::new(|| {
     .table()
 });
 
-/// The tables of every FMU: Quadrotor, Lander2D, Hexacopter.
-pub fn tables() -> [&'static ModelTable; 3] {
-    [&QUADROTOR.table, &LANDER2D.table, &HEXACOPTER.table]
+/// RateController.fmu: the core's PX4 rate loop and allocation.
+static RATE_CONTROLLER: LazyLock<Table<RateController>> = LazyLock::new(rate_controller::table);
+
+/// The tables of every FMU: Quadrotor, Lander2D, Hexacopter, RateController.
+pub fn tables() -> [&'static ModelTable; 4] {
+    [
+        &QUADROTOR.table,
+        &LANDER2D.table,
+        &HEXACOPTER.table,
+        &RATE_CONTROLLER.table,
+    ]
 }
 
 /// A fresh simulation of the FMU whose GUID (FMI 2.0) or instantiation token (FMI 3.0) is
@@ -64,4 +74,5 @@ pub fn simulation_for(api: Api, token: &str) -> Option<Result<Box<dyn Simulation
     of(&QUADROTOR, api, token)
         .or_else(|| of(&LANDER2D, api, token))
         .or_else(|| of(&HEXACOPTER, api, token))
+        .or_else(|| of(&RATE_CONTROLLER, api, token))
 }

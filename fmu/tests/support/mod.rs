@@ -13,16 +13,24 @@ pub enum Model {
     Quadrotor,
     Lander2D,
     Hexacopter,
+    RateController,
 }
 
 impl Model {
     /// Every FMU the library serves.
-    pub const ALL: [Model; 3] = [Model::Quadrotor, Model::Lander2D, Model::Hexacopter];
+    pub const ALL: [Model; 4] = [
+        Model::Quadrotor,
+        Model::Lander2D,
+        Model::Hexacopter,
+        Model::RateController,
+    ];
+    /// The plants (the FMUs with motor commands as inputs).
+    pub const PLANTS: [Model; 3] = [Model::Quadrotor, Model::Lander2D, Model::Hexacopter];
     /// The multirotor FMUs (one model, two frames).
     pub const MULTIROTORS: [Model; 2] = [Model::Quadrotor, Model::Hexacopter];
 
     pub fn is_multirotor(self) -> bool {
-        self != Model::Lander2D
+        matches!(self, Model::Quadrotor | Model::Hexacopter)
     }
 
     pub fn table(self) -> &'static flyloop_fmu::table::ModelTable {
@@ -30,6 +38,7 @@ impl Model {
             Model::Quadrotor => tables()[0],
             Model::Lander2D => tables()[1],
             Model::Hexacopter => tables()[2],
+            Model::RateController => tables()[3],
         }
     }
 

@@ -25,15 +25,20 @@ class QuadHoverEnv(FlyloopEnv):
     1 rear-left (CCW), 2 front-left (CW), 3 rear-right (CW); thrust per motor 10 N · m² for
     motor state m ∈ [0, 1]; hover at m ≈ 0.495 with the default mass of 1 kg.
 
+    ``frame`` picks another of the core's rotor tables: ``"quad_plus"``, ``"hexa_x"`` (six
+    motors in PX4's 6001 order, hover at m ≈ 0.404 at 1 kg) or ``"octo_x"`` (eight, PX4's
+    8001 order); n below is its rotor count (4 on the quads).
+
     ## Action space
 
-    ``Box(0, 1, (4,), float32)``: commanded motor states, in motor order above. Values outside
+    ``Box(0, 1, (n,), float32)``: commanded motor states, in motor order above. Values outside
     [0, 1] are clipped by the core; a non-finite value raises ``ValueError``. The motors follow
     the command with a first-order lag (τ = 0.08 s).
 
     ## Observation space
 
-    ``Box(low, high, (33,), float32)``; every value is clipped into its bound by the core:
+    ``Box(low, high, (25 + 2n,), float32)`` (33 on a quad, 37 on a hexa, 41 on an octo);
+    every value is clipped into its bound by the core:
 
     | index | value | unit | bound |
     |---|---|---|---|
@@ -45,8 +50,8 @@ class QuadHoverEnv(FlyloopEnv):
     | 16–18 | angular acceleration | rad/s² | ±100 |
     | 19–21 | body z axis in the world ("normal") | 1 | ±1 |
     | 22–24 | wind velocity | m/s | ±(wind max + 5 σ/√(2θ)) (±10 by default; ±1 without wind) |
-    | 25–28 | motor states | 1 | [0, 1] |
-    | 29–32 | motor commands in effect | 1 | [0, 1] |
+    | 25 … 24+n | motor states | 1 | [0, 1] |
+    | 25+n … 24+2n | motor commands in effect | 1 | [0, 1] |
 
     ## Reward
 
@@ -138,7 +143,7 @@ class QuadHoverEnv(FlyloopEnv):
             velocity=obs[at["velocity"]],
             quaternion=part("quaternion", (1.0, 0.0, 0.0, 0.0)),
             wind=part("wind", np.zeros(3)),
-            motors=part("motor_states", np.zeros(4)),
+            motors=part("motor_states", np.zeros(self.core["rotors"])),
             target=info.get("target_position"),
             next_waypoint=info.get("next_waypoint_pos"),
             reward=reward,
@@ -147,4 +152,5 @@ class QuadHoverEnv(FlyloopEnv):
             arm_length=float(values["arm_length"]),
             waypoints_reached=info.get("waypoints_reached"),
             status="crashed" if crashed else "out of bounds" if out else "",
+            frame=self.core["frame"],
         )

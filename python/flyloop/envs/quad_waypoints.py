@@ -10,13 +10,14 @@ class QuadWaypointsEnv(QuadHoverEnv):
     """Fly a quadrotor through a sequence of waypoints as fast as possible (seed 001's
     ``SequentialWaypointEnv``, docs/reference/quadrotor.md).
 
-    ``gymnasium.make("flyloop/QuadWaypoints-v0")``. Frames, units, motors, action space,
-    starting state and errors are those of ``QuadHoverEnv``.
+    ``gymnasium.make("flyloop/QuadWaypoints-v0")``. Frames, units, motors (``frame``: n
+    rotors), action space, starting state and errors are those of ``QuadHoverEnv``.
 
     ## Observation space
 
-    ``Box(low, high, (37,), float32)``: values 0–32 are QuadHover's with the *current*
-    waypoint as the target (position bound ±2·√3·space_side_length = ±10.39 m), then
+    ``Box(low, high, (29 + 2n,), float32)`` (37 on a quad): values 0 … 24+2n are QuadHover's
+    with the *current* waypoint as the target (position bound ±2·√3·space_side_length =
+    ±10.39 m), then (indices for the quad; + 2 per rotor beyond four)
 
     | index | value | unit | bound |
     |---|---|---|---|

@@ -5,6 +5,7 @@ and lines, then solids far to near, the hub last (tests track its pixels)."""
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -35,6 +36,44 @@ TEXT, PANEL, BAD, BACKGROUND_TOP = (20, 20, 30), (255, 255, 236), (200, 0, 0), (
 BACKGROUND_BOTTOM = (246, 246, 250)
 ROTOR_COLORS = tuple(ROTOR_CCW if spin < 0 else ROTOR_CW for spin in ROTOR_SPIN)
 SPIN_NAMES = tuple("CCW" if spin < 0 else "CW" for spin in ROTOR_SPIN)
+
+
+@dataclass(frozen=True)
+class Rotors:
+    """A frame's rotors as drawn: position (forward, left) in arm lengths, colour, name and
+    spin name per rotor, in motor order."""
+
+    positions: np.ndarray  # (n, 2)
+    colors: tuple
+    names: tuple[str, ...]
+    spins: tuple[str, ...]
+
+
+def _sector(x: float, y: float) -> str:
+    """The compass name of the direction (x forward, y left) from the centre, in 45-degree
+    sectors: F, FL, L, RL, B, RR, R, FR."""
+    angle = math.degrees(math.atan2(y, x)) % 360.0
+    names = ("F", "FL", "L", "RL", "B", "RR", "R", "FR")
+    return names[round(angle / 45.0) % 8]
+
+
+@functools.cache
+def frame_rotors(frame: str) -> Rotors:
+    """The drawing of the core's shipped frame `frame` (its rotor table, `_native.frames()`);
+    the quad X as it was always drawn."""
+    if frame == "quad_x":
+        positions = ROTOR_POSITION_SIGNS / math.sqrt(2.0)
+        return Rotors(positions, ROTOR_COLORS, ROTOR_NAMES, SPIN_NAMES)
+    table = _native.frames()[frame]
+    spins = [spin for _, _, spin in table]
+    return Rotors(
+        np.array([(x, y) for x, y, _ in table]),
+        tuple(ROTOR_CCW if spin < 0 else ROTOR_CW for spin in spins),
+        tuple(_sector(x, y) for x, y, _ in table),
+        tuple("CCW" if spin < 0 else "CW" for spin in spins),
+    )
+
+
 AXES = ((AXIS_X, "x E"), (AXIS_Y, "y N"), (AXIS_Z, "z"))
 TARGET_RADIUS_M, WAYPOINT_RADIUS_M, UP_ARROW_M, MAX_ARROW_M = 0.08, 0.06, 0.5, 2.0
 VELOCITY_SECONDS = 0.5  # the velocity arrow shows where the drone is in this many seconds
@@ -62,7 +101,7 @@ class QuadScene:
     position: np.ndarray  # (3,) m, world ENU
     velocity: np.ndarray  # (3,) m/s, world ENU
     quaternion: np.ndarray  # (4,) [w, x, y, z], body FLU -> world ENU; normalised here
-    motors: np.ndarray = field(default_factory=lambda: np.zeros(4))  # (4,) states, [0, 1]
+    motors: np.ndarray = field(default_factory=lambda: np.zeros(4))  # (n,) states, [0, 1]
     wind: np.ndarray = field(default_factory=lambda: np.zeros(3))  # (3,) m/s, world ENU
     target: np.ndarray | None = None  # (3,) m, world ENU: the current target / waypoint
     next_waypoint: np.ndarray | None = None  # (3,) m, the waypoint after the target
@@ -72,6 +111,7 @@ class QuadScene:
     arm_length: float = _CORE["arm_length"]  # m, centre to rotor
     waypoints_reached: int | None = None  # Waypoints task only
     status: str = ""  # e.g. "crashed", "out of bounds"; empty while flying
+    frame: str = "quad_x"  # the core's shipped frame: its rotors are drawn, one per motor
 
     def __post_init__(self) -> None:
         for name in ("position", "velocity", "wind", "target", "next_waypoint"):
@@ -146,7 +186,12 @@ def drone(p: Painter, pr: Projector, scene: QuadScene, scale: float) -> None:
     rot = rotation_matrix(scene.quaternion)
     pos = scene.position
     arm = scene.arm_length * scale
-    rotors = pos + np.c_[ROTOR_POSITION_SIGNS * (arm / math.sqrt(2.0)), np.zeros(4)] @ rot.T
+    drawn = frame_rotors(scene.frame)
+    n = len(drawn.positions)
+    if scene.frame == "quad_x":
+        rotors = pos + np.c_[ROTOR_POSITION_SIGNS * (arm / math.sqrt(2.0)), np.zeros(4)] @ rot.T
+    else:
+        rotors = pos + np.c_[drawn.positions * arm, np.zeros(n)] @ rot.T
     rotor_radius = 0.38 * arm
     disc_axes = rot.T[:2]  # body x and y in world coordinates
     cam = pr.camera
@@ -155,12 +200,12 @@ def drone(p: Painter, pr: Projector, scene: QuadScene, scale: float) -> None:
         _line(p, pr, pos, rotors[i], ARM, 4)
         poly = pr.polygon(_circle_points(rotors[i], rotor_radius, disc_axes))
         if len(poly):
-            color = ROTOR_COLORS[i]
+            color = drawn.colors[i]
             p.translucent_polygon(poly, color, 150)
             p.polyline(np.vstack([poly, poly[:1]]), tuple(int(c * 0.6) for c in color), 2)
         level = pr.polygon(_circle_points(rotors[i], rotor_radius * scene.motors[i], disc_axes))
         if len(level) and scene.motors[i] > 0.02:
-            p.translucent_polygon(level, ROTOR_COLORS[i], 170)
+            p.translucent_polygon(level, drawn.colors[i], 170)
     _arrow(p, pr, pos, rot[:, 2] * UP_ARROW_M, UP, 3)
     for vec, m_per_unit, color, width in (
         (scene.velocity, VELOCITY_SECONDS, VELOCITY, 3),
@@ -262,10 +307,12 @@ def info_panel(p: Painter, scene: QuadScene) -> None:
 def motor_bars(p: Painter, scene: QuadScene) -> None:
     """Bottom-right: one bar per motor (PX4 order), labelled with position and spin colour."""
     width, height = p.surface.get_size()
+    drawn = frame_rotors(scene.frame)
+    n = len(scene.motors)
     bar_w, bar_h, gap = 26, 120, 20
-    x0 = width - 4 * (bar_w + gap) - 14
+    x0 = width - n * (bar_w + gap) - 14
     y0 = height - bar_h - 50
-    p.panel((x0 - 12, y0 - 34, 4 * (bar_w + gap) + 8, bar_h + 76), PANEL)
+    p.panel((x0 - 12, y0 - 34, n * (bar_w + gap) + 8, bar_h + 76), PANEL)
     for i, level in enumerate(scene.motors):
         x = x0 + i * (bar_w + gap)
         fill = round(bar_h * float(level))
@@ -274,9 +321,9 @@ def motor_bars(p: Painter, scene: QuadScene) -> None:
         p.pg.draw.rect(p.surface, color, (x, y0 + bar_h - fill, bar_w, fill))
         p.pg.draw.rect(p.surface, (0, 0, 0), (x, y0, bar_w, bar_h), 1)
         p.text(f"{round(float(level) * 100)}%", (x + bar_w / 2, y0 - 6), TEXT, 17, "midbottom")
-        p.disc((x + bar_w / 2, y0 - 26), 5, ROTOR_COLORS[i])
-        p.text(f"M{i} {ROTOR_NAMES[i]}", (x + bar_w / 2, y0 + bar_h + 4), TEXT, 17, "midtop")
-        p.text(SPIN_NAMES[i], (x + bar_w / 2, y0 + bar_h + 20), TEXT, 15, "midtop")
+        p.disc((x + bar_w / 2, y0 - 26), 5, drawn.colors[i])
+        p.text(f"M{i} {drawn.names[i]}", (x + bar_w / 2, y0 + bar_h + 4), TEXT, 17, "midtop")
+        p.text(drawn.spins[i], (x + bar_w / 2, y0 + bar_h + 20), TEXT, 15, "midtop")
 
 
 def axis_gizmo(p: Painter, camera: OrbitCamera) -> None:

@@ -269,6 +269,8 @@ class Listener:
         self.peers: dict[tuple, object] = {}  # address -> its parser
         self.asked: set[tuple] = set()
         self.autopilots: list[tuple] = []
+        # (system, component) of each autopilot heard at an address: commands' targets
+        self.systems: dict[tuple, set[tuple]] = {}
         self.last_beat = 0.0
         self.mav = mavlink2.MAVLink(None, srcSystem=255, srcComponent=190)
         self.datagrams = 0
@@ -295,6 +297,10 @@ class Listener:
             for msg in _decode(parser, data):
                 n += 1
                 self.view.handle(msg, peer)
+                if msg.get_type() == "HEARTBEAT" and msg.autopilot in AUTOPILOTS:
+                    self.systems.setdefault(peer, set()).add(
+                        (msg.get_srcSystem(), msg.get_srcComponent())
+                    )
                 if msg.get_type() == "HEARTBEAT" and peer not in self.asked:
                     if msg.autopilot == GENERIC:
                         self._ask(peer, STREAM_INTERVAL_US)
@@ -302,11 +308,16 @@ class Listener:
                         self._greet(peer)
 
     def _commands(self, peer: tuple, commands: list[tuple]) -> None:
-        """COMMAND_LONGs (command, param1, param2) to every system at `peer`, one datagram."""
+        """COMMAND_LONGs (command, param1, param2) to every system at `peer`, one datagram:
+        addressed to each autopilot heard there (PX4 ignores a broadcast
+        SET_MESSAGE_INTERVAL), broadcast to a flyloop-sitl."""
         out = b""
-        for command, p1, p2 in commands:
-            msg = self.mav.command_long_encode(0, 0, command, 0, p1, p2, 0, 0, 0, 0, 0)
-            out += msg.pack(self.mav)
+        for system, component in sorted(self.systems.get(peer, {(0, 0)})):
+            for command, p1, p2 in commands:
+                msg = self.mav.command_long_encode(
+                    system, component, command, 0, p1, p2, 0, 0, 0, 0, 0
+                )
+                out += msg.pack(self.mav)
         self.sock.sendto(out, peer)
 
     def _ask(self, peer: tuple, interval_us: float) -> None:

@@ -4,14 +4,14 @@
 use super::packet::{self, MAX_PWM, PacketError, ServoFrame};
 use super::reply::{self, State};
 use crate::config::AutopilotVehicle;
-use crate::kinematics::{attitude_ned, flu_to_frd};
+use crate::kinematics::attitude_ned;
 use crate::speed::SpeedLog;
 use crate::stats::us_per;
 use crate::track::SessionTrack;
 use flyloop_core::ParamError;
-use flyloop_core::quadrotor::Quadrotor;
+use flyloop_core::quadrotor::standing_multirotor;
 use flyloop_core::sensors::Sensors;
-use flyloop_core::vehicle::Vehicle;
+use flyloop_core::vehicle::{Vehicle, VehicleStart};
 use nalgebra::Vector3;
 use std::fmt;
 use std::net::SocketAddr;
@@ -105,8 +105,8 @@ enum Kind {
 /// The vehicle, its IMU and ArduPilot's lockstep state.
 #[derive(Debug)]
 pub struct Session {
-    start: (Quadrotor, Sensors),
-    quad: Quadrotor,
+    start: (VehicleStart, Sensors),
+    vehicle: Box<dyn Vehicle + Send>,
     sensors: Sensors,
     /// Physics time of the last reply, µs (whole microseconds, so ArduPilot's clock, which
     /// counts whole microseconds, follows it exactly).
@@ -139,12 +139,11 @@ impl Session {
     /// The vehicle at rest on its landing gear at home, facing north.
     pub fn new(options: &SessionOptions) -> Result<Self, ParamError> {
         let c = &options.vehicle;
-        let quad =
-            Quadrotor::standing(c.quadrotor.clone(), options.seed)?.with_frame(c.frame.clone());
+        let start = standing_multirotor(c.quadrotor.clone(), c.frame.clone(), options.seed)?;
         let sensors = Sensors::new(c.sensors.clone(), options.seed)?;
         Ok(Session {
-            start: (quad.clone(), sensors.clone()),
-            quad,
+            vehicle: start.take(),
+            start: (start, sensors.clone()),
             sensors,
             time_us: 0,
             last: None,
@@ -162,8 +161,8 @@ impl Session {
     }
 
     /// The simulated vehicle.
-    pub fn quadrotor(&self) -> &Quadrotor {
-        &self.quad
+    pub fn vehicle(&self) -> &dyn Vehicle {
+        self.vehicle.as_ref()
     }
 
     /// Whether an ArduPilot has sent a frame (since the start).
@@ -273,7 +272,7 @@ impl Session {
 
     /// The vehicle and IMU back to their start state, physics time to 0.
     fn reset(&mut self) {
-        self.quad = self.start.0.clone();
+        self.vehicle = self.start.0.take();
         self.sensors = self.start.1.clone();
         self.time_us = 0;
         self.last = None;
@@ -282,7 +281,7 @@ impl Session {
     /// Motor commands from the first servo outputs, one per rotor; absurd ones are refused
     /// (counted) and the previous command holds.
     fn apply_motors(&mut self, frame: &ServoFrame) {
-        let outputs = &frame.motors[..self.quad.frame().rotor_count()];
+        let outputs = &frame.motors[..self.vehicle.actuator_count()];
         if let Some(&pwm) = outputs.iter().find(|&&p| p > MAX_PWM) {
             self.stats.absurd_pwm += 1;
             self.log_once(
@@ -295,7 +294,7 @@ impl Session {
             return;
         }
         let command: Vec<f64> = outputs.iter().map(|&p| packet::motor_command(p)).collect();
-        if let Err(e) = self.quad.set_command(&command) {
+        if let Err(e) = self.vehicle.set_actuators(&command) {
             // Commands in [0, 1] are always accepted; kept for a future bound.
             self.stats.absurd_pwm += 1;
             self.log_once(Kind::Pwm, format_args!("motor command refused: {e}"));
@@ -310,8 +309,8 @@ impl Session {
         let step_us = frame_step_us(frame.frame_rate);
         self.time_us += step_us;
         let dt = step_us as f64 * 1e-6;
-        self.quad.step(dt);
-        let k = self.quad.kinematics();
+        self.vehicle.advance(dt);
+        let k = self.vehicle.kinematics();
         let imu = self.sensors.sample_imu(&k, dt);
         self.stats.steps += 1;
         self.stats.physics += start.elapsed();
@@ -333,12 +332,12 @@ impl Session {
             );
         }
         reply::write(&mut self.reply, &state);
-        self.track.record(self.time_us, &self.quad);
+        self.track.record(self.time_us, self.vehicle.as_ref());
     }
 
     /// The body rates without noise, FRD (for tests).
     pub fn true_gyro(&self) -> Vector3<f64> {
-        flu_to_frd(&self.quad.body.body_rates)
+        self.vehicle.kinematics().body_rates_frd()
     }
 }
 

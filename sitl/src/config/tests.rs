@@ -224,3 +224,46 @@ fn faults_in_the_config_file_reach_the_task() {
         .to_string();
     assert!(e.contains("take no faults yet"), "{e}");
 }
+
+/// A motor fault on a hexa addresses its six motors; a motor the frame lacks is refused
+/// naming the index and the frame's count.
+#[test]
+fn a_hexa_motor_fault_addresses_six_motors() {
+    let hexa = "[frame]\nname = \"hexa_x\"\n[[faults]]\nkind = \"motor_off\"\nmotor = ";
+    let c = parse(TaskKind::Hover, &format!("{hexa}6")).unwrap();
+    assert_eq!((c.frame.rotor_count(), c.faults.faults[0].motor), (6, 6));
+    let e = parse(TaskKind::Hover, &format!("{hexa}7"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`motor` = 7 is out of range: it must be in [0, 6]"),
+        "{e}"
+    );
+}
+
+/// The task modes fly the file's `[frame]` too (the gym's SITL backend writes it), with the
+/// lander refusing one; no `[frame]` is the quad X.
+#[test]
+fn a_task_config_flies_its_frame_table() {
+    let c = parse(TaskKind::Hover, "mass = 1.2\n[frame]\nname = \"hexa_x\"").unwrap();
+    assert_eq!((c.frame.rotor_count(), c.quadrotor.mass), (6, 1.2));
+    let c = parse(
+        TaskKind::Waypoints,
+        "[randomize]\nmass = [1, 2]\n[frame]\nname = \"octo_x\"",
+    );
+    assert_eq!(c.unwrap().frame.rotor_count(), 8);
+    assert!(
+        parse(TaskKind::Hover, "mass = 1.2")
+            .unwrap()
+            .frame
+            .is_quad_x()
+    );
+    let e = parse(TaskKind::Hover, "[frame]\nname = \"tri\"").unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("unknown frame `tri`: the shipped frames are"),
+        "{e}"
+    );
+    let e = parse(TaskKind::Landing, "[frame]\nname = \"hexa_x\"").unwrap_err();
+    assert!(e.to_string().contains("takes no frame"), "{e}");
+}

@@ -10,9 +10,9 @@ use crate::telemetry;
 use crate::track::SessionTrack;
 use crate::wire::{Encoder, StreamDecoder};
 use flyloop_core::ParamError;
-use flyloop_core::quadrotor::Quadrotor;
+use flyloop_core::quadrotor::standing_multirotor;
 use flyloop_core::sensors::Sensors;
-use flyloop_core::vehicle::Vehicle;
+use flyloop_core::vehicle::{Vehicle, VehicleStart};
 use mavlink::dialects::common::{COMMAND_LONG_DATA, MavCmd, MavMessage};
 use std::time::Instant;
 
@@ -32,8 +32,8 @@ pub struct SessionOptions {
 /// The vehicle, its sensors and PX4's lockstep state.
 #[derive(Debug)]
 pub struct Session {
-    start: (Quadrotor, Sensors),
-    quad: Quadrotor,
+    start: (VehicleStart, Sensors),
+    vehicle: Box<dyn Vehicle + Send>,
     sensors: Sensors,
     home: Home,
     step_us: u64,
@@ -55,14 +55,19 @@ pub struct Session {
     pub speed: SpeedLog,
 }
 
+/// The start vehicle after one step with the motors off: the state PX4's first controls meet.
+fn first_state(start: &VehicleStart, step_us: u64) -> Box<dyn Vehicle + Send> {
+    let mut vehicle = start.take();
+    vehicle.advance(step_us as f64 * 1e-6);
+    vehicle
+}
+
 impl Session {
     /// The vehicle at rest on its landing gear at the origin, facing north.
     pub fn new(options: &SessionOptions) -> Result<Self, ParamError> {
         let c = &options.vehicle;
-        let mut quad =
-            Quadrotor::standing(c.quadrotor.clone(), options.seed)?.with_frame(c.frame.clone());
-        // One step with the motors off: the state PX4's first controls meet.
-        quad.step(options.step_us.max(1) as f64 * 1e-6);
+        let start = standing_multirotor(c.quadrotor.clone(), c.frame.clone(), options.seed)?;
+        let vehicle = first_state(&start, options.step_us.max(1));
         let sensors = Sensors::new(c.sensors.clone(), options.seed)?;
         let home = Home {
             latitude_deg: c.sensors.home_latitude,
@@ -70,8 +75,8 @@ impl Session {
             altitude_m: c.sensors.home_altitude,
         };
         Ok(Session {
-            start: (quad.clone(), sensors.clone()),
-            quad,
+            start: (start, sensors.clone()),
+            vehicle,
             sensors,
             home,
             step_us: options.step_us.max(1),
@@ -92,7 +97,7 @@ impl Session {
     /// the first step, and the first HIL_SENSOR appended to `out`. `gps_epoch_us` is the UNIX
     /// time (µs) HIL_GPS counts from.
     pub fn connect(&mut self, gps_epoch_us: u64, out: &mut Vec<u8>) {
-        self.quad = self.start.0.clone();
+        self.vehicle = first_state(&self.start.0, self.step_us);
         self.sensors = self.start.1.clone();
         self.time_us = self.step_us;
         self.lockstep = false;
@@ -120,8 +125,8 @@ impl Session {
     }
 
     /// The simulated vehicle.
-    pub fn quadrotor(&self) -> &Quadrotor {
-        &self.quad
+    pub fn vehicle(&self) -> &dyn Vehicle {
+        self.vehicle.as_ref()
     }
 
     /// The home point (local origin).
@@ -171,9 +176,9 @@ impl Session {
     /// Motor commands from controls[0..n], one per rotor (PX4's motor n is the frame's rotor
     /// n); a non-finite one refuses the whole set (counted), and the previous command holds.
     fn apply_controls(&mut self, controls: &[f32; 16]) {
-        let n = self.quad.frame().rotor_count();
+        let n = self.vehicle.actuator_count();
         let command: Vec<f64> = controls[..n].iter().map(|&c| f64::from(c)).collect();
-        if let Err(e) = self.quad.set_command(&command) {
+        if let Err(e) = self.vehicle.set_actuators(&command) {
             self.stats.refused_controls += 1;
             tracing::warn!(
                 refused = self.stats.refused_controls,
@@ -200,7 +205,7 @@ impl Session {
     /// One physics step, then the sensors of the new time.
     fn advance(&mut self, out: &mut Vec<u8>) {
         let start = Instant::now();
-        self.quad.step(self.step_us as f64 * 1e-6);
+        self.vehicle.advance(self.step_us as f64 * 1e-6);
         self.time_us += self.step_us;
         self.stats.steps += 1;
         self.emit(out);
@@ -211,11 +216,11 @@ impl Session {
     /// HIL_SENSOR now, HIL_GPS when a fix is delivered, HIL_STATE_QUATERNION when due.
     fn emit(&mut self, out: &mut Vec<u8>) {
         let dt = self.step_us as f64 * 1e-6;
-        let k = self.quad.kinematics();
+        let k = self.vehicle.kinematics();
         let reading = self.sensors.sample(&k, dt);
         let sensor = messages::hil_sensor(&reading, self.time_us);
         self.encoder.push(out, SIMULATOR_SYSTEM, &sensor);
-        self.track.record(self.time_us, &self.quad);
+        self.track.record(self.time_us, self.vehicle.as_ref());
         if let Some(fix) = self.sensors.gps(&k, self.time_us as f64 * 1e-6) {
             let stamp = self.gps_epoch_us + (fix.measured_at * 1e6).round() as u64;
             self.encoder

@@ -2,7 +2,7 @@
 
 use crate::faults::FaultPlan;
 use crate::lander2d::Lander2dParams;
-use crate::quadrotor::QuadrotorParams;
+use crate::quadrotor::{Frame, QuadrotorParams};
 use crate::rate_loop::RateLoopParams;
 use crate::tasks::flight::FlightParams;
 use crate::tasks::landing::LandingParams;
@@ -22,17 +22,20 @@ pub struct TaskConfig {
     pub landing: LandingParams,
     /// Per-episode ranges of the flight tasks' vehicle parameters (empty: off).
     pub randomize: Randomization,
+    /// The flight tasks' rotor table (`Frame::named("hexa_x")`, …); default the quad X.
+    pub frame: Frame,
     /// The flight tasks' faults (`[[faults]]`, `[[fault_randomization]]`; empty: none).
     pub faults: FaultPlan,
 }
 
 impl TaskConfig {
-    /// The flight tasks' vehicle: quadrotor, rate loop and flight parameters.
+    /// The flight tasks' vehicle: quadrotor, rate loop and flight parameters, and the frame.
     pub fn vehicle(&self) -> VehicleParams {
         VehicleParams {
             quadrotor: self.quadrotor.clone(),
             rate_loop: self.rate_loop.clone(),
             flight: self.flight.clone(),
+            frame: self.frame.clone(),
             faults: self.faults.clone(),
         }
     }

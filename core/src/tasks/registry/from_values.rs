@@ -6,6 +6,7 @@ use super::{ModelKind, TaskConfig, TaskInstance, TaskKind};
 use crate::ParamError;
 use crate::faults::{FaultPlan, Reach};
 use crate::params::Parameters;
+use crate::quadrotor::Frame;
 use crate::tasks::randomization::{ParamRange, Randomization};
 
 /// The parameter sets of `task` from `(name or short id, value)` pairs (other parameters keep
@@ -16,26 +17,29 @@ pub fn from_values<'a>(
     task: TaskKind,
     pairs: impl IntoIterator<Item = (&'a str, f64)>,
 ) -> Result<TaskConfig, ParamError> {
-    from_values_and_ranges(task, pairs, Vec::new())
+    from_values_and_ranges(task, pairs, Vec::new(), None)
 }
 
-/// [`from_values`] with randomisation ranges (flight tasks only; checked against the
-/// parameter sets by the core).
+/// [`from_values`] with randomisation ranges and a frame (flight tasks only; checked
+/// against the parameter sets by the core). No frame: the quad X.
 pub fn from_values_and_ranges<'a>(
     task: TaskKind,
     pairs: impl IntoIterator<Item = (&'a str, f64)>,
     ranges: Vec<ParamRange>,
+    frame: Option<Frame>,
 ) -> Result<TaskConfig, ParamError> {
-    from_values_ranges_and_faults(task, pairs, ranges, FaultPlan::default())
+    from_values_ranges_and_faults(task, pairs, ranges, frame, FaultPlan::default())
 }
 
 /// [`from_values_and_ranges`] with a fault plan (flight tasks only), checked against the
-/// task: a motor the frame lacks, a trigger that can never fire in its episodes (past
-/// `max_steps · dt`, a waypoint index it does not have) is refused.
+/// task and its frame: a motor the frame lacks (named with the frame's motor count), a
+/// trigger that can never fire in its episodes (past `max_steps · dt`, a waypoint index it
+/// does not have) is refused.
 pub fn from_values_ranges_and_faults<'a>(
     task: TaskKind,
     pairs: impl IntoIterator<Item = (&'a str, f64)>,
     ranges: Vec<ParamRange>,
+    frame: Option<Frame>,
     faults: FaultPlan,
 ) -> Result<TaskConfig, ParamError> {
     let entries = param_rows::entries(task);
@@ -69,6 +73,18 @@ pub fn from_values_ranges_and_faults<'a>(
         }
         config.randomize = Randomization::new(ranges)?;
     }
+    if let Some(frame) = frame {
+        if task.model() != ModelKind::Quadrotor {
+            return Err(ParamError::Relation {
+                name: "frame",
+                requirement: format!(
+                    "task `{}` flies no multirotor, so it takes no frame; the flight tasks (hover, waypoints) do",
+                    task.frame_name()
+                ),
+            });
+        }
+        config.frame = frame;
+    }
     if !faults.is_empty() {
         if task.model() != ModelKind::Quadrotor {
             return Err(ParamError::Parse(format!(
@@ -80,7 +96,8 @@ pub fn from_values_ranges_and_faults<'a>(
         faults.check(&Reach {
             duration: Some(f64::from(f.max_steps) * f.dt),
             waypoints: (task == TaskKind::Waypoints).then_some(config.waypoints.max_num_waypoints),
-            rotors: 4,
+            // The frame's motors: a motor fault on a hexa addresses 1..=6.
+            rotors: config.frame.rotor_count(),
         })?;
         config.faults = faults;
     }
@@ -113,9 +130,19 @@ mod tests {
             low: 1.0,
             high: 2.0,
         };
-        let err = from_values_and_ranges(TaskKind::Landing, [], vec![range.clone()]).unwrap_err();
+        let err =
+            from_values_and_ranges(TaskKind::Landing, [], vec![range.clone()], None).unwrap_err();
         assert!(err.to_string().contains("no randomisation"), "{err}");
-        let c = from_values_and_ranges(TaskKind::Hover, [], vec![range]).unwrap();
+        let c = from_values_and_ranges(TaskKind::Hover, [], vec![range], None).unwrap();
         assert_eq!(c.randomize.ranges().len(), 1);
+    }
+
+    #[test]
+    fn a_frame_is_taken_by_the_flight_tasks_and_refused_by_the_lander() {
+        let hexa = || Some(Frame::named("hexa_x").unwrap());
+        let c = from_values_and_ranges(TaskKind::Waypoints, [], Vec::new(), hexa()).unwrap();
+        assert_eq!(c.frame.rotor_count(), 6);
+        let err = from_values_and_ranges(TaskKind::Landing, [], Vec::new(), hexa()).unwrap_err();
+        assert!(err.to_string().contains("takes no frame"), "{err}");
     }
 }

@@ -88,7 +88,7 @@ fn full_throttle_lifts_off_and_the_motor_mapping_holds() {
     for k in 0..600 {
         s.receive(&servo(k, 1900), ap);
     }
-    assert_eq!(s.quadrotor().command(), [0.9; 4]);
+    assert_eq!(s.vehicle().actuators(), [0.9; 4]);
     // Thrust 4 * 10 N * 0.81 = 32 N against 14.7 N of weight: climbing after 0.5 s.
     let v = field(s.reply(), "velocity");
     let p = field(s.reply(), "position");
@@ -98,9 +98,9 @@ fn full_throttle_lifts_off_and_the_motor_mapping_holds() {
     assert!(a[2] < -15.0, "{a:?}");
     // Unset outputs (0) and pulses below 1000 us are off.
     s.receive(&servo(600, 0), ap);
-    assert_eq!(s.quadrotor().command(), [0.0; 4]);
+    assert_eq!(s.vehicle().actuators(), [0.0; 4]);
     s.receive(&servo(601, 900), ap);
-    assert_eq!(s.quadrotor().command(), [0.0; 4]);
+    assert_eq!(s.vehicle().actuators(), [0.0; 4]);
 }
 
 #[test]
@@ -171,14 +171,14 @@ fn bad_packets_are_skipped_and_counted_and_absurd_pwm_holds_the_command() {
         s.receive(&encode_16(1200, 2, &channels), ap),
         Outcome::Stepped
     );
-    assert_eq!(s.quadrotor().command(), [0.5; 4]);
+    assert_eq!(s.vehicle().actuators(), [0.5; 4]);
     assert_eq!((s.stats.absurd_pwm, s.stats.steps), (1, 3));
     // A valid 32-channel packet flies.
     let mut p32 = servo(3, 1600);
     p32[..2].copy_from_slice(&packet::MAGIC_32.to_le_bytes());
     p32.extend_from_slice(&[0; 32]);
     assert_eq!(s.receive(&p32, ap), Outcome::Stepped);
-    assert_eq!(s.quadrotor().command(), [0.6; 4]);
+    assert_eq!(s.vehicle().actuators(), [0.6; 4]);
     // A frame count skipping ahead is stepped once and counted.
     assert_eq!(s.receive(&servo(10, 1600), ap), Outcome::Stepped);
     assert_eq!(s.stats.gaps, 1);

@@ -79,7 +79,7 @@ fn connect_sends_sensors_at_once_and_each_controls_message_is_one_step() {
     assert!(s.is_lockstep());
     let times: Vec<u64> = sensors(&out).iter().map(|m| m.time_usec).collect();
     assert_eq!(times, vec![12_000, 16_000, 20_000]);
-    assert_eq!(s.quadrotor().command(), [0.7f32 as f64; 4]);
+    assert_eq!(s.vehicle().actuators(), [0.7f32 as f64; 4]);
     assert_eq!(s.stats.steps, 4);
 }
 
@@ -130,7 +130,7 @@ fn nan_controls_are_counted_and_skipped_but_time_goes_on() {
     out.clear();
     assert_eq!(s.receive(&controls(f32::NAN), &mut out), 1);
     assert_eq!(s.stats.refused_controls, 1);
-    assert_eq!(s.quadrotor().command(), [0.4f32 as f64; 4]);
+    assert_eq!(s.vehicle().actuators(), [0.4f32 as f64; 4]);
     assert_eq!(sensors(&out)[0].time_usec, 12_000);
 }
 
@@ -157,15 +157,15 @@ fn a_new_connection_starts_from_the_start_state() {
     for _ in 0..200 {
         s.receive(&controls(0.9), &mut out);
     }
-    assert!(s.quadrotor().body.position.z > 1.0);
+    assert!(s.vehicle().kinematics().position.z > 1.0);
     out.clear();
     s.connect(0, &mut out);
     assert_eq!(s.time_us(), 4000);
     assert!(!s.is_lockstep());
     // Standing on its landing gear again: the centre of mass at the rest height.
-    let standing = Vector3::new(0.0, 0.0, rest_height(&s.quadrotor().params));
-    assert!((s.quadrotor().body.position - standing).norm() < 1e-12);
-    assert_eq!(s.quadrotor().command(), [0.0; 4]);
+    let standing = Vector3::new(0.0, 0.0, rest_height(&AutopilotVehicle::iris().quadrotor));
+    assert!((s.vehicle().kinematics().position - standing).norm() < 1e-12);
+    assert_eq!(s.vehicle().actuators(), [0.0; 4]);
 }
 
 #[test]
@@ -222,12 +222,12 @@ fn a_frame_from_a_config_file_flies_on_its_own_rotor_count() {
         encoder.push(&mut bytes, 1, &m);
     }
     assert_eq!(s.receive(&bytes, &mut out), 250);
-    assert_eq!(s.quadrotor().command(), [1.0; 5]);
-    assert_eq!(s.quadrotor().body.motors.len(), 5);
+    assert_eq!(s.vehicle().actuators(), [1.0; 5]);
+    assert_eq!(s.vehicle().actuator_states().len(), 5);
     assert!(
-        s.quadrotor().body.position.z > 1.0,
+        s.vehicle().kinematics().position.z > 1.0,
         "{}",
-        s.quadrotor().body.position.z
+        s.vehicle().kinematics().position.z
     );
     assert_eq!(s.stats.refused_controls, 0);
 }

@@ -1,0 +1,114 @@
+"""N PX4 instances in one flyloop world (docs/performance.md, "Fleets"): every vehicle arms,
+takes off, holds 5 m (worst error over 2 s of PX4 time must be ≤ 0.3 m) and lands; prints
+per run the real-time factor (world time / wall time, from flyloop's stop line), the CPU
+seconds of flyloop and of the PX4s (from /proc), and flyloop's share.
+
+    FLYLOOP_PX4=/work/shared/px4 python benchmarks/fleet_px4.py --vehicles 8 --runs 3
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+for folder in ("px4", "fleet"):
+    sys.path.insert(0, str(REPO / "tests" / folder))
+
+from fleet_support import FleetSitl, free_block, px4_ports_free  # noqa: E402
+from flyloop import find_sitl_binary  # noqa: E402
+from px4_support import Px4, collect, fresh_dir, launch, px4_root, settle  # noqa: E402
+
+TICKS = os.sysconf("SC_CLK_TCK")
+
+
+def cpu_seconds(pid: int) -> float:
+    """User + system CPU time of a live process, s."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / TICKS
+
+
+def run(binary: Path, root: Path, n: int, speed: float) -> dict:
+    base = free_block(n, px4_ports_free, 10, 240)
+    sitl = FleetSitl(
+        binary, fresh_dir("bench-fleet-"), "--px4", "--vehicles", str(n),
+        "--px4-listen", f"127.0.0.1:{4560 + base}", speed=speed,
+    )  # fmt: skip
+    px4s = [Px4(root, base + k, fresh_dir(f"bench-px4-{k}-")) for k in range(n)]
+    try:
+        for p in px4s:
+            p.heartbeat(180)
+        targets = [launch(p)[1] for p in px4s]
+        for p, t in zip(px4s, targets, strict=True):
+            settle(p, t, 0.3, 300)
+        worst = 0.0
+        for p, t in zip(px4s, targets, strict=True):
+            h, v = collect(p, 2.0).worst(t)
+            worst = max(worst, h, v)
+        for p in px4s:
+            p.land()
+        for p in px4s:
+            p.wait_for(
+                "the disarm after landing",
+                lambda m, p=p: m.get_srcSystem() == p.target and not p.armed(m),
+                300,
+                "HEARTBEAT",
+            )
+        cpu_px4 = sum(cpu_seconds(p.proc.pid) for p in px4s)
+        cpu_flyloop = cpu_seconds(sitl.proc.pid)
+    finally:
+        for p in px4s:
+            p.kill()
+        sitl.stop()
+    c = sitl.counters()
+    return {
+        "worst_m": worst,
+        "rtf": float(c["real_time_factor"]),
+        "sim_s": float(c["time_s"]),
+        "cpu_flyloop_s": cpu_flyloop,
+        "cpu_px4_s": cpu_px4,
+        "share": cpu_flyloop / (cpu_flyloop + cpu_px4),
+        "silenced": sitl.stderr().count("silent for"),
+    }
+
+
+def main() -> int:
+    a = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    a.add_argument("--vehicles", type=int, default=8)
+    a.add_argument("--runs", type=int, default=3)
+    a.add_argument("--speed-factor", type=float, default=0.0)
+    args = a.parse_args()
+    root = px4_root(Path(tempfile.mkdtemp(prefix="bench-px4-build-")))
+    binary = find_sitl_binary(build=True)
+    print(f"cpu: {os.cpu_count()} x {cpu_model()}, load before: {os.getloadavg()[0]:.2f}")
+    ok = True
+    for k in range(args.runs):
+        start = time.monotonic()
+        r = run(binary, root, args.vehicles, args.speed_factor)
+        good = r["worst_m"] <= 0.3 and r["silenced"] == 0
+        ok &= good
+        print(
+            f"run {k + 1}: {args.vehicles} PX4s {'all held 5 m and landed' if good else 'FAILED'}"
+            f" worst {r['worst_m']:.3f} m, world {r['sim_s']:.1f} s at {r['rtf']:.2f}x real"
+            f" time, CPU flyloop {r['cpu_flyloop_s']:.1f} s / PX4s {r['cpu_px4_s']:.1f} s"
+            f" (flyloop {100 * r['share']:.1f} %, {r['cpu_px4_s'] / args.vehicles:.1f} s"
+            f" per PX4), silenced {r['silenced']}, wall {time.monotonic() - start:.0f} s,"
+            f" load {os.getloadavg()[0]:.2f}",
+            flush=True,
+        )
+    return 0 if ok else 1
+
+
+def cpu_model() -> str:
+    for line in Path("/proc/cpuinfo").read_text().splitlines():
+        if line.startswith("model name"):
+            return line.split(":", 1)[1].strip()
+    return "unknown"
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,103 @@
+"""PX4s flying one flyloop world: each PX4 instance i on TCP 4560 + i with MAV_SYS_ID i + 1,
+all in one lockstep; a PX4 that stops answering does not hang the others; two PX4s sent into
+each other collide, and flyloop says so."""
+
+from __future__ import annotations
+
+import signal
+import time
+
+from fleet_support import FleetSitl, free_block, px4_ports_free
+from px4_support import Px4, collect, fresh_dir, launch, settle
+
+TAKEOFF_ALT = 5.0
+
+
+def start_fleet(started, sitl_binary, px4_dir, n: int, *args: str, talk=True, **params):
+    """flyloop-sitl with n PX4 vehicles and the n PX4s; with `talk`, each heard (its first
+    heartbeat: PX4 then answers this test's link only, so leave it out when another program
+    is to command them)."""
+    base = free_block(n, px4_ports_free, 10, 240)
+    sitl = FleetSitl(
+        sitl_binary,
+        fresh_dir("flyloop-fleet-"),
+        "--px4",
+        "--vehicles",
+        str(n),
+        "--px4-listen",
+        f"127.0.0.1:{4560 + base}",
+        *args,
+    )
+    started.append(sitl)
+    px4s = []
+    for k in range(n):
+        p = Px4(px4_dir, base + k, fresh_dir(f"px4-fleet-{k}-"), **params)
+        started.append(p)
+        px4s.append(p)
+    for p in px4s if talk else ():
+        p.heartbeat(120)
+    return sitl, px4s
+
+
+def land_all(px4s) -> None:
+    for p in px4s:
+        p.land()
+    for p in px4s:
+        p.wait_for(
+            "the automatic disarm after landing",
+            lambda m, p=p: m.get_srcSystem() == p.target and not p.armed(m),
+            120,
+            "HEARTBEAT",
+        )
+
+
+def test_two_px4s_share_one_world_each_with_its_own_sysid(started, sitl_binary, px4_dir):
+    sitl, px4s = start_fleet(started, sitl_binary, px4_dir, 2)
+    assert [p.target for p in px4s] == [p.instance + 1 for p in px4s]
+    targets = []
+    for p in px4s:
+        targets.append(launch(p))
+    for p, (_, target) in zip(px4s, targets, strict=False):
+        settle(p, target, 0.3, 90)
+    for p, (_, target) in zip(px4s, targets, strict=False):
+        hold = collect(p, 2.0)
+        horizontal, vertical = hold.worst(target)
+        assert vertical < 0.3 and horizontal < 0.3, (p.instance, horizontal, vertical)
+    land_all(px4s)
+    sitl.stop()
+    counters = sitl.counters()
+    assert counters["collisions"] == "0", counters
+    assert "silent" not in sitl.stderr()
+
+
+def test_a_silent_px4_does_not_hang_the_others_and_rejoins(started, sitl_binary, px4_dir):
+    sitl, px4s = start_fleet(started, sitl_binary, px4_dir, 2, "--autopilot-timeout", "1")
+    flying, stalled = px4s
+    _, target = launch(flying)
+    stalled.proc.send_signal(signal.SIGSTOP)
+    text = sitl.statustext("silent", 30)
+    assert text.startswith("px4-001: px4 silent for 1."), text
+    # The world goes on without it: the other one climbs and holds.
+    settle(flying, target, 0.3, 60)
+    horizontal, vertical = collect(flying, 2.0).worst(target)
+    assert vertical < 0.3 and horizontal < 0.3, (horizontal, vertical)
+    stalled.proc.send_signal(signal.SIGCONT)
+    sitl.statustext("px4-001: answers again", 30)
+    land_all([flying])
+    assert stalled.proc.poll() is None
+
+
+def test_two_px4s_sent_into_each_other_collide_and_flyloop_says_so(started, sitl_binary, px4_dir):
+    sitl, (a, b) = start_fleet(started, sitl_binary, px4_dir, 2)
+    frame_a, target_a = launch(a)
+    frame_b, target_b = launch(b)
+    settle(a, target_a, 0.3, 90)
+    settle(b, target_b, 0.3, 90)
+    # b flies to where a hovers.
+    b.goto(frame_b, frame_b.from_global(*frame_a.to_global(target_a)))
+    text = sitl.statustext("collision px4-000 px4-001", 60)
+    assert "closing at" in text or text.startswith("collision px4-000 px4-001")
+    deadline = time.monotonic() + 5
+    while "collision px4-000 px4-001" not in sitl.stderr() and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert "collision px4-000 px4-001" in sitl.stderr()
