@@ -3,7 +3,7 @@
 
 use flyloop_core::SimRng;
 use flyloop_core::faults::{FaultKind, FaultPlan};
-use flyloop_core::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
+use flyloop_core::quadrotor::{BodyState, Frame, Quadrotor, QuadrotorParams};
 use flyloop_core::tasks::flight_faults::FlightFaults;
 use flyloop_core::tasks::hover::Hover;
 use flyloop_core::tasks::randomization::{Randomization, VehicleParams};
@@ -334,5 +334,49 @@ fn bad_faults_are_refused_naming_the_field_and_its_bound() {
             FaultPlan::from_toml_str("[[faults]]\nkind = 'motor_off'\nat_waypoint = 14").unwrap()
         )
         .is_ok()
+    );
+}
+
+/// Issue 35 on the multirotor frames: a motor fault on a hexa addresses its six motors (the
+/// sixth stops, the other five keep their command), and a motor the hexa lacks is refused
+/// naming the index and the frame's count.
+#[test]
+fn a_hexa_loses_its_sixth_motor_and_refuses_a_seventh() {
+    let plan = |motor: u8| {
+        FaultPlan::from_toml_str(&format!("[[faults]]\nkind = 'motor_off'\nmotor = {motor}"))
+            .unwrap()
+    };
+    let nominal = VehicleParams {
+        frame: Frame::named("hexa_x").unwrap(),
+        faults: plan(6),
+        ..VehicleParams::default()
+    };
+    let mut task = Hover::with_vehicle(nominal, Randomization::none()).unwrap();
+    task.reset(0);
+    for _ in 0..100 {
+        task.step(&[0.6; 6]).unwrap();
+    }
+    let motors = task.quadrotor().body.motors;
+    assert_eq!(motors.len(), 6);
+    // Spun down through the motor lag over the 1 s flown (from hover).
+    assert!(motors[5] < 1e-4, "{motors:?}");
+    for (i, m) in motors[..5].iter().enumerate() {
+        assert!((m - 0.6).abs() < 1e-3, "motor {}: {m}", i + 1);
+    }
+    assert_eq!(vector(&task, "fault_target"), vec![6.0]);
+    // The command read back is what was commanded, not what the faulted motor got.
+    assert_eq!(&task.quadrotor().command()[..], &[0.6; 6]);
+    let e = from_values_ranges_and_faults(
+        TaskKind::Hover,
+        [],
+        vec![],
+        Frame::named("hexa_x").ok(),
+        plan(7),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("`motor` = 7 is out of range: it must be in [0, 6]"),
+        "{e}"
     );
 }
