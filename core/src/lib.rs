@@ -22,6 +22,7 @@
 //! ```
 
 pub mod error;
+pub mod faults;
 pub mod frames;
 pub mod lander2d;
 pub mod number;

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from .errors import SitlError, SitlParameterError
+from .faults import FAULTS_KEY
 from .link import SitlLink
 from .protocol import (
     FRAME_ARRAY_LEN,
@@ -141,6 +142,11 @@ def configure_attached(link: SitlLink, encoder: Encoder, spec: TaskSpec, config,
         raise ValueError(
             "randomize needs a SITL the env starts itself (or backend='native'): a running "
             "SITL takes its randomisation ranges from its --config file's [randomize] table"
+        )
+    if FAULTS_KEY in config:
+        raise ValueError(
+            "faults need a SITL the env starts itself (or backend='native'): a running SITL "
+            "takes its faults from its --config file's [[faults]] tables"
         )
     for name, value in config.items():
         if name == FRAME_KEY:

@@ -14,7 +14,7 @@ import difflib
 import functools
 import math
 import numbers
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,6 +22,7 @@ import numpy as np
 
 from . import _native
 from .errors import SitlParameterError
+from .faults import FAULTS_KEY, mentions_fault, plan_text
 
 # ---- argument conversion: seed names and Python values -> core names and numbers ----
 
@@ -216,6 +217,17 @@ FLIGHT_RENAMED = (
         "domain randomisation: {core parameter: (low, high)} drawn per episode from its seed",
     ),
     _renamed(
+        "faults", (), lambda a, v: (), lambda d: None, Sequence[Mapping[str, Any]] | None,
+        "faults (docs/faults.md): dicts with kind, motor (1 = first, 0 = all) or sensor, "
+        "parameters, one trigger (at, above_height, after_takeoff, at_waypoint), duration",
+    ),
+    _renamed(
+        "fault_randomization", (), lambda a, v: (), lambda d: None,
+        Mapping[str, Any] | Sequence[Mapping[str, Any]] | None,
+        "faults drawn per episode from its seed: kinds, probability, at, motor, sensors, "
+        "duration and (low, high) ranges of the kinds' parameters",
+    ),
+    _renamed(
         "frame", (), frame_entry, lambda d: DEFAULT_FRAME, str,
         "the multirotor's rotor table: 'quad_x', 'quad_plus', 'hexa_x' or 'octo_x' (the "
         "motor interface takes one command per rotor)",
@@ -329,7 +341,7 @@ class TaskSpec:
         values = {
             k: (
                 v
-                if k == FRAME_KEY
+                if k in (FAULTS_KEY, FRAME_KEY)
                 else tuple(map(float, v))
                 if k.startswith(RANGE_PREFIX)
                 else float(v)
@@ -395,6 +407,8 @@ def resolve_config(
         if name == "randomize":
             config.update(randomize_entries(name, value))
             continue
+        if name in ("faults", "fault_randomization"):
+            continue
         if name == FRAME_KEY:
             # The quad X is the core's default: its config stays as it was before frames.
             entry = frame_entry(name, value)
@@ -403,6 +417,9 @@ def resolve_config(
             continue
         for core, v in zip(arg.core, arg.convert(name, value), strict=True):
             config[core] = v
+    text = plan_text(arguments.get("faults"), arguments.get("fault_randomization"))
+    if text is not None:
+        config[FAULTS_KEY] = text
     extra = dict(model_params or {})
     for name, value in extra.items():
         if name not in spec.model_params:
@@ -446,6 +463,8 @@ def parameter_error(spec: TaskSpec, message: str) -> SitlParameterError:
     where = ", ".join(argument_for(spec, n) for n in names) or "an argument"
     if "randomisation" in lead:
         where = "randomize"
+    elif not names and mentions_fault(lead):
+        where = "faults / fault_randomization"
     return SitlParameterError(f"{spec.env_id}: {where} refused by the core: {lead}")
 
 
@@ -458,7 +477,7 @@ def to_toml(config: Mapping[str, Any]) -> str:
         for k, (lo, hi) in ((k, v) for k, v in config.items() if k.startswith(RANGE_PREFIX))
     ]
     for name, v in config.items():
-        if name.startswith(RANGE_PREFIX) or name == FRAME_KEY:
+        if name.startswith(RANGE_PREFIX) or name in (FAULTS_KEY, FRAME_KEY):
             continue
         if isinstance(v, bool):
             text = "true" if v else "false"
@@ -469,6 +488,8 @@ def to_toml(config: Mapping[str, Any]) -> str:
         lines.append(f"{name} = {text}")
     if ranges:
         lines += ["", "[randomize]", *ranges]
+    if FAULTS_KEY in config:
+        lines += ["", config[FAULTS_KEY]]
     if FRAME_KEY in config:
         lines += ["", f"[{FRAME_KEY}]", f'name = "{config[FRAME_KEY]}"']
     return "\n".join(lines) + "\n"

@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from .faults import INFO_KEYS, active_faults, add_fault_list
 from .tasks import FLAG, INTEGER, REAL, TaskSpec, task_arguments
 
 # Single-env arguments a vector env accepts and ignores (they only change drawing).
@@ -51,6 +52,14 @@ class InfoColumns:
             else:
                 infos[name] = values[:, a:b].astype(np.float64)
         infos.update(self.masks)
+        if "fault_kind" in infos:
+            # Per env, the faults in effect (a list of dicts, see flyloop.faults).
+            per_env = np.empty(len(values), dtype=object)
+            per_env[:] = [
+                active_faults({k: infos[k][i] for k in INFO_KEYS}) for i in range(len(values))
+            ]
+            infos["faults"] = per_env
+            infos["_faults"] = np.ones(len(values), bool)
         return infos
 
     def dicts(self, values: np.ndarray) -> list[dict[str, Any]]:
@@ -70,4 +79,5 @@ class InfoColumns:
         names = [name for name, _, _, _ in self.fields]
         if not names:
             return [{} for _ in range(len(values))]
-        return [dict(zip(names, row, strict=True)) for row in zip(*columns, strict=True)]
+        out = [dict(zip(names, row, strict=True)) for row in zip(*columns, strict=True)]
+        return [add_fault_list(d) for d in out]

@@ -37,6 +37,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<multi_batch::MultiBatch>()?;
     m.add_function(wrap_pyfunction!(tables::describe, m)?)?;
     m.add_function(wrap_pyfunction!(tables::frames, m)?)?;
+    m.add_function(wrap_pyfunction!(tables::fault_catalogue, m)?)?;
     m.add_function(wrap_pyfunction!(sitl_command::sitl_main, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_test, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -1,6 +1,7 @@
 //! The core's tables for Python: task names, parameter sets built from `{name: value}`, and
 //! [`describe`], everything the Python package needs to declare spaces and check arguments.
 
+use flyloop_core::faults::FaultPlan;
 use flyloop_core::params::ValueKind;
 use flyloop_core::quadrotor::Frame;
 use flyloop_core::quadrotor::frame::shipped_names;
@@ -8,7 +9,7 @@ use flyloop_core::tasks::InfoValue;
 use flyloop_core::tasks::randomization::ParamRange;
 use flyloop_core::tasks::registry::param_rows;
 use flyloop_core::tasks::registry::{
-    ModelKind, TaskConfig, TaskInstance, TaskKind, from_values_and_ranges,
+    ModelKind, TaskConfig, TaskInstance, TaskKind, from_values_ranges_and_faults,
 };
 use numpy::PyArray1;
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -28,6 +29,10 @@ pub fn task_kind(name: &str) -> PyResult<TaskKind> {
 /// (the SITL's config file has them in its `[randomize]` table).
 const RANGE_PREFIX: &str = "randomize.";
 
+/// Config key of the fault plan: the TOML text of its `[[faults]]` and
+/// `[[fault_randomization]]` tables, exactly as the SITL's config file holds them.
+const FAULTS_KEY: &str = "faults";
+
 /// The parameter sets of `task` from `{core name or param_id: number}` and
 /// `{"randomize.<name>": (low, high)}`, checked by the core exactly as the SITL checks its
 /// parameter file; errors are ValueErrors carrying the core's message (it names the parameter
@@ -35,12 +40,23 @@ const RANGE_PREFIX: &str = "randomize.";
 pub fn task_config(task: TaskKind, params: Option<&Bound<'_, PyDict>>) -> PyResult<TaskConfig> {
     let mut pairs: Vec<(String, f64)> = Vec::new();
     let mut ranges = Vec::new();
+    let mut faults = FaultPlan::default();
     let mut frame = None;
     if let Some(params) = params {
         for (key, value) in params.iter() {
             let name: String = key.extract().map_err(|_| {
                 PyTypeError::new_err(format!("parameter names are strings, got {key}"))
             })?;
+            if name == FAULTS_KEY {
+                let text: String = value.extract().map_err(|_| {
+                    PyTypeError::new_err(format!(
+                        "`{FAULTS_KEY}` must be the TOML text of [[faults]] / [[fault_randomization]] tables, got {value}"
+                    ))
+                })?;
+                faults = FaultPlan::from_toml_str(&text)
+                    .map_err(|e| PyValueError::new_err(e.to_string()))?;
+                continue;
+            }
             if name == FRAME_KEY {
                 frame = Some(frame_named(&value)?);
                 continue;
@@ -66,11 +82,12 @@ pub fn task_config(task: TaskKind, params: Option<&Bound<'_, PyDict>>) -> PyResu
             pairs.push((name, number));
         }
     }
-    from_values_and_ranges(
+    from_values_ranges_and_faults(
         task,
         pairs.iter().map(|(k, v)| (k.as_str(), *v)),
         ranges,
         frame,
+        faults,
     )
     .map_err(|e| PyValueError::new_err(e.to_string()))
 }
@@ -185,4 +202,39 @@ pub fn frames(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
         out.set_item(name, rotors)?;
     }
     Ok(out)
+}
+
+/// The core's fault catalogue: a list of dicts (`name`, `target`: "motor" / "sensor" /
+/// "vehicle", `effect`, `fields`: list of dicts name, unit, min, max, default, description)
+/// in the catalogue's order (a task's `fault_kind` info value is an index into it), and the
+/// sensors' names in their `fault_target` order.
+#[pyfunction]
+pub fn fault_catalogue(py: Python<'_>) -> PyResult<(Bound<'_, PyList>, Vec<&'static str>)> {
+    use flyloop_core::faults::catalogue::{CATALOGUE, SensorId, Target};
+    let kinds = PyList::empty(py);
+    for k in CATALOGUE.iter() {
+        let row = PyDict::new(py);
+        row.set_item("name", k.name)?;
+        let target = match k.target {
+            Target::Motor => "motor",
+            Target::Sensor => "sensor",
+            Target::Vehicle => "vehicle",
+        };
+        row.set_item("target", target)?;
+        row.set_item("effect", k.effect)?;
+        let fields = PyList::empty(py);
+        for f in k.fields {
+            let d = PyDict::new(py);
+            d.set_item("name", f.name)?;
+            d.set_item("unit", f.unit)?;
+            d.set_item("min", f.min)?;
+            d.set_item("max", f.max)?;
+            d.set_item("default", f.default)?;
+            d.set_item("description", f.description)?;
+            fields.append(d)?;
+        }
+        row.set_item("fields", fields)?;
+        kinds.append(row)?;
+    }
+    Ok((kinds, SensorId::ALL.iter().map(|s| s.name()).collect()))
 }

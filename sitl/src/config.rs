@@ -6,11 +6,15 @@
 //! core's [`ParamError`]).
 
 use flyloop_core::ParamError;
+use flyloop_core::faults::FaultPlan;
+use flyloop_core::faults::plan::{FAULTS_TABLE, RANDOMIZATION_TABLE};
 use flyloop_core::params::Parameters;
 use flyloop_core::quadrotor::{Frame, QuadrotorParams};
 use flyloop_core::sensors::SensorParams;
 use flyloop_core::tasks::randomization::ParamRange;
-use flyloop_core::tasks::registry::{TaskConfig, TaskKind, from_values_and_ranges, param_rows};
+use flyloop_core::tasks::registry::{
+    TaskConfig, TaskKind, from_values_ranges_and_faults, param_rows,
+};
 use std::path::{Path, PathBuf};
 
 /// Why a config file was refused.
@@ -36,6 +40,8 @@ pub const RANDOMIZE_TABLE: &str = "randomize";
 struct Entries<'t> {
     values: Vec<(&'t str, f64)>,
     ranges: Option<Vec<ParamRange>>,
+    /// `[[faults]]` and `[[fault_randomization]]` (checked against the task by the core).
+    faults: FaultPlan,
 }
 
 /// Walks a parameter file's table, the one walker of every mode. `name_of` gives a key's
@@ -47,10 +53,15 @@ fn walk<'t>(
     let mut entries = Entries {
         values: Vec::with_capacity(table.len()),
         ranges: None,
+        faults: FaultPlan::default(),
     };
     for (key, value) in table {
         if key == RANDOMIZE_TABLE {
             entries.ranges = Some(parse_ranges(value)?);
+            continue;
+        }
+        if key == FAULTS_TABLE || key == RANDOMIZATION_TABLE {
+            entries.faults.add(key, value)?;
             continue;
         }
         let name = name_of(key)?;
@@ -107,7 +118,13 @@ pub fn parse(task: TaskKind, text: &str) -> Result<TaskConfig, ParamError> {
     let frame = take_frame(&mut table)?;
     let rows = param_rows::entries(task);
     let file = walk(&table, |key| Ok(param_rows::find(&rows, task, key)?.name))?;
-    from_values_and_ranges(task, file.values, file.ranges.unwrap_or_default(), frame)
+    from_values_ranges_and_faults(
+        task,
+        file.values,
+        file.ranges.unwrap_or_default(),
+        frame,
+        file.faults,
+    )
 }
 
 /// The file's `[frame]` table as a frame (taken out of `table`), if it has one.
@@ -146,6 +163,11 @@ impl AutopilotVehicle {
         let mut table: toml::Table = toml::from_str(text)?;
         let frame = take_frame(&mut table)?.unwrap_or_default();
         let file = walk(&table, autopilot_name)?;
+        if !file.faults.is_empty() {
+            return Err(ParamError::Parse(format!(
+                "`{FAULTS_TABLE}`: the PX4 and ArduPilot modes take no faults yet (the lockstep task mode does)"
+            )));
+        }
         if file.ranges.is_some() {
             return Err(ParamError::Parse(format!(
                 "`{RANDOMIZE_TABLE}`: the PX4 and ArduPilot modes fly one vehicle, without randomisation"

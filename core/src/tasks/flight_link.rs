@@ -24,6 +24,7 @@
 //! the episode's own, so the same seed gives the same noise.
 
 use super::flight::{FlightParams, base_bounds, base_observation, write_base_observation};
+use super::flight_faults::FlightFaults;
 use super::randomization::{Randomization, VehicleParams};
 use crate::error::ParamError;
 use crate::frames::{attitude_ned, enu_to_ned, flu_to_frd};
@@ -63,6 +64,8 @@ pub struct FlightLink {
     /// The flight parameters in effect this episode (latency and noise may be drawn).
     flight: FlightParams,
     rates: Option<RatesLink>,
+    /// The episode's faults (`None`: a healthy vehicle, stepped exactly as without faults).
+    faults: Option<FlightFaults>,
 }
 
 /// The rates interface's state.
@@ -127,7 +130,16 @@ impl FlightLink {
         } else {
             None
         };
+        let faults = if nominal.faults.is_empty() {
+            None
+        } else {
+            let f = &nominal.flight;
+            let duration = f64::from(f.max_steps) * f.dt;
+            let rotors = nominal.frame.rotor_count();
+            Some(FlightFaults::new(nominal.faults.clone(), rotors, duration)?)
+        };
         let link = FlightLink {
+            faults,
             flight: nominal.flight.clone(),
             nominal,
             randomization,
@@ -180,6 +192,19 @@ impl FlightLink {
             link.noise = SimRng::new(seed ^ NOISE_STREAM);
             link.estimate = estimate(quad, &self.flight, &mut link.noise);
         }
+        if let Some(faults) = &mut self.faults {
+            faults.restart(seed, quad, self.flight.dt);
+        }
+    }
+
+    /// The episode's faults, if the vehicle has any.
+    pub fn faults(&self) -> Option<&FlightFaults> {
+        self.faults.as_ref()
+    }
+
+    /// Mutable access to the faults (the task's waypoint, run-time injection).
+    pub fn faults_mut(&mut self) -> Option<&mut FlightFaults> {
+        self.faults.as_mut()
     }
 
     /// Number of rotors (motor commands of the motor interface).
@@ -233,6 +258,9 @@ impl FlightLink {
         dt: f64,
     ) -> Result<(), ActionError> {
         check_action(action, self.action_size())?;
+        if let Some(faults) = &mut self.faults {
+            faults.begin_step(quad, dt);
+        }
         let (start, _) = self.window(dt);
         let (lo, hi) = self.action_bounds();
         let Some(link) = &mut self.rates else {
@@ -278,11 +306,38 @@ impl FlightLink {
         link.ticks += 1;
     }
 
+    /// Before `quad` advances by `dt` within the step: the actuator faults put what the
+    /// motors get in place of its command (nothing without faults).
+    pub fn before_advance(&mut self, quad: &mut Quadrotor, dt: f64) {
+        if let Some(faults) = &mut self.faults {
+            faults.before_advance(quad, dt);
+        }
+    }
+
+    /// After `quad` advanced: it holds the commanded values again.
+    pub fn after_advance(&mut self, quad: &mut Quadrotor) {
+        if let Some(faults) = &mut self.faults {
+            faults.after_advance(quad);
+        }
+    }
+
+    /// Advances a lone `quad` by `dt` within the step, through the actuator fault path when
+    /// it has faults (a world steps its vehicles together between
+    /// [`FlightLink::before_advance`] and [`FlightLink::after_advance`]).
+    pub fn advance(&mut self, quad: &mut Quadrotor, dt: f64) {
+        self.before_advance(quad, dt);
+        quad.step(dt);
+        self.after_advance(quad);
+    }
+
     /// Ends the step (`quad` at the step's end): the estimator's view is updated.
     pub fn finish(&mut self, quad: &Quadrotor) {
         if let Some(link) = &mut self.rates {
             link.steps += 1;
             link.estimate = estimate(quad, &self.flight, &mut link.noise);
+        }
+        if let Some(faults) = &mut self.faults {
+            faults.end_step();
         }
     }
 
@@ -382,10 +437,14 @@ impl FlightLink {
         (lo, hi)
     }
 
-    /// Info entries of the vehicle: the values drawn this episode, when randomised.
+    /// Info entries of the vehicle: the values drawn this episode, when randomised; the
+    /// faults' slots, when it has faults ([`FlightFaults::visit_info`]).
     pub fn visit_info(&self, visit: &mut InfoVisitor<'_>) {
         if !self.randomization.is_off() {
             visit("randomized", InfoRef::Vector(&self.drawn));
+        }
+        if let Some(faults) = &self.faults {
+            faults.visit_info(visit);
         }
     }
 }

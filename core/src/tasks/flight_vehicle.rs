@@ -1,6 +1,7 @@
 //! The vehicle a lone flight task flies: a quadrotor and its [`FlightLink`] (the action
 //! interface, randomisation and, on the rates interface, PX4's rate loop; see that module).
 
+use super::flight_faults::FlightFaults;
 use super::flight_link::FlightLink;
 use super::randomization::{Randomization, VehicleParams};
 use crate::error::ParamError;
@@ -62,6 +63,16 @@ impl FlightVehicle {
         &self.link
     }
 
+    /// The episode's faults, if the vehicle has any.
+    pub fn faults(&self) -> Option<&FlightFaults> {
+        self.link.faults()
+    }
+
+    /// Mutable access to the faults (the task's waypoint, run-time injection).
+    pub fn faults_mut(&mut self) -> Option<&mut FlightFaults> {
+        self.link.faults_mut()
+    }
+
     /// Whether actions are thrust + body rates.
     pub fn rates_interface(&self) -> bool {
         self.link.rates_interface()
@@ -79,13 +90,13 @@ impl FlightVehicle {
         let (mut now, end) = self.link.window(dt);
         while let Some(tick) = self.link.next_tick(end) {
             if tick > now {
-                self.quad.step(tick - now);
+                self.link.advance(&mut self.quad, tick - now);
                 now = tick;
             }
             self.link.tick(&mut self.quad);
         }
         if end > now {
-            self.quad.step(end - now);
+            self.link.advance(&mut self.quad, end - now);
         }
         self.link.finish(&self.quad);
         Ok(())
@@ -124,7 +135,8 @@ impl FlightVehicle {
         self.link.write_observation(&self.quad, target, lo, hi, out);
     }
 
-    /// Info entries of the vehicle: the values drawn this episode, when randomised.
+    /// Info entries of the vehicle: the values drawn this episode, when randomised; the
+    /// faults' slots, when it has faults.
     pub fn visit_info(&self, visit: &mut InfoVisitor<'_>) {
         self.link.visit_info(visit);
     }

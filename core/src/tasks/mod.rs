@@ -136,6 +136,7 @@ pub fn clip_f32(value: f64, lo: f32, hi: f32) -> f32 {
 }
 
 pub mod flight;
+pub mod flight_faults;
 pub mod flight_link;
 pub mod flight_vehicle;
 pub mod hover;

@@ -8,6 +8,7 @@
 //! target, wind — are the same with or without randomisation).
 
 use crate::error::ParamError;
+use crate::faults::FaultPlan;
 use crate::number::Compact;
 use crate::params::{ParamSpec, Parameters, ValueKind};
 use crate::quadrotor::{Frame, QuadrotorParams};
@@ -51,6 +52,9 @@ pub struct VehicleParams {
     pub flight: FlightParams,
     #[serde(default)]
     pub frame: Frame,
+    /// The vehicle's faults (empty: healthy). Not randomised by ranges: its own
+    /// `[[fault_randomization]]` draws them ([`crate::faults`]).
+    pub faults: FaultPlan,
 }
 
 impl VehicleParams {

@@ -209,6 +209,9 @@ impl Task for Waypoints {
             from = sample_target(&self.flight, &from, &mut rng);
             self.waypoints.push(from);
         }
+        if let Some(faults) = self.vehicle.faults_mut() {
+            faults.set_waypoint(0);
+        }
         self.vehicle.restart(body, rng, seed);
         self.current = 0;
         self.reached = 0;
@@ -220,6 +223,9 @@ impl Task for Waypoints {
     }
 
     fn step(&mut self, action: &[f64]) -> Result<StepOutcome, ActionError> {
+        if let Some(faults) = self.vehicle.faults_mut() {
+            faults.set_waypoint(self.current as u32);
+        }
         self.vehicle.apply(action, self.flight.dt)?;
         self.status.step_count += 1;
         self.steps_since_checkpoint += 1;

@@ -11,6 +11,7 @@ import gymnasium as gym
 import numpy as np
 
 from ..backends import check_backend, make_backend
+from ..faults import add_fault_list
 from ..sitl_process import SitlProcess
 from ..spaces import FastBox
 from ..tasks import TaskSpec, resolve_config
@@ -155,6 +156,7 @@ class FlyloopEnv(gym.Env):
             seed = int(self.np_random.integers(0, 2**63))
         self.episode_seed = seed
         obs, info = self._backend.reset_one(seed)
+        add_fault_list(info)
         self._episode_return = 0.0
         self._last = (obs, info, None)
         if self._view is not None:
@@ -166,6 +168,7 @@ class FlyloopEnv(gym.Env):
     def step(self, action):
         a = as_actions(action, self.action_space.shape, "action")
         obs, reward, terminated, truncated, info = self._backend.step_one(a)
+        add_fault_list(info)
         if self._view is not None:
             self._episode_return += reward
             self._last = (obs, info, reward)

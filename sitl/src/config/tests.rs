@@ -196,6 +196,51 @@ fn a_bad_frame_table_names_the_rotor_and_field() {
     );
 }
 
+/// Issue 35: the lockstep task mode takes `[[faults]]` and `[[fault_randomization]]` from its
+/// config file through the core's one parser; bad ones name the field and its bound.
+#[test]
+fn faults_in_the_config_file_reach_the_task() {
+    let text = "mass = 1.1\n[[faults]]\nkind = \"motor_effectiveness\"\nmotor = 2\neffectiveness = 0.5\nat = 1.0\n\
+                [[fault_randomization]]\nkinds = [\"gust\", \"motor_off\"]\nat = [0.0, 2.0]\n";
+    let c = parse(TaskKind::Hover, text).unwrap();
+    assert_eq!((c.faults.faults.len(), c.faults.draws.len()), (1, 1));
+    assert_eq!(c.quadrotor.mass, 1.1);
+    let e = parse(
+        TaskKind::Hover,
+        "[[faults]]\nkind = \"motor_off\"\nmotor = 9",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("`motor` = 9 is out of range: it must be in [0, 4]"),
+        "{e}"
+    );
+    let e = parse(TaskKind::Hover, "faults = 3")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("`faults` must be tables"), "{e}");
+    let e = AutopilotVehicle::parse("[[faults]]\nkind = \"motor_off\"")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("take no faults yet"), "{e}");
+}
+
+/// A motor fault on a hexa addresses its six motors; a motor the frame lacks is refused
+/// naming the index and the frame's count.
+#[test]
+fn a_hexa_motor_fault_addresses_six_motors() {
+    let hexa = "[frame]\nname = \"hexa_x\"\n[[faults]]\nkind = \"motor_off\"\nmotor = ";
+    let c = parse(TaskKind::Hover, &format!("{hexa}6")).unwrap();
+    assert_eq!((c.frame.rotor_count(), c.faults.faults[0].motor), (6, 6));
+    let e = parse(TaskKind::Hover, &format!("{hexa}7"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`motor` = 7 is out of range: it must be in [0, 6]"),
+        "{e}"
+    );
+}
+
 /// The task modes fly the file's `[frame]` too (the gym's SITL backend writes it), with the
 /// lander refusing one; no `[frame]` is the quad X.
 #[test]

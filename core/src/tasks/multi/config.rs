@@ -123,6 +123,7 @@ impl MultiConfig {
             rate_loop: self.rate_loop.clone(),
             flight: self.flight.clone(),
             frame: Frame::quad_x(),
+            faults: crate::faults::FaultPlan::default(),
         }
     }
 }

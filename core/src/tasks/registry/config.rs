@@ -1,5 +1,6 @@
 //! Every parameter set a task is built from.
 
+use crate::faults::FaultPlan;
 use crate::lander2d::Lander2dParams;
 use crate::quadrotor::{Frame, QuadrotorParams};
 use crate::rate_loop::RateLoopParams;
@@ -23,6 +24,8 @@ pub struct TaskConfig {
     pub randomize: Randomization,
     /// The flight tasks' rotor table (`Frame::named("hexa_x")`, …); default the quad X.
     pub frame: Frame,
+    /// The flight tasks' faults (`[[faults]]`, `[[fault_randomization]]`; empty: none).
+    pub faults: FaultPlan,
 }
 
 impl TaskConfig {
@@ -33,6 +36,7 @@ impl TaskConfig {
             rate_loop: self.rate_loop.clone(),
             flight: self.flight.clone(),
             frame: self.frame.clone(),
+            faults: self.faults.clone(),
         }
     }
 }

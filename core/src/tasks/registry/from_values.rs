@@ -4,6 +4,7 @@
 use super::param_rows::{self, Group, ParamEntry};
 use super::{ModelKind, TaskConfig, TaskInstance, TaskKind};
 use crate::ParamError;
+use crate::faults::{FaultPlan, Reach};
 use crate::params::Parameters;
 use crate::quadrotor::Frame;
 use crate::tasks::randomization::{ParamRange, Randomization};
@@ -26,6 +27,20 @@ pub fn from_values_and_ranges<'a>(
     pairs: impl IntoIterator<Item = (&'a str, f64)>,
     ranges: Vec<ParamRange>,
     frame: Option<Frame>,
+) -> Result<TaskConfig, ParamError> {
+    from_values_ranges_and_faults(task, pairs, ranges, frame, FaultPlan::default())
+}
+
+/// [`from_values_and_ranges`] with a fault plan (flight tasks only), checked against the
+/// task and its frame: a motor the frame lacks (named with the frame's motor count), a
+/// trigger that can never fire in its episodes (past `max_steps · dt`, a waypoint index it
+/// does not have) is refused.
+pub fn from_values_ranges_and_faults<'a>(
+    task: TaskKind,
+    pairs: impl IntoIterator<Item = (&'a str, f64)>,
+    ranges: Vec<ParamRange>,
+    frame: Option<Frame>,
+    faults: FaultPlan,
 ) -> Result<TaskConfig, ParamError> {
     let entries = param_rows::entries(task);
     let mut values: Vec<(ParamEntry, f64)> = Vec::new();
@@ -69,6 +84,22 @@ pub fn from_values_and_ranges<'a>(
             });
         }
         config.frame = frame;
+    }
+    if !faults.is_empty() {
+        if task.model() != ModelKind::Quadrotor {
+            return Err(ParamError::Parse(format!(
+                "task `{}` has no faults; the flight tasks (hover, waypoints) do",
+                task.frame_name()
+            )));
+        }
+        let f = &config.flight;
+        faults.check(&Reach {
+            duration: Some(f64::from(f.max_steps) * f.dt),
+            waypoints: (task == TaskKind::Waypoints).then_some(config.waypoints.max_num_waypoints),
+            // The frame's motors: a motor fault on a hexa addresses 1..=6.
+            rotors: config.frame.rotor_count(),
+        })?;
+        config.faults = faults;
     }
     TaskInstance::build(task, &config)?;
     Ok(config)

@@ -14,7 +14,7 @@ pub mod param_rows;
 
 pub use config::TaskConfig;
 pub use controls::{ControlError, clamp_controls};
-pub use from_values::{from_values, from_values_and_ranges};
+pub use from_values::{from_values, from_values_and_ranges, from_values_ranges_and_faults};
 pub use info::{push_info, push_infos};
 pub use instance::TaskInstance;
 pub use kind::{ModelKind, TaskKind};
