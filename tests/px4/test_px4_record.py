@@ -68,6 +68,8 @@ def test_px4_takeoff_recorded_with_controls_sensors_and_truth(pair, tmp_path):
     assert len(t_d) == n and -d.min() > TAKEOFF_ALT - 0.5
     t_m, m0 = series["/motors/vehicle1_command/m0"]
     assert len(t_m) == n and m0.max() > 0.3
+    t_a, acc_z = series["/sensors/vehicle1/accel/z"]
+    assert len(t_a) == n and np.array_equal(acc_z, [m.zacc for _, m in sensors])
     png = tmp_path / "px4_tlog.png"
     plot = [sys.executable, "-m", "flyloop.plot", str(tlog), "-o", str(png)]
     plotted = subprocess.run(plot, capture_output=True, text=True, timeout=120)

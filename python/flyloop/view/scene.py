@@ -222,6 +222,13 @@ class Scene:
         for i, f in enumerate(fractions):
             self._log(f"/motors/{name}/m{i}", rr.Scalars(float(f)))
 
+    def sensors(self, name: str, accel_frd, gyro_frd) -> None:
+        """An IMU sample the SITL sent an autopilot (m/s², rad/s as deg/s; body FRD), as
+        series under /sensors (in the recording; no panel of the default layout)."""
+        for axis, a, g in zip("xyz", accel_frd, gyro_frd, strict=True):
+            self._log(f"/sensors/{name}/accel/{axis}", rr.Scalars(float(a)))
+            self._log(f"/sensors/{name}/gyro/{axis}", rr.Scalars(math.degrees(float(g))))
+
     def target(self, name: str, target_ned) -> None:
         point = rr.Points3D(
             [[float(v) for v in target_ned]], colors=[TARGET], radii=0.08, labels=["target"]
