@@ -1,6 +1,7 @@
 """What `--record` costs a PX4 flight: PX4 v1.16.0 flying flyloop-sitl --px4 unpaced
 (`--speed-factor 0`; PX4's own PX4_SIM_SPEED_FACTOR as given), armed and taken off to 5 m and
-held for a fixed wall time, in two set-ups alternated round by round in the same run:
+held for a fixed wall time, in two set-ups alternated in the same run (ABBA: the order swaps
+every round):
 
 - base: flyloop-sitl --px4 as it is;
 - record: the same with `--record FILE.tlog` (every 4 ms step written).
@@ -74,7 +75,9 @@ def main() -> int:
         px4_dir = px4_root(Path(tmp) / "px4")
         tlog = Path(tmp) / "px4.tlog"
         for r in range(args.rounds):
-            for name in factor:
+            # Order swapped every round: a load that rises or falls through the run does not
+            # always fall on the same set-up.
+            for name in list(factor)[:: 1 if r % 2 == 0 else -1]:
                 f, cpu_us, simulated = flight(
                     px4_dir, args.seconds, tlog if name == "record" else None
                 )
