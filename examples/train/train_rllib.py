@@ -79,6 +79,18 @@ def observation_filter(env=None, spaces=None, device=None):
     return MeanStdFilter()
 
 
+def ppo_hyperparameters(train_batch: int, minibatch: int, epochs: int) -> dict[str, Any]:
+    """PPO's learning settings (PPOConfig.training's keywords) shared by the RLlib examples."""
+    return dict(
+        lr=3e-4,
+        gamma=0.99,
+        lambda_=0.95,
+        train_batch_size_per_learner=train_batch,
+        minibatch_size=minibatch,
+        num_epochs=epochs,
+    )
+
+
 def build_config(
     env: str,
     num_env_runners: int,
@@ -114,14 +126,7 @@ def build_config(
             env_to_module_connector=observation_filter,
         )
         .learners(num_learners=num_learners)
-        .training(
-            lr=3e-4,
-            gamma=0.99,
-            lambda_=0.95,
-            train_batch_size_per_learner=train_batch,
-            minibatch_size=minibatch,
-            num_epochs=epochs,
-        )
+        .training(**ppo_hyperparameters(train_batch, minibatch, epochs))
         .rl_module(model_config=DefaultModelConfig(fcnet_hiddens=[64, 64]))
         .debugging(seed=seed)
     )
