@@ -16,10 +16,10 @@ import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-for folder in ("px4", "fleet"):
+for folder in ("sitl", "px4", "ardupilot", "fleet"):
     sys.path.insert(0, str(REPO / "tests" / folder))
 
-from fleet_support import FleetSitl, free_block, px4_ports_free  # noqa: E402
+from fleet_support import FleetSitl, free_block, land_all, px4_ports_free  # noqa: E402
 from flyloop import find_sitl_binary  # noqa: E402
 from px4_support import Px4, collect, fresh_dir, launch, px4_root, settle  # noqa: E402
 
@@ -49,15 +49,7 @@ def run(binary: Path, root: Path, n: int, speed: float) -> dict:
         for p, t in zip(px4s, targets, strict=True):
             h, v = collect(p, 2.0).worst(t)
             worst = max(worst, h, v)
-        for p in px4s:
-            p.land()
-        for p in px4s:
-            p.wait_for(
-                "the disarm after landing",
-                lambda m, p=p: m.get_srcSystem() == p.target and not p.armed(m),
-                300,
-                "HEARTBEAT",
-            )
+        land_all(px4s, 300)
         cpu_px4 = sum(cpu_seconds(p.proc.pid) for p in px4s)
         cpu_flyloop = cpu_seconds(sitl.proc.pid)
     finally:

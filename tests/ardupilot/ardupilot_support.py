@@ -17,8 +17,8 @@ import os
 import signal
 import socket
 import subprocess
+import sys
 import tarfile
-import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -27,6 +27,10 @@ import pytest
 
 os.environ["MAVLINK20"] = "1"
 from pymavlink import mavutil  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "sitl"))
+# Re-exported: the tests import stop and fresh_dir from here.
+from processes import fresh_dir, port_free, stop, stop_counters  # noqa: E402, F401
 
 REPO = Path(__file__).resolve().parents[2]
 PARM = REPO / "sitl" / "presets" / "ardupilot_iris.parm"
@@ -88,40 +92,21 @@ def ardupilot_build(unpack_into: Path) -> Build:
     pytest.fail(f"no copter.parm beside {path / 'bin'}")
 
 
-def _free(kind: int, port: int) -> bool:
-    with socket.socket(socket.AF_INET, kind) as s:
-        try:
-            s.bind(("127.0.0.1", port))
-        except OSError:
-            return False
-    return True
+def ardupilot_ports_free(i: int) -> bool:
+    """Whether ArduPilot instance i's ports are free right now: TCP 5760/5762/5763 + 10i (its
+    serial ports), UDP 5501 + 10i (RC input) and 9002 + 10i (its default physics port)."""
+    tcp = all(port_free(socket.SOCK_STREAM, p + 10 * i) for p in (5760, 5762, 5763))
+    return tcp and all(port_free(socket.SOCK_DGRAM, p + 10 * i) for p in (5501, 9002))
 
 
 def free_instance() -> int:
     """An ArduPilot instance number (3..150, never 0: a developer's own SITL uses it) whose
-    ports are free right now: TCP 5760/5762/5763 + 10i (its serial ports) and UDP 5501 + 10i
-    (RC input)."""
+    ports are free right now (ardupilot_ports_free)."""
     for _ in range(200):
         i = 3 + int.from_bytes(os.urandom(2), "little") % 148
-        tcp = all(_free(socket.SOCK_STREAM, p + 10 * i) for p in (5760, 5762, 5763))
-        if tcp and _free(socket.SOCK_DGRAM, 5501 + 10 * i):
+        if ardupilot_ports_free(i):
             return i
     raise RuntimeError("no free ArduPilot instance found")
-
-
-def stop(proc: subprocess.Popen, sig: int = signal.SIGTERM, timeout: float = 10) -> None:
-    """Stops a process by its PID (SIGKILL if it does not go)."""
-    if proc.poll() is None:
-        proc.send_signal(sig)
-        try:
-            proc.wait(timeout=timeout)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
-
-
-def fresh_dir(prefix: str) -> Path:
-    return Path(tempfile.mkdtemp(prefix=prefix))
 
 
 class Flyloop:
@@ -167,8 +152,7 @@ class Flyloop:
 
     def counters(self) -> dict[str, str]:
         """The counters of the line flyloop logs when it stops."""
-        stats = self.stderr().split("stopped: ", 1)[1].split()
-        return dict(kv.split("=", 1) for kv in stats)
+        return stop_counters(self.stderr())
 
     def wait_for_log(self, text: str, timeout: float) -> None:
         end = time.monotonic() + timeout
@@ -245,6 +229,8 @@ class ArduPilot:
             ],
             cwd=workdir,
             stdin=subprocess.DEVNULL,
+            # Its own group: stop() kills the children it starts (processes.py says why).
+            start_new_session=True,
             stdout=self.log,
             stderr=subprocess.STDOUT,
         )

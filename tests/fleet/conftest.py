@@ -10,7 +10,7 @@ import pytest
 from flyloop import find_sitl_binary
 
 TESTS = Path(__file__).resolve().parents[1]
-for folder in ("px4", "ardupilot", "fleet"):
+for folder in ("sitl", "px4", "ardupilot", "fleet"):
     sys.path.insert(0, str(TESTS / folder))
 from ardupilot_support import ardupilot_build  # noqa: E402
 from px4_support import px4_root  # noqa: E402
@@ -34,8 +34,15 @@ def ardupilot(tmp_path_factory):
 @pytest.fixture
 def started():
     """Processes the test started (anything with kill() or stop()), stopped at the end in
-    reverse order."""
+    reverse order: every one, even when stopping another failed (the failures reported
+    together; none can block: processes.stop bounds every wait)."""
     procs: list = []
     yield procs
+    failures = []
     for p in reversed(procs):
-        (getattr(p, "kill", None) or p.stop)()
+        try:
+            (getattr(p, "kill", None) or p.stop)()
+        except Exception as e:  # noqa: BLE001 — reported below, after the rest are stopped
+            failures.append(f"{type(p).__name__}: {e}")
+    if failures:
+        pytest.fail("teardown: " + "; ".join(failures))

@@ -1,59 +1,28 @@
 """A fleet of real autopilots (PX4s, ArduPilots) flying one flyloop-sitl world: free blocks
-of instance numbers, flyloop-sitl in fleet mode, and the STATUSTEXT it sends a ground
-station. The autopilots themselves come from tests/px4/px4_support.py and
-tests/ardupilot/ardupilot_support.py."""
+of instance numbers, flyloop-sitl in fleet mode, the STATUSTEXT it sends a ground station, and
+landing a fleet. The autopilots themselves (and which of their ports are free) come from
+tests/px4/px4_support.py and tests/ardupilot/ardupilot_support.py; processes and ports from
+tests/sitl/processes.py."""
 
 from __future__ import annotations
 
 import os
-import socket
 import subprocess
+import sys
 import time
 from pathlib import Path
 
 os.environ["MAVLINK20"] = "1"
 from pymavlink import mavutil  # noqa: E402
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "sitl"))
+from ardupilot_support import ardupilot_ports_free  # noqa: E402, F401 (re-exported)
+from processes import stop, stop_counters  # noqa: E402
+from px4_support import px4_ports_free  # noqa: E402, F401 (re-exported)
+
 # flyloop's home (its default, where the Iris preset's magnetic field is PX4's World Magnetic
 # Model's): ArduPilots of a fleet are started with it (`--home`), heading north.
 HOME = (47.397742, 8.545594, 488.0, 0.0)
-
-
-def _free(kind: int, port: int) -> bool:
-    with socket.socket(socket.AF_INET, kind) as s:
-        try:
-            s.bind(("127.0.0.1", port))
-        except OSError:
-            return False
-    return True
-
-
-def _px4_server_running(i: int) -> bool:
-    """Whether PX4 instance i's server socket answers (a killed PX4 leaves the file behind;
-    a new PX4 of that instance starts over a stale one)."""
-    path = Path(f"/tmp/px4-sock-{i}")
-    if not path.exists():
-        return False
-    with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as s:
-        try:
-            s.connect(str(path))
-        except OSError:
-            return False
-    return True
-
-
-def px4_ports_free(i: int) -> bool:
-    return (
-        not _px4_server_running(i)
-        and _free(socket.SOCK_STREAM, 4560 + i)
-        and all(_free(socket.SOCK_DGRAM, p) for p in (14580 + i, 18570 + i, 14280 + i, 13030 + i))
-    )
-
-
-def ardupilot_ports_free(i: int) -> bool:
-    return all(_free(socket.SOCK_STREAM, p + 10 * i) for p in (5760, 5762, 5763)) and all(
-        _free(socket.SOCK_DGRAM, p + 10 * i) for p in (5501, 9002)
-    )
 
 
 def free_block(n: int, free, low: int, high: int) -> int:
@@ -97,20 +66,13 @@ class FleetSitl:
         return Path(self.log.name).read_text()
 
     def stop(self) -> int:
-        if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
+        stop(self.proc)
         self.gcs.close()
         return self.proc.returncode
 
     def counters(self) -> dict[str, str]:
         """The counters of the line flyloop logs when it stops."""
-        stats = self.stderr().split("stopped: ", 1)[1].split()
-        return dict(kv.split("=", 1) for kv in stats)
+        return stop_counters(self.stderr())
 
     def statustext(self, contains: str, timeout: float) -> str:
         """The first STATUSTEXT (from now, or kept from before) containing `contains`."""
@@ -126,3 +88,16 @@ class FleetSitl:
             m = self.gcs.recv_match(type="STATUSTEXT", blocking=True, timeout=0.2)
             if m is not None:
                 self.texts.append(m.text)
+
+
+def land_all(px4s, timeout: float = 120) -> None:
+    """Lands every PX4 of `px4s` and waits (each up to `timeout` s) for its automatic disarm."""
+    for p in px4s:
+        p.land()
+    for p in px4s:
+        p.wait_for(
+            "the automatic disarm after landing",
+            lambda m, p=p: m.get_srcSystem() == p.target and not p.armed(m),
+            timeout,
+            "HEARTBEAT",
+        )

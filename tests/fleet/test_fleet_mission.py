@@ -3,24 +3,16 @@ altitudes: every leg end within 0.3 m, all land and disarm, no collision."""
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 from pathlib import Path
 
-import pytest
 from fleet_support import HOME
 from test_fleet_px4 import start_fleet
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "fleet_mission.py"
 
 
-# Once, run in one pytest session with the other fleet tests, this test's teardown waited for
-# PX4s that outlived their SIGKILL (unexplained yet); until that is found it runs on request.
-@pytest.mark.skipif(
-    os.environ.get("FLYLOOP_FLEET_MISSION") != "1",
-    reason="set FLYLOOP_FLEET_MISSION=1 (its teardown once hung; see the docstring)",
-)
 def test_four_px4s_fly_the_crossing_legs_within_0_3_m(started, sitl_binary, px4_dir):
     sitl, px4s = start_fleet(started, sitl_binary, px4_dir, 4, talk=False)
     out = subprocess.run(

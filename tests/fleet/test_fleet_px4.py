@@ -7,7 +7,7 @@ from __future__ import annotations
 import signal
 import time
 
-from fleet_support import FleetSitl, free_block, px4_ports_free
+from fleet_support import FleetSitl, free_block, land_all, px4_ports_free
 from px4_support import Px4, collect, fresh_dir, launch, settle
 
 TAKEOFF_ALT = 5.0
@@ -37,18 +37,6 @@ def start_fleet(started, sitl_binary, px4_dir, n: int, *args: str, talk=True, **
     for p in px4s if talk else ():
         p.heartbeat(120)
     return sitl, px4s
-
-
-def land_all(px4s) -> None:
-    for p in px4s:
-        p.land()
-    for p in px4s:
-        p.wait_for(
-            "the automatic disarm after landing",
-            lambda m, p=p: m.get_srcSystem() == p.target and not p.armed(m),
-            120,
-            "HEARTBEAT",
-        )
 
 
 def test_two_px4s_share_one_world_each_with_its_own_sysid(started, sitl_binary, px4_dir):

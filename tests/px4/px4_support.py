@@ -11,11 +11,12 @@ from __future__ import annotations
 import csv
 import math
 import os
+import shutil
 import signal
 import socket
 import subprocess
+import sys
 import tarfile
-import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,6 +25,10 @@ import pytest
 
 os.environ["MAVLINK20"] = "1"
 from pymavlink import mavutil  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "sitl"))
+# Re-exported: the tests import stop and fresh_dir from here.
+from processes import fresh_dir, port_free, stop, stop_counters  # noqa: E402, F401
 
 HOW_TO_GET_PX4 = (
     "PX4 tests need a PX4 SITL build: build PX4-Autopilot's px4_sitl_default (v1.14 or later) "
@@ -36,6 +41,18 @@ HOME = (47.397742, 8.545594, 488.0)
 SPEED = 4
 # Takeoff height above home, m (PX4's MIS_TAKEOFF_ALT).
 TAKEOFF_ALT = 5.0
+
+
+# PX4 gives its work queues SCHED_FIFO priorities 1-99 when it may (as root here). On a shared
+# 2-core machine those threads starve everything else, and a SIGKILLed PX4's 26 runnable
+# FIFO threads waited 20-60 s for a CPU before exiting while its zombie leader could not be
+# reaped (the fleet mission test's teardown hang). Without CAP_SYS_NICE PX4 falls back to
+# normal threads, as it runs for any non-root user.
+WITHOUT_REALTIME = (
+    ("setpriv", "--inh-caps=-sys_nice", "--bounding-set=-sys_nice")
+    if os.geteuid() == 0 and shutil.which("setpriv")
+    else ()
+)
 
 
 def px4_root(unpack_into: Path) -> Path:
@@ -57,15 +74,6 @@ def px4_root(unpack_into: Path) -> Path:
     return unpack_into / "px4"
 
 
-def _free(kind: int, port: int) -> bool:
-    with socket.socket(socket.AF_INET, kind) as s:
-        try:
-            s.bind(("127.0.0.1", port))
-        except OSError:
-            return False
-    return True
-
-
 def _stale(server: Path) -> bool:
     """Whether PX4's server socket file is left over (a killed PX4 never removes it; nothing
     listens): then it is removed, and its instance number is free again."""
@@ -80,30 +88,26 @@ def _stale(server: Path) -> bool:
             return False
 
 
+def px4_ports_free(i: int) -> bool:
+    """Whether PX4 instance i's simulator port (4560 + i), MAVLink ports (14580 + i,
+    18570 + i, 14280 + i, 13030 + i) and server socket are all free right now (a stale
+    server socket file is removed)."""
+    server = Path(f"/tmp/px4-sock-{i}")
+    if server.exists() and not _stale(server):
+        return False
+    udp = (14580 + i, 18570 + i, 14280 + i, 13030 + i)
+    return port_free(socket.SOCK_STREAM, 4560 + i) and all(
+        port_free(socket.SOCK_DGRAM, p) for p in udp
+    )
+
+
 def free_instance() -> int:
-    """A PX4 instance number whose simulator port (4560 + i), MAVLink ports (14580 + i,
-    18570 + i, 14280 + i, 13030 + i) and server socket are all free right now."""
+    """A PX4 instance number whose ports and server socket are free (px4_ports_free)."""
     for _ in range(200):
         i = 10 + int.from_bytes(os.urandom(2), "little") % 240  # MAV_SYS_ID = i + 1 ≤ 251
-        server = Path(f"/tmp/px4-sock-{i}")
-        if server.exists() and not _stale(server):
-            continue
-        if _free(socket.SOCK_STREAM, 4560 + i) and all(
-            _free(socket.SOCK_DGRAM, p) for p in (14580 + i, 18570 + i, 14280 + i, 13030 + i)
-        ):
+        if px4_ports_free(i):
             return i
     raise RuntimeError("no free PX4 instance found")
-
-
-def stop(proc: subprocess.Popen, sig: int = signal.SIGTERM, timeout: float = 10) -> None:
-    """Stops a process by its PID (SIGKILL if it does not go)."""
-    if proc.poll() is None:
-        proc.send_signal(sig)
-        try:
-            proc.wait(timeout=timeout)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
 
 
 class Flyloop:
@@ -225,6 +229,7 @@ class Px4:
         self.log = open(workdir / "px4.log", "w+")
         self.proc = subprocess.Popen(
             [
+                *WITHOUT_REALTIME,
                 str(root / "bin" / "px4"),
                 "-d",
                 "-i",
@@ -236,6 +241,8 @@ class Px4:
             cwd=workdir,
             env=env,
             stdin=subprocess.DEVNULL,
+            # Its own group: stop() kills the children it starts (processes.py says why).
+            start_new_session=True,
             stdout=self.log,
             stderr=subprocess.STDOUT,
         )
@@ -507,7 +514,3 @@ def autopilot_params(sitl_binary: Path, preset: Path, autopilot: str) -> dict[st
     ).stdout
     lines = [line.split() for line in out.splitlines() if line and not line.startswith("#")]
     return {name: value for name, value in lines}
-
-
-def fresh_dir(prefix: str) -> Path:
-    return Path(tempfile.mkdtemp(prefix=prefix))
