@@ -43,9 +43,10 @@ fly to the opposite point, all through the middle; success = every agent within
 
 **Version history** (Swap): v1 — each agent starts and ends on an altitude layer of its own,
 ``swap_layer`` = 0.6 m apart around the start height (0.6 / 1.2 / 1.8 / 2.4 m for four
-agents), so the straight line is a swap that leaves two hulls of room; everything else as v0.
-v0 — every agent at the start height (``swap_layer`` = 0): the lines all meet in the middle
-and a straight flight always collides (docs/training.md "Swap").
+agents), so the straight line is a swap that leaves two hulls of room, and the circle is
+``swap_radius`` = 1 m (2 m to fly, QuadHover's distances); everything else as v0. v0 — every
+agent at the start height (``swap_layer`` = 0) on a 2 m circle: the lines all meet in the
+middle and a straight flight always collides (docs/training.md "Swap").
 
 **Info** per agent: distance_to_target, position, target_position, step_count, episode_time,
 distance_progress, crashed, out_of_bounds, collided (this step), collision_speed (m/s),
@@ -76,7 +77,9 @@ ENV_TASKS = {
     "flyloop/Swap-v1": "swap",
 }
 # What an id sets over the core's defaults (an argument of the same name overrides it).
-ENV_DEFAULTS: dict[str, dict[str, Any]] = {"flyloop/Swap-v1": {"swap_layer": 0.6}}
+ENV_DEFAULTS: dict[str, dict[str, Any]] = {
+    "flyloop/Swap-v1": {"swap_layer": 0.6, "swap_radius": 1.0}
+}
 _INTERFACES = ("motors", "rates")
 
 

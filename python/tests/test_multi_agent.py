@@ -158,18 +158,21 @@ def test_bad_input_names_the_item():
 
 
 def test_swap_v1_flies_each_agent_on_its_own_layer_and_v0_on_one():
-    """Swap-v1 = Swap-v0 with swap_layer 0.6 m: starts and targets at 0.6 / 1.2 / 1.8 / 2.4 m;
-    v0 with the same argument is the same episode, bit for bit."""
+    """Swap-v1 = Swap-v0 with swap_layer 0.6 m and swap_radius 1 m: starts and targets at
+    0.6 / 1.2 / 1.8 / 2.4 m, 1 m from the middle; v0 with the same arguments is the same
+    episode, bit for bit."""
     v1 = flyloop.parallel_env("flyloop/Swap-v1", num_agents=4)
     _, infos = v1.reset(seed=5)
     heights = [infos[a]["position"][2] for a in v1.agents]
     targets = [infos[a]["target_position"][2] for a in v1.agents]
     np.testing.assert_allclose(heights, [0.6, 1.2, 1.8, 2.4], atol=1e-6)
     np.testing.assert_allclose(targets, heights, atol=1e-6)
+    radii = [np.hypot(*infos[a]["position"][:2]) for a in v1.agents]
+    np.testing.assert_allclose(radii, 1.0, atol=1e-6)
     v0 = flyloop.parallel_env("flyloop/Swap-v0", num_agents=4)
     _, flat = v0.reset(seed=5)
     np.testing.assert_allclose([flat[a]["position"][2] for a in v0.agents], 1.5, atol=1e-6)
-    same = flyloop.parallel_env("flyloop/Swap-v0", num_agents=4, swap_layer=0.6)
+    same = flyloop.parallel_env("flyloop/Swap-v0", num_agents=4, swap_layer=0.6, swap_radius=1.0)
     obs0, _ = same.reset(seed=5)
     obs1, _ = v1.reset(seed=5)
     for a in v1.agents:
