@@ -89,6 +89,22 @@ fn swap_starts_on_a_circle_with_the_opposite_point_as_target() {
 }
 
 #[test]
+fn swap_layers_put_each_agent_on_its_own_height_from_start_to_target() {
+    // 4 agents 0.6 m apart around the 1.5 m start height: 0.6, 1.2, 1.8 and 2.4 m.
+    let t = task(Scenario::Swap, &[("num_agents", 4.0), ("swap_layer", 0.6)]);
+    for (i, height) in [0.6, 1.2, 1.8, 2.4].into_iter().enumerate() {
+        let p = t.world().vehicle(i).body.position;
+        assert!((p.z - height).abs() < 1e-12, "agent {i}: {p}");
+        assert!(
+            (t.target(i).z - height).abs() < 1e-12,
+            "agent {i}: {}",
+            t.target(i)
+        );
+        assert!((t.target(i).xy() + p.xy()).norm() < 1e-12);
+    }
+}
+
+#[test]
 fn neighbours_are_nearest_first_and_absent_slots_are_zero() {
     let t = task(
         Scenario::MultiHover,
@@ -256,6 +272,11 @@ fn bad_input_names_the_item() {
         Scenario::Swap,
     );
     assert!(e.contains("swap_radius") && e.contains("hulls"), "{e}");
+    // 4 layers of 1.2 m around 1.5 m: the lowest at -0.3 m.
+    let e = err(&[("swap_layer", 1.2)], Scenario::Swap);
+    assert!(e.contains("swap_layer") && e.contains("-0.300"), "{e}");
+    let e = err(&[("swap_layer", 11.0)], Scenario::Swap);
+    assert!(e.contains("swap_layer") && e.contains("10"), "{e}");
     let e = err(&[("hover_spacing", 0.2)], Scenario::MultiHover);
     assert!(e.contains("hover_spacing"), "{e}");
     let e = err(&[("neighbours", 65.0)], Scenario::Swap);

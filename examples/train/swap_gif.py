@@ -1,4 +1,4 @@
-"""A GIF of a fast_ppo.py swap policy flying one held-out Swap-v0 world: the four agents from
+"""A GIF of a fast_ppo.py swap policy flying one held-out Swap world: the four agents from
 above (each with its target) and their heights, frame by frame.
 
     .venv/bin/python examples/train/swap_gif.py runs/swap_fast/native --seed 1000000 \\

@@ -132,12 +132,12 @@ OFFBOARD_RANDOMIZE = {
 }
 
 PRESETS: dict[str, Preset] = {
-    # Four agents exchange places across a 2 m circle (flyloop.parallel_env's Swap-v0), one
-    # policy for all: 5 s episodes (250 steps of 20 ms), no wind. Trained through
-    # flyloop.MultiAgentVectorEnv (one sub-env per agent; `multi_agent` marks it).
+    # Four agents exchange places across a 1 m circle, each on its own altitude layer
+    # (flyloop.parallel_env's Swap-v1), one policy for all: 5 s episodes (250 steps of 20 ms),
+    # no wind. Trained through flyloop.MultiAgentVectorEnv (one sub-env per agent).
     "swap": Preset(
         name="swap",
-        env_id="flyloop/Swap-v0",
+        env_id="flyloop/Swap-v1",
         env_kwargs={"num_agents": 4, "max_steps": 250, "dt": 0.02},
         actions=None,
         success=swap_success,

@@ -41,6 +41,13 @@ start evenly on a circle of ``swap_radius`` (default 2 m, turned at random each 
 fly to the opposite point, all through the middle; success = every agent within
 ``arrival_radius`` (0.5 m) of its target and no agent collided or crashed.
 
+**Version history** (Swap): v1 — each agent starts and ends on an altitude layer of its own,
+``swap_layer`` = 0.6 m apart around the start height (0.6 / 1.2 / 1.8 / 2.4 m for four
+agents), so the straight line is a swap that leaves two hulls of room, and the circle is
+``swap_radius`` = 1 m (2 m to fly, QuadHover's distances); everything else as v0. v0 — every
+agent at the start height (``swap_layer`` = 0) on a 2 m circle: the lines all meet in the
+middle and a straight flight always collides (docs/training.md "Swap").
+
 **Info** per agent: distance_to_target, position, target_position, step_count, episode_time,
 distance_progress, crashed, out_of_bounds, collided (this step), collision_speed (m/s),
 collisions (this episode), arrived, all_arrived, success, and randomized (the drawn values)
@@ -49,11 +56,11 @@ with domain randomisation.
 **Arguments**: ``num_agents`` (1–65,536), ``interface`` ("motors" | "rates"),
 ``domain_randomization`` ({core parameter: (low, high)}, drawn per agent and episode from the
 seed), and any core parameter by name: the multi-agent task's (``neighbours``,
-``collision_penalty``, ``arrival_radius``, ``swap_radius``, ``hover_spacing``), the world's
-(``wind_enabled`` — off by default here —, ``wind_speed_max``, ``collisions_enabled``,
-``downwash_enabled``, …), the flight task's (``dt``, ``max_steps``, …) and the vehicle's
-(``mass``, …). Same seed, same episode, bit for bit; the order of the action dict changes
-nothing.
+``collision_penalty``, ``arrival_radius``, ``swap_radius``, ``swap_layer``,
+``hover_spacing``), the world's (``wind_enabled`` — off by default here —,
+``wind_speed_max``, ``collisions_enabled``, ``downwash_enabled``, …), the flight task's
+(``dt``, ``max_steps``, …) and the vehicle's (``mass``, …). Same seed, same episode, bit
+for bit; the order of the action dict changes nothing.
 """
 
 from __future__ import annotations
@@ -64,7 +71,15 @@ from typing import Any
 import gymnasium
 import numpy as np
 
-ENV_TASKS = {"flyloop/MultiHover-v0": "multi_hover", "flyloop/Swap-v0": "swap"}
+ENV_TASKS = {
+    "flyloop/MultiHover-v0": "multi_hover",
+    "flyloop/Swap-v0": "swap",
+    "flyloop/Swap-v1": "swap",
+}
+# What an id sets over the core's defaults (an argument of the same name overrides it).
+ENV_DEFAULTS: dict[str, dict[str, Any]] = {
+    "flyloop/Swap-v1": {"swap_layer": 0.6, "swap_radius": 1.0}
+}
 _INTERFACES = ("motors", "rates")
 
 
@@ -94,7 +109,7 @@ def _batch(env_id: str, num_worlds: int, num_threads: int, kwargs: dict[str, Any
 
     if env_id not in ENV_TASKS:
         raise ValueError(f"unknown multi-agent env {env_id!r}; known: {sorted(ENV_TASKS)}")
-    kwargs = dict(kwargs)
+    kwargs = {**ENV_DEFAULTS.get(env_id, {}), **kwargs}
     if "action_interface" in kwargs:  # the single-agent envs' name
         kwargs["interface"] = kwargs.pop("action_interface")
     if "randomize" in kwargs:
@@ -236,7 +251,7 @@ def _parallel_env_class():
 
 
 def parallel_env(env_id: str, num_agents: int = 4, backend: str = "native", **kwargs: Any):
-    """The multi-agent env `env_id` ("flyloop/MultiHover-v0", "flyloop/Swap-v0") as a
+    """The multi-agent env `env_id` ("flyloop/MultiHover-v0", "flyloop/Swap-v0" or "-v1") as a
     PettingZoo ParallelEnv (module docs for the spaces, reward, ends and arguments)."""
     if backend == "sitl":
         raise NotImplementedError(

@@ -10,7 +10,7 @@ from pettingzoo.test import parallel_api_test, parallel_seed_test
 
 import flyloop
 
-ENVS = ["flyloop/MultiHover-v0", "flyloop/Swap-v0"]
+ENVS = ["flyloop/MultiHover-v0", "flyloop/Swap-v0", "flyloop/Swap-v1"]
 
 
 @pytest.mark.parametrize("env_id", ENVS)
@@ -98,7 +98,8 @@ def _first_collision(env, seeds=range(30), steps=100):
     return None
 
 
-@pytest.mark.parametrize("env_id", ENVS)
+# Swap-v1's layers keep two agents 0.6 m apart in height: its collisions are v0's.
+@pytest.mark.parametrize("env_id", ENVS[:2])
 def test_a_collision_is_in_both_agents_info_and_ends_them(env_id):
     env = flyloop.parallel_env(
         env_id, num_agents=2, swap_radius=0.16, hover_spacing=0.32, collision_penalty=10.0
@@ -154,3 +155,25 @@ def test_bad_input_names_the_item():
         env.step(
             {a: hover if a != "drone_1" else np.full(4, np.nan, np.float32) for a in env.agents}
         )
+
+
+def test_swap_v1_flies_each_agent_on_its_own_layer_and_v0_on_one():
+    """Swap-v1 = Swap-v0 with swap_layer 0.6 m and swap_radius 1 m: starts and targets at
+    0.6 / 1.2 / 1.8 / 2.4 m, 1 m from the middle; v0 with the same arguments is the same
+    episode, bit for bit."""
+    v1 = flyloop.parallel_env("flyloop/Swap-v1", num_agents=4)
+    _, infos = v1.reset(seed=5)
+    heights = [infos[a]["position"][2] for a in v1.agents]
+    targets = [infos[a]["target_position"][2] for a in v1.agents]
+    np.testing.assert_allclose(heights, [0.6, 1.2, 1.8, 2.4], atol=1e-6)
+    np.testing.assert_allclose(targets, heights, atol=1e-6)
+    radii = [np.hypot(*infos[a]["position"][:2]) for a in v1.agents]
+    np.testing.assert_allclose(radii, 1.0, atol=1e-6)
+    v0 = flyloop.parallel_env("flyloop/Swap-v0", num_agents=4)
+    _, flat = v0.reset(seed=5)
+    np.testing.assert_allclose([flat[a]["position"][2] for a in v0.agents], 1.5, atol=1e-6)
+    same = flyloop.parallel_env("flyloop/Swap-v0", num_agents=4, swap_layer=0.6, swap_radius=1.0)
+    obs0, _ = same.reset(seed=5)
+    obs1, _ = v1.reset(seed=5)
+    for a in v1.agents:
+        assert obs0[a].tobytes() == obs1[a].tobytes()

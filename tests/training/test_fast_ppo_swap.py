@@ -1,4 +1,4 @@
-"""examples/train/fast_ppo.py --env swap: one policy shared by four agents of the Swap-v0
+"""examples/train/fast_ppo.py --env swap: one policy shared by four agents of the Swap-v1
 world, trained on flyloop.MultiAgentVectorEnv. The smoke test CI affords: a few updates run,
 write their figures and evaluate on held-out worlds."""
 
@@ -19,7 +19,7 @@ def test_fast_ppo_swap_runs_a_few_updates_and_evaluates_held_out_worlds(tmp_path
     )
     assert done.returncode == 0, done.stderr[-3000:]
     s = json.loads((tmp_path / "native" / "summary.json").read_text())
-    assert s["env_id"] == "flyloop/Swap-v0" and s["env_kwargs"]["num_agents"] == 4
+    assert s["env_id"] == "flyloop/Swap-v1" and s["env_kwargs"]["num_agents"] == 4
     # 32 sub-envs = 8 worlds x 4 agents, 128 steps each: two updates.
     assert s["env_steps"] == 8192 and len(s["rows"]) == 2
     assert s["evaluation"]["episodes"] == 4

@@ -232,12 +232,13 @@ impl MultiFlight {
             let point = self.scenario.start_point(&self.config.multi, i, n, turn);
             body.position.x += point.x;
             body.position.y += point.y;
+            body.position.z += self.scenario.layer_offset(&self.config.multi, i, n);
             self.targets[i] = match self.scenario {
                 Scenario::MultiHover => {
                     let t = sample_target(flight, &local, &mut rng);
                     Vector3::new(t.x + point.x, t.y + point.y, t.z)
                 }
-                Scenario::Swap => Vector3::new(-body.position.x, -body.position.y, local.z),
+                Scenario::Swap => Vector3::new(-body.position.x, -body.position.y, body.position.z),
             };
             link.restart(&mut quad, body, rng, agent_seed);
             vehicles.push((agent_name(i), quad));
@@ -491,6 +492,16 @@ fn check_separation(scenario: Scenario, config: &MultiConfig) -> Result<(), Para
         })
         .map(|q| shape(&config.world, &q).hull_radius)
         .fold(0.0, f64::max);
+    let lowest = config.flight.start_height + scenario.layer_offset(&config.multi, 0, n);
+    if lowest <= largest {
+        return Err(ParamError::Relation {
+            name: "swap_layer",
+            requirement: format!(
+                "the lowest of {n} layers {} m apart starts at {lowest:.3} m, inside the ground for a {largest:.3} m hull: lower swap_layer or raise start_height",
+                config.multi.swap_layer
+            ),
+        });
+    }
     let separation = scenario.start_separation(&config.multi, n);
     if separation <= 2.0 * largest {
         let name = match scenario {

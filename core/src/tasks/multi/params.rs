@@ -28,6 +28,10 @@ pub struct MultiParams {
     pub swap_radius: f64,
     /// MultiHover: distance between neighbouring start points (a square grid), m. Default 2.
     pub hover_spacing: f64,
+    /// Swap: height between the agents' altitude layers, m: agent i starts and ends at
+    /// `start_height + (i − (n−1)/2)·swap_layer` (0: all at `start_height`, as Swap-v0).
+    /// Default 0.
+    pub swap_layer: f64,
 }
 
 impl Default for MultiParams {
@@ -39,17 +43,19 @@ impl Default for MultiParams {
             arrival_radius: 0.5,
             swap_radius: 2.0,
             hover_spacing: 2.0,
+            swap_layer: 0.0,
         }
     }
 }
 
-static MULTI_SPECS: [ParamSpec<MultiParams>; 6] = [
+static MULTI_SPECS: [ParamSpec<MultiParams>; 7] = [
     param!(integer num_agents, "", 1, MAX_VEHICLES, "Number of agents (vehicles) in the world"),
     param!(integer neighbours, "", 0, MAX_NEIGHBOURS, "Nearest neighbours each agent observes"),
     param!(real collision_penalty, "", 0.0, 1e6, "Reward taken on the step a collision starts"),
     param!(real arrival_radius, "m", 0.0, 1e4, "An agent this close to its target has arrived"),
     param!(real swap_radius, "m", 0.01, 1e4, "Swap: radius of the start circle"),
     param!(real hover_spacing, "m", 0.01, 1e4, "MultiHover: distance between neighbouring start points"),
+    param!(real swap_layer, "m", 0.0, 10.0, "Swap: height between the agents' altitude layers"),
 ];
 
 impl Parameters for MultiParams {

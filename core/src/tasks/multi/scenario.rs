@@ -60,6 +60,15 @@ impl Scenario {
         }
     }
 
+    /// Height of agent `i` of `n` above its start height, m: its altitude layer (Swap, 0 when
+    /// `swap_layer` is 0; MultiHover 0).
+    pub fn layer_offset(self, p: &MultiParams, i: usize, n: usize) -> f64 {
+        match self {
+            Scenario::MultiHover => 0.0,
+            Scenario::Swap => (i as f64 - (n as f64 - 1.0) / 2.0) * p.swap_layer,
+        }
+    }
+
     /// The smallest distance between two start points of `n` agents, m (infinite for one).
     pub fn start_separation(self, p: &MultiParams, n: usize) -> f64 {
         if n < 2 {
