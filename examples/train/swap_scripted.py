@@ -9,7 +9,9 @@ waypoint; the strategies differ only in the waypoint:
   layer; the layer is chosen by agent index, which the shared policy does not observe);
 - ``roundabout``: its target pushed ``offset`` m to the agent's right of the line start →
   target while it is farther than ``settle`` m, then the target (the same rule for every
-  agent: what one policy shared by symmetric agents can do).
+  agent: what one policy shared by symmetric agents can do);
+- ``hold``: the point ``stop`` m short of the middle on the agent's own side, at its target's
+  height (the deadlock of agents that learned not to collide but not to pass).
 
     .venv/bin/python examples/train/swap_scripted.py --episodes 100
 
@@ -42,6 +44,7 @@ class Strategy:
     layer: float = 0.6  # altitude: height step between agents' layers
     offset: float = 1.0  # roundabout: offset to the right of the direction of travel
     settle: float = 1.0  # horizontal distance from the target where the detour ends
+    stop: float = 0.6  # hold: distance from the middle where the agent stays
 
 
 def waypoint(strategy: Strategy, info: dict, i: int, n: int) -> np.ndarray:
@@ -49,6 +52,9 @@ def waypoint(strategy: Strategy, info: dict, i: int, n: int) -> np.ndarray:
     position = np.asarray(info["position"], float)
     target = np.asarray(info["target_position"], float)
     away = target - position
+    if strategy.name == "hold":  # the target is opposite the start: its direction is -start
+        inward = target[:2] / np.linalg.norm(target[:2])
+        return np.array([-inward[0] * strategy.stop, -inward[1] * strategy.stop, target[2]])
     if strategy.name == "straight" or np.hypot(away[0], away[1]) < strategy.settle:
         return target
     if strategy.name == "altitude":
@@ -106,6 +112,7 @@ def main() -> None:
     parser.add_argument("--layer", type=float, default=0.6, help="altitude step, m")
     parser.add_argument("--offset", type=float, default=1.0, help="roundabout offset, m")
     parser.add_argument("--settle", type=float, default=1.0, help="m from the target")
+    parser.add_argument("--stop", type=float, default=0.6, help="hold: m from the middle")
     parser.add_argument(
         "--param", action="append", default=[], help="env parameter NAME=VALUE (repeatable)"
     )
@@ -118,7 +125,7 @@ def main() -> None:
         if key in args.params:
             args.params[key] = int(args.params[key])
     for name in args.strategies.split(","):
-        strategy = Strategy(name, args.layer, args.offset, args.settle)
+        strategy = Strategy(name, args.layer, args.offset, args.settle, args.stop)
         r = run(strategy, args.episodes, args.params)
         print(
             f"{name:10s} success {r['success']}/{args.episodes}  collision "
