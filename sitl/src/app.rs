@@ -138,12 +138,11 @@ fn start_px4(args: Args) -> Result<(), StartError> {
         step_us,
         seed: args.seed,
     })?;
-    if let Some(track) = track(&args, session.vehicle().actuator_count())? {
-        session.track.set(track);
-    }
-    if let Some(view) = view_stream(&args)? {
-        session.track.set_view(view);
-    }
+    session_outputs(
+        &args,
+        session.vehicle().actuator_count(),
+        &mut session.track,
+    )?;
     let listener =
         std::net::TcpListener::bind(args.px4_listen).map_err(|source| StartError::Bind {
             link: "PX4",
@@ -323,6 +322,30 @@ fn track(args: &Args, rotors: usize) -> Result<Option<Track>, StartError> {
     Ok(Some(track))
 }
 
+/// What an autopilot session writes beside the flight, as asked for: `--track`, `--view`,
+/// `--record`.
+fn session_outputs(
+    args: &Args,
+    rotors: usize,
+    outputs: &mut crate::track::SessionTrack,
+) -> Result<(), StartError> {
+    if let Some(track) = track(args, rotors)? {
+        outputs.set(track);
+    }
+    if let Some(view) = view_stream(args)? {
+        outputs.set_view(view);
+    }
+    if let Some(path) = &args.record {
+        let recorder = crate::autopilot_record::AutopilotRecorder::create(path, args.home)
+            .map_err(|source| StartError::Record {
+                path: path.clone(),
+                source,
+            })?;
+        outputs.set_recording(recorder);
+    }
+    Ok(())
+}
+
 /// The live view's stream of the autopilot modes (`--view`), if asked for.
 fn view_stream(args: &Args) -> Result<Option<crate::view_stream::ViewStream>, StartError> {
     let Some(target) = args.view else {
@@ -349,12 +372,11 @@ fn start_ardupilot(args: Args) -> Result<(), StartError> {
         vehicle,
         seed: args.seed,
     })?;
-    if let Some(track) = track(&args, session.vehicle().actuator_count())? {
-        session.track.set(track);
-    }
-    if let Some(view) = view_stream(&args)? {
-        session.track.set_view(view);
-    }
+    session_outputs(
+        &args,
+        session.vehicle().actuator_count(),
+        &mut session.track,
+    )?;
     let socket =
         std::net::UdpSocket::bind(args.ardupilot_listen).map_err(|source| StartError::Bind {
             link: "ArduPilot",
@@ -386,10 +408,10 @@ fn start_ardupilot(args: Args) -> Result<(), StartError> {
 }
 
 fn start(args: Args) -> Result<(), StartError> {
-    if (args.px4 || args.ardupilot) && args.record.is_some() {
+    let fleet = args.fleet.is_some() || ((args.px4 || args.ardupilot) && args.vehicles > 1);
+    if fleet && args.record.is_some() {
         return Err(StartError::Options(
-            "--record is for lockstep and real time; PX4 and ArduPilot mode record with --track"
-                .to_string(),
+            "--record records one vehicle's autopilot, not a fleet (yet): use --track".to_string(),
         ));
     }
     if let Some(autopilot) = args.print_autopilot_params {
@@ -403,7 +425,7 @@ fn start(args: Args) -> Result<(), StartError> {
         print!("{text}");
         return Ok(());
     }
-    if args.fleet.is_some() || ((args.px4 || args.ardupilot) && args.vehicles > 1) {
+    if fleet {
         return start_fleet(args);
     }
     if args.px4 {

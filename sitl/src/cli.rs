@@ -125,8 +125,10 @@ pub struct Args {
     #[arg(long)]
     pub view: Option<SocketAddr>,
 
-    /// Lockstep and real time: record every step of every vehicle (motor command, ground
-    /// truth, wind, task frame) to this MAVLink telemetry log (.tlog; docs/view.md).
+    /// Record every step of every vehicle (motor command, ground truth, wind; the task frame
+    /// in lockstep and real time; PX4 and ArduPilot mode: the sensor samples sent and the
+    /// autopilot's outputs) to this MAVLink telemetry log (.tlog; docs/view.md). Not in fleet
+    /// mode.
     #[arg(long)]
     pub record: Option<PathBuf>,
 

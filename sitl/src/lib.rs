@@ -20,6 +20,7 @@
 pub mod app;
 pub mod ardupilot;
 pub mod autopilot_params;
+pub mod autopilot_record;
 pub mod cli;
 pub mod commands;
 pub mod config;

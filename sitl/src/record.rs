@@ -15,7 +15,7 @@ use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
 /// The unsigned MAVLink 2 frames packed back to back in `bytes` (this SITL's own output).
-fn frames_of(bytes: &[u8]) -> impl Iterator<Item = &[u8]> {
+pub(crate) fn frames_of(bytes: &[u8]) -> impl Iterator<Item = &[u8]> {
     let mut rest = bytes;
     std::iter::from_fn(move || {
         let len = 12 + usize::from(*rest.get(1)?);
@@ -26,31 +26,70 @@ fn frames_of(bytes: &[u8]) -> impl Iterator<Item = &[u8]> {
 }
 
 /// The message id of a MAVLink 2 frame (bytes 7..10, little-endian).
-fn message_id(frame: &[u8]) -> u32 {
+pub(crate) fn message_id(frame: &[u8]) -> u32 {
     match frame.get(7..10) {
         Some(id) => u32::from_le_bytes([id[0], id[1], id[2], 0]),
         None => u32::MAX,
     }
 }
 
+/// A telemetry log file being written: after the first write error nothing more is written
+/// (logged once); what is buffered is written when it is dropped.
+#[derive(Debug)]
+pub struct TlogFile {
+    out: BufWriter<File>,
+    failed: bool,
+}
+
+impl TlogFile {
+    /// Creates (truncates) `path`.
+    pub fn create(path: &Path) -> io::Result<Self> {
+        Ok(TlogFile {
+            out: BufWriter::with_capacity(1 << 16, File::create(path)?),
+            failed: false,
+        })
+    }
+
+    /// Appends `bytes` (time-stamped frames).
+    pub fn write(&mut self, bytes: &[u8]) {
+        if self.failed {
+            return;
+        }
+        if let Err(e) = self.out.write_all(bytes) {
+            self.failed = true;
+            tracing::error!(error = %e, "cannot write the recording: recording stopped");
+        }
+    }
+
+    /// Writes what is buffered.
+    pub fn flush(&mut self) {
+        if let Err(e) = self.out.flush() {
+            tracing::error!(error = %e, "cannot write the recording");
+        }
+    }
+}
+
+impl Drop for TlogFile {
+    fn drop(&mut self) {
+        self.flush();
+    }
+}
+
 /// A recording being written.
 #[derive(Debug)]
 pub struct Recorder {
-    out: BufWriter<File>,
+    out: TlogFile,
     encoder: Encoder,
     frame: Vec<u8>,
-    /// The first write error (later steps are not recorded; logged once).
-    failed: bool,
 }
 
 impl Recorder {
     /// Creates (truncates) `path`.
     pub fn create(path: &Path) -> io::Result<Self> {
         Ok(Recorder {
-            out: BufWriter::with_capacity(1 << 16, File::create(path)?),
+            out: TlogFile::create(path)?,
             encoder: Encoder::default(),
             frame: Vec::with_capacity(512),
-            failed: false,
         })
     }
 
@@ -59,9 +98,6 @@ impl Recorder {
     /// HIL_STATE_QUATERNION and task frame are recorded as they are, not encoded again);
     /// what it lacks is encoded here.
     pub fn step(&mut self, v: &mut Vehicle, home: &Home, reply: &[u8]) {
-        if self.failed {
-            return;
-        }
         self.frame.clear();
         let (time, system_id) = (v.clock_us.to_be_bytes(), v.system_id);
         let (mut has_state, mut has_frame) = (false, false);
@@ -86,22 +122,11 @@ impl Recorder {
                 push(&mut self.frame, &m);
             }
         }
-        if let Err(e) = self.out.write_all(&self.frame) {
-            self.failed = true;
-            tracing::error!(error = %e, "cannot write the recording: recording stopped");
-        }
+        self.out.write(&self.frame);
     }
 
     /// Writes what is buffered (at the stop).
     pub fn flush(&mut self) {
-        if let Err(e) = self.out.flush() {
-            tracing::error!(error = %e, "cannot write the recording");
-        }
-    }
-}
-
-impl Drop for Recorder {
-    fn drop(&mut self) {
-        self.flush();
+        self.out.flush();
     }
 }

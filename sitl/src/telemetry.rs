@@ -18,6 +18,9 @@ pub mod id {
     pub const GLOBAL_POSITION_INT: u32 = 33;
     pub const VFR_HUD: u32 = 74;
     pub const HIL_STATE_QUATERNION: u32 = 115;
+    pub const HIL_SENSOR: u32 = 107;
+    pub const HIL_GPS: u32 = 113;
+    pub const HIL_ACTUATOR_CONTROLS: u32 = 93;
     pub const AUTOPILOT_VERSION: u32 = 148;
     pub const WIND_COV: u32 = 231;
     pub const HOME_POSITION: u32 = 242;
@@ -178,12 +181,18 @@ pub fn vfr_hud(v: &Vehicle, home: &Home) -> MavMessage {
 /// actuator-channel order of protocol.md §4; unused channels 0. `time_usec` is the
 /// simulation time (µs, wrapping at 2^32 as the field is 32 bits).
 pub fn servo_output_raw(v: &Vehicle) -> MavMessage {
+    servo_output_raw_of(command_fractions(v), v.clock_us)
+}
+
+/// SERVO_OUTPUT_RAW of motor commands given as fractions of full (0 → 1000 µs, 1 → 2000 µs;
+/// the first 16) at simulation time `time_us`.
+pub fn servo_output_raw_of(fractions: impl Iterator<Item = f64>, time_us: u64) -> MavMessage {
     let mut pwm = [0u16; 16];
-    for (p, f) in pwm.iter_mut().zip(command_fractions(v)) {
+    for (p, f) in pwm.iter_mut().zip(fractions) {
         *p = round_u16(1000.0 + 1000.0 * f.clamp(0.0, 1.0));
     }
     MavMessage::SERVO_OUTPUT_RAW(SERVO_OUTPUT_RAW_DATA {
-        time_usec: v.clock_us as u32,
+        time_usec: time_us as u32,
         servo1_raw: pwm[0],
         servo2_raw: pwm[1],
         servo3_raw: pwm[2],
@@ -206,10 +215,14 @@ pub fn servo_output_raw(v: &Vehicle) -> MavMessage {
 
 /// The wind at the vehicle (velocity − air velocity), world NED, m/s, at simulation time.
 pub fn wind_cov(v: &Vehicle) -> MavMessage {
-    let k = v.task.kinematics();
+    wind_cov_of(&v.task.kinematics(), v.clock_us)
+}
+
+/// WIND_COV of the wind at `k` (velocity − air velocity, world NED, m/s) at `time_usec`.
+pub fn wind_cov_of(k: &Kinematics, time_usec: u64) -> MavMessage {
     let wind = crate::kinematics::enu_to_ned(&(k.velocity - k.air_velocity));
     MavMessage::WIND_COV(WIND_COV_DATA {
-        time_usec: v.clock_us,
+        time_usec,
         wind_x: wind.x as f32,
         wind_y: wind.y as f32,
         wind_z: wind.z as f32,

@@ -8,8 +8,10 @@
 //! `grounded` (0/1),
 //! `p,q,r` (body rates, rad/s, FRD).
 
+use crate::autopilot_record::{AutopilotRecorder, Sent};
 use crate::kinematics::attitude_ned;
 use flyloop_core::vehicle::Vehicle;
+use mavlink::dialects::common::MavMessage;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
@@ -91,50 +93,82 @@ impl Track {
     }
 }
 
-/// A session's track: none, or one being written until a write fails (logged, and the
-/// track ends; the flight goes on); and the live view's stream (`--view`), if any.
+/// What a session writes beside the flight: its track (none, or one being written until a
+/// write fails: logged, and the track ends; the flight goes on), the live view's stream
+/// (`--view`) and the recording (`--record`), each if asked for.
 #[derive(Debug, Default)]
-pub struct SessionTrack(Option<Track>, Option<crate::view_stream::ViewStream>);
+pub struct SessionTrack {
+    track: Option<Track>,
+    view: Option<crate::view_stream::ViewStream>,
+    recording: Option<AutopilotRecorder>,
+}
 
 impl SessionTrack {
     /// Writes the ground truth to `track` from now on.
     pub fn set(&mut self, track: Track) {
-        self.0 = Some(track);
+        self.track = Some(track);
     }
 
     /// Sends the ground truth to a live view from now on.
     pub fn set_view(&mut self, view: crate::view_stream::ViewStream) {
-        self.1 = Some(view);
+        self.view = Some(view);
+    }
+
+    /// Records every step from now on.
+    pub fn set_recording(&mut self, recording: AutopilotRecorder) {
+        self.recording = Some(recording);
+    }
+
+    /// Whether a recording is made (what only it needs is built only then).
+    pub fn is_recording(&self) -> bool {
+        self.recording.is_some()
     }
 
     /// A new autopilot connection (see [`Track::connect`]).
     pub fn connect(&mut self) {
         self.write(Track::connect);
-        if let Some(view) = &mut self.1 {
+        if let Some(view) = &mut self.view {
             view.connect();
         }
-    }
-
-    /// A row for `vehicle` at `time_us` when one is due (and the view's state).
-    pub fn record(&mut self, time_us: u64, vehicle: &dyn Vehicle) {
-        self.write(|track| track.record(time_us, vehicle));
-        if let Some(view) = &mut self.1 {
-            view.send(time_us, vehicle);
+        if let Some(recording) = &mut self.recording {
+            recording.connect();
         }
     }
 
-    /// Writes out buffered rows (on disconnect, silence and shutdown).
+    /// A message the autopilot sent, at `time_us`, into the recording.
+    pub fn received(&mut self, time_us: u64, system_id: u8, message: &MavMessage) {
+        if let Some(recording) = &mut self.recording {
+            recording.received(time_us, system_id, message);
+        }
+    }
+
+    /// A row for `vehicle` at `time_us` when one is due (and the view's state); the step and
+    /// what was `sent` into the recording.
+    pub fn record(&mut self, time_us: u64, vehicle: &dyn Vehicle, sent: Sent<'_>) {
+        self.write(|track| track.record(time_us, vehicle));
+        if let Some(view) = &mut self.view {
+            view.send(time_us, vehicle);
+        }
+        if let Some(recording) = &mut self.recording {
+            recording.step(time_us, vehicle, sent);
+        }
+    }
+
+    /// Writes out buffered rows and recording (on disconnect, silence and shutdown).
     pub fn flush(&mut self) {
         self.write(Track::flush);
+        if let Some(recording) = &mut self.recording {
+            recording.flush();
+        }
     }
 
     fn write(&mut self, write: impl FnOnce(&mut Track) -> io::Result<()>) {
-        let Some(track) = &mut self.0 else {
+        let Some(track) = &mut self.track else {
             return;
         };
         if let Err(e) = write(track) {
             tracing::error!(error = %e, "writing the track failed: track stopped");
-            self.0 = None;
+            self.track = None;
         }
     }
 }

@@ -66,12 +66,27 @@ def _free(kind: int, port: int) -> bool:
     return True
 
 
+def _stale(server: Path) -> bool:
+    """Whether PX4's server socket file is left over (a killed PX4 never removes it; nothing
+    listens): then it is removed, and its instance number is free again."""
+    with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as s:
+        try:
+            s.connect(str(server))
+            return False
+        except ConnectionRefusedError:
+            server.unlink(missing_ok=True)
+            return True
+        except OSError:
+            return False
+
+
 def free_instance() -> int:
     """A PX4 instance number whose simulator port (4560 + i), MAVLink ports (14580 + i,
     18570 + i, 14280 + i, 13030 + i) and server socket are all free right now."""
     for _ in range(200):
         i = 10 + int.from_bytes(os.urandom(2), "little") % 240  # MAV_SYS_ID = i + 1 ≤ 251
-        if Path(f"/tmp/px4-sock-{i}").exists():
+        server = Path(f"/tmp/px4-sock-{i}")
+        if server.exists() and not _stale(server):
             continue
         if _free(socket.SOCK_STREAM, 4560 + i) and all(
             _free(socket.SOCK_DGRAM, p) for p in (14580 + i, 18570 + i, 14280 + i, 13030 + i)

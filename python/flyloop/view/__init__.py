@@ -14,6 +14,7 @@ import rerun as rr
 
 from .env import Watch, WatchVector
 from .mavlink import Listener, MavlinkScene, poll, read_tlog
+from .multi import WatchParallel
 from .scene import Frame, Scene, blueprint
 
 __all__ = [
@@ -22,6 +23,7 @@ __all__ = [
     "ViewError",
     "Viewer",
     "Watch",
+    "WatchParallel",
     "WatchVector",
     "blueprint",
     "read_recording",

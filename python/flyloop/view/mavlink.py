@@ -150,6 +150,14 @@ class MavlinkScene:
         position = self._vehicle(key[1]).position
         self.scene.wind(f"vehicle{key[1]}", position, [m.wind_x, m.wind_y, m.wind_z])
 
+    def _on_hil_sensor(self, key: tuple, m) -> None:
+        """The IMU sample flyloop sent an autopilot (a PX4 or ArduPilot recording)."""
+        if self.is_autopilot(key):
+            return
+        self.scene.time(m.time_usec / 1e6)
+        accel, gyro = (m.xacc, m.yacc, m.zacc), (m.xgyro, m.ygyro, m.zgyro)
+        self.scene.sensors(f"vehicle{key[1]}", accel, gyro)
+
     def _on_debug_float_array(self, key: tuple, m) -> None:
         """The task frame: its arrays gathered (protocol.md §6), then reward, ends, target."""
         if self.is_autopilot(key):

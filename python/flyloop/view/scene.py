@@ -21,6 +21,7 @@ TIMELINE = "sim_time"
 # The vehicle's hub: a colour the browser test looks for (it appears nowhere else).
 HUB = (255, 0, 200)
 ESTIMATE = (255, 150, 0)
+COLLISION = (230, 20, 20)
 ROTOR_CCW, ROTOR_CW, ARM = (70, 200, 90), (235, 90, 80), (60, 60, 70)
 GROUND, PAD, TRAIL, TARGET, WIND = (
     (150, 155, 150),
@@ -221,6 +222,22 @@ class Scene:
         """Motor commands in [0, 1], one series per motor."""
         for i, f in enumerate(fractions):
             self._log(f"/motors/{name}/m{i}", rr.Scalars(float(f)))
+
+    def sensors(self, name: str, accel_frd, gyro_frd) -> None:
+        """An IMU sample the SITL sent an autopilot (m/s², rad/s as deg/s; body FRD), as
+        series under /sensors (in the recording; no panel of the default layout)."""
+        for axis, a, g in zip("xyz", accel_frd, gyro_frd, strict=True):
+            self._log(f"/sensors/{name}/accel/{axis}", rr.Scalars(float(a)))
+            self._log(f"/sensors/{name}/gyro/{axis}", rr.Scalars(math.degrees(float(g))))
+
+    def collision(self, name: str, position_ned, speed: float) -> None:
+        """A collision the world reported for vehicle `name`: a red mark where it happened
+        and its closing speed (m/s) as a series."""
+        mark = rr.Points3D(
+            [[float(v) for v in position_ned]], colors=[COLLISION], radii=0.2, labels=["collision"]
+        )
+        self._log(f"/world/{name}_collision", mark)
+        self._log(f"/task/{name}/collision_speed", rr.Scalars(speed))
 
     def target(self, name: str, target_ned) -> None:
         point = rr.Points3D(

@@ -3,6 +3,7 @@
 
 use super::packet::{self, MAX_PWM, PacketError, ServoFrame};
 use super::reply::{self, State};
+use crate::autopilot_record::Sent;
 use crate::config::AutopilotVehicle;
 use crate::kinematics::attitude_ned;
 use crate::speed::SpeedLog;
@@ -332,7 +333,8 @@ impl Session {
             );
         }
         reply::write(&mut self.reply, &state);
-        self.track.record(self.time_us, self.vehicle.as_ref());
+        let sent = Sent::Imu(&imu);
+        self.track.record(self.time_us, self.vehicle.as_ref(), sent);
     }
 
     /// The body rates without noise, FRD (for tests).

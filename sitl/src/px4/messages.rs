@@ -2,7 +2,7 @@
 //! (units as PX4's simulator_mavlink reads them; see docs/protocol.md).
 
 use crate::kinematics::{round_i16, round_i32, round_u16};
-use flyloop_core::sensors::{GpsFix, SensorReading};
+use flyloop_core::sensors::{GpsFix, ImuReading, SensorReading};
 use mavlink::dialects::common::{HIL_GPS_DATA, HIL_SENSOR_DATA, HilSensorUpdatedFlags, MavMessage};
 
 /// Every field group HIL_SENSOR carries each step: accel, gyro, mag and the three baro fields
@@ -26,15 +26,8 @@ pub fn sensor_fields() -> HilSensorUpdatedFlags {
 /// HIL_SENSOR at simulation time `time_usec` (µs): accel m/s², gyro rad/s, mag gauss, all body
 /// FRD; pressure hPa, altitude m, temperature °C.
 pub fn hil_sensor(r: &SensorReading, time_usec: u64) -> MavMessage {
-    let (a, g, m, b) = (r.imu.accel, r.imu.gyro, r.mag, r.baro);
+    let (m, b) = (r.mag, r.baro);
     MavMessage::HIL_SENSOR(HIL_SENSOR_DATA {
-        time_usec,
-        xacc: a.x as f32,
-        yacc: a.y as f32,
-        zacc: a.z as f32,
-        xgyro: g.x as f32,
-        ygyro: g.y as f32,
-        zgyro: g.z as f32,
         xmag: m.x as f32,
         ymag: m.y as f32,
         zmag: m.z as f32,
@@ -43,8 +36,31 @@ pub fn hil_sensor(r: &SensorReading, time_usec: u64) -> MavMessage {
         pressure_alt: b.pressure_altitude as f32,
         temperature: b.temperature_c as f32,
         fields_updated: sensor_fields(),
-        id: 0,
+        ..hil_imu(&r.imu, time_usec)
     })
+}
+
+/// The IMU part of HIL_SENSOR (accel m/s², gyro rad/s, body FRD), flagged alone; the other
+/// fields 0.
+pub fn hil_imu(imu: &ImuReading, time_usec: u64) -> HIL_SENSOR_DATA {
+    use HilSensorUpdatedFlags as F;
+    let (a, g) = (imu.accel, imu.gyro);
+    HIL_SENSOR_DATA {
+        time_usec,
+        xacc: a.x as f32,
+        yacc: a.y as f32,
+        zacc: a.z as f32,
+        xgyro: g.x as f32,
+        ygyro: g.y as f32,
+        zgyro: g.z as f32,
+        fields_updated: F::HIL_SENSOR_UPDATED_XACC
+            | F::HIL_SENSOR_UPDATED_YACC
+            | F::HIL_SENSOR_UPDATED_ZACC
+            | F::HIL_SENSOR_UPDATED_XGYRO
+            | F::HIL_SENSOR_UPDATED_YGYRO
+            | F::HIL_SENSOR_UPDATED_ZGYRO,
+        ..Default::default()
+    }
 }
 
 /// HIL_GPS for `fix`, stamped `time_usec` (µs since the UNIX epoch): lat/lon degE7, alt mm

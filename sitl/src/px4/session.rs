@@ -2,6 +2,7 @@
 //! out. The server feeds it; tests drive it directly.
 
 use super::messages;
+use crate::autopilot_record::Sent;
 use crate::config::AutopilotVehicle;
 use crate::kinematics::Home;
 use crate::speed::SpeedLog;
@@ -156,8 +157,12 @@ impl Session {
                 }
             };
             self.stats.frames += 1;
-            match incoming.message {
+            match &incoming.message {
                 MavMessage::HIL_ACTUATOR_CONTROLS(c) => {
+                    if self.track.is_recording() {
+                        let (id, m) = (incoming.header.system_id, &incoming.message);
+                        self.track.received(self.time_us, id, m);
+                    }
                     self.apply_controls(&c.controls);
                     if !self.lockstep {
                         tracing::info!(time_us = self.time_us, "first controls from PX4: lockstep");
@@ -166,7 +171,7 @@ impl Session {
                     self.advance(out);
                     steps += 1;
                 }
-                MavMessage::COMMAND_LONG(c) => self.command(&c),
+                MavMessage::COMMAND_LONG(c) => self.command(c),
                 _ => self.stats.ignored_messages += 1,
             }
         }
@@ -218,9 +223,9 @@ impl Session {
         let dt = self.step_us as f64 * 1e-6;
         let k = self.vehicle.kinematics();
         let reading = self.sensors.sample(&k, dt);
+        let sent_from = out.len();
         let sensor = messages::hil_sensor(&reading, self.time_us);
         self.encoder.push(out, SIMULATOR_SYSTEM, &sensor);
-        self.track.record(self.time_us, self.vehicle.as_ref());
         if let Some(fix) = self.sensors.gps(&k, self.time_us as f64 * 1e-6) {
             let stamp = self.gps_epoch_us + (fix.measured_at * 1e6).round() as u64;
             self.encoder
@@ -236,8 +241,10 @@ impl Session {
                 }
             }
         }
+        let sent = Sent::Frames(&out[sent_from..]);
+        self.track.record(self.time_us, self.vehicle.as_ref(), sent);
     }
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -18,7 +18,8 @@ fn session(seed: u64) -> Session {
     .unwrap()
 }
 
-fn controls(value: f32) -> Vec<u8> {
+/// PX4's HIL_ACTUATOR_CONTROLS with `value` on motors 1-4, armed, lockstep.
+pub(crate) fn controls(value: f32) -> Vec<u8> {
     let mut c = [0.0f32; 16];
     c[..4].fill(value);
     let m = MavMessage::HIL_ACTUATOR_CONTROLS(HIL_ACTUATOR_CONTROLS_DATA {

@@ -1,0 +1,122 @@
+//! The recording of the autopilot modes (`--px4 --record FILE`, `--ardupilot --record FILE`):
+//! the MAVLink telemetry log of lockstep and real time ([`crate::record`]: each frame preceded
+//! by its simulation time in µs, big-endian), so one reader replays and plots every mode.
+//!
+//! Per connection of an autopilot: HOME_POSITION (the truth's local origin, `--home`). Per
+//! physics step: what the autopilot sent, as received (PX4: HIL_ACTUATOR_CONTROLS, with PX4's
+//! system id, stamped with the time it answers); the ground truth after the step
+//! (HIL_STATE_QUATERNION); the motor command the autopilot's outputs set (SERVO_OUTPUT_RAW,
+//! 1000–2000 µs); the wind (WIND_COV); and the sensor samples the SITL sent (PX4: its
+//! HIL_SENSOR and HIL_GPS frames as sent; ArduPilot: the JSON line's IMU as HIL_SENSOR with
+//! only the accel and gyro fields flagged). No task frame: an autopilot flight has no task.
+//! Nothing is encoded when no recording is made.
+
+use crate::kinematics::Home;
+use crate::px4::messages::hil_imu;
+use crate::record::{TlogFile, frames_of, message_id};
+use crate::telemetry;
+use crate::wire::Encoder;
+use flyloop_core::sensors::ImuReading;
+use flyloop_core::vehicle::Vehicle;
+use mavlink::dialects::common::MavMessage;
+use std::io;
+use std::path::Path;
+
+/// The system id of flyloop's truth in the recording (the view's and the lockstep's vehicle 1).
+const TRUTH_SYSTEM: u8 = 1;
+
+/// The sensor samples the SITL sent the autopilot in one step.
+#[derive(Debug, Clone, Copy)]
+pub enum Sent<'a> {
+    /// MAVLink frames as sent (PX4: HIL_SENSOR, HIL_GPS, HIL_STATE_QUATERNION if it asked).
+    Frames(&'a [u8]),
+    /// The IMU values of ArduPilot's JSON line (its other fields are the truth).
+    Imu(&'a ImuReading),
+}
+
+/// A recording of an autopilot flight being written.
+#[derive(Debug)]
+pub struct AutopilotRecorder {
+    out: TlogFile,
+    encoder: Encoder,
+    home: Home,
+    frame: Vec<u8>,
+    /// Whether HOME_POSITION is still to be written (at the start of each connection).
+    home_due: bool,
+}
+
+impl AutopilotRecorder {
+    /// Creates (truncates) `path`; `home` is the truth's local origin.
+    pub fn create(path: &Path, home: Home) -> io::Result<Self> {
+        Ok(AutopilotRecorder {
+            out: TlogFile::create(path)?,
+            encoder: Encoder::default(),
+            home,
+            frame: Vec::with_capacity(512),
+            home_due: true,
+        })
+    }
+
+    /// A new autopilot connection: its clock starts again, HOME_POSITION is written again.
+    pub fn connect(&mut self) {
+        self.home_due = true;
+    }
+
+    /// Appends a message the autopilot sent (from `system_id`) at simulation time `time_us`.
+    pub fn received(&mut self, time_us: u64, system_id: u8, message: &MavMessage) {
+        self.frame.clear();
+        self.frame.extend_from_slice(&time_us.to_be_bytes());
+        self.encoder.push(&mut self.frame, system_id, message);
+        self.write();
+    }
+
+    /// Appends the step that ended at `time_us`: truth, motor command, wind, sensor samples.
+    pub fn step(&mut self, time_us: u64, vehicle: &dyn Vehicle, sent: Sent<'_>) {
+        self.frame.clear();
+        let time = time_us.to_be_bytes();
+        let k = vehicle.kinematics();
+        if std::mem::take(&mut self.home_due) {
+            let home = telemetry::home_position_of(&self.home, time_us);
+            self.frame.extend_from_slice(&time);
+            self.encoder.push(&mut self.frame, TRUTH_SYSTEM, &home);
+        }
+        let mut messages = Vec::with_capacity(4);
+        let mut has_state = false;
+        match sent {
+            Sent::Frames(bytes) => {
+                for frame in frames_of(bytes) {
+                    has_state |= message_id(frame) == telemetry::id::HIL_STATE_QUATERNION;
+                    self.frame.extend_from_slice(&time);
+                    self.frame.extend_from_slice(frame);
+                }
+            }
+            Sent::Imu(imu) => messages.push(MavMessage::HIL_SENSOR(hil_imu(imu, time_us))),
+        }
+        if !has_state {
+            messages.push(telemetry::hil_state_quaternion_of(&k, &self.home, time_us));
+        }
+        let commands = vehicle.actuators();
+        messages.push(telemetry::servo_output_raw_of(
+            commands.into_iter(),
+            time_us,
+        ));
+        messages.push(telemetry::wind_cov_of(&k, time_us));
+        for m in &messages {
+            self.frame.extend_from_slice(&time);
+            self.encoder.push(&mut self.frame, TRUTH_SYSTEM, m);
+        }
+        self.write();
+    }
+
+    fn write(&mut self) {
+        self.out.write(&self.frame);
+    }
+
+    /// Writes what is buffered (on disconnect, silence and the stop).
+    pub fn flush(&mut self) {
+        self.out.flush();
+    }
+}
+
+#[cfg(test)]
+mod tests;
