@@ -7,7 +7,7 @@ use flyloop_core::quadrotor::{BodyState, Frame, Quadrotor, QuadrotorParams};
 use flyloop_core::tasks::flight_faults::FlightFaults;
 use flyloop_core::tasks::hover::Hover;
 use flyloop_core::tasks::randomization::{Randomization, VehicleParams};
-use flyloop_core::tasks::registry::{TaskKind, from_values_ranges_and_faults};
+use flyloop_core::tasks::registry::{TaskInstance, TaskKind, from_values_ranges_and_faults};
 use flyloop_core::tasks::{InfoValue, Task};
 use nalgebra::Vector3;
 
@@ -379,4 +379,30 @@ fn a_hexa_loses_its_sixth_motor_and_refuses_a_seventh() {
         e.contains("`motor` = 7 is out of range: it must be in [0, 6]"),
         "{e}"
     );
+}
+
+/// MAV_CMD_INJECT_FAILURE's codes on a healthy task: all motors off (FAILURE_UNIT 101,
+/// FAILURE_TYPE 1, instance 0) stops every rotor; the info gets the injected slot; a reset
+/// flies healthy again.
+#[test]
+fn an_injected_px4_motor_failure_stops_the_rotors_until_the_reset() {
+    let mut task = TaskInstance::build(TaskKind::Hover, &Default::default()).unwrap();
+    task.reset(0);
+    let done = task.inject_px4(101, 1, 0).unwrap();
+    assert_eq!(done, "fault injected: motor_off:0");
+    for _ in 0..100 {
+        task.step(&[0.6; 4]).unwrap();
+    }
+    let TaskInstance::Hover(hover) = &task else {
+        unreachable!()
+    };
+    let motors = hover.quadrotor().body.motors;
+    assert!(motors.iter().all(|m| *m < 1e-4), "{motors:?}");
+    assert_eq!(vector(hover.as_ref(), "fault_active"), vec![1.0]);
+    task.reset(0);
+    task.step(&[0.6; 4]).unwrap();
+    let TaskInstance::Hover(hover) = &task else {
+        unreachable!()
+    };
+    assert!(vector(hover.as_ref(), "fault_active").is_empty());
 }

@@ -1,4 +1,5 @@
-//! Reading COMMAND_LONG parameters: the reset command's seed and a message id.
+//! Reading COMMAND_LONG parameters: the reset command's seed, a message id and an injected
+//! failure's PX4 code.
 //!
 //! COMMAND_LONG carries float32 parameters, which hold integers exactly only up to 2^24, so
 //! the 64-bit seed travels in four 16-bit pieces: param1 = bits 0–15, param2 = bits 16–31,
@@ -71,6 +72,24 @@ pub fn reset_request(c: &COMMAND_LONG_DATA) -> Result<ResetRequest, ResetError> 
 /// A message id carried in a float parameter (an integer in [0, 2^24)).
 pub fn message_id(value: f32) -> Option<u32> {
     ((0.0..16_777_216.0).contains(&value) && value.fract() == 0.0).then_some(value as u32)
+}
+
+/// The PX4 failure code of MAV_CMD_INJECT_FAILURE: (FAILURE_UNIT from param1, FAILURE_TYPE
+/// from param2, instance from param3), each an integer in [0, 255]; the error names the
+/// parameter.
+pub fn failure_code(c: &COMMAND_LONG_DATA) -> Result<(u8, u8, u8), String> {
+    let byte = |name: &str, value: f32| {
+        if value.fract() == 0.0 && (0.0..=255.0).contains(&value) {
+            Ok(value as u8)
+        } else {
+            Err(format!("{name} = {value} must be an integer in [0, 255]"))
+        }
+    };
+    Ok((
+        byte("param1 (failure_unit)", c.param1)?,
+        byte("param2 (failure_type)", c.param2)?,
+        byte("param3 (instance)", c.param3)?,
+    ))
 }
 
 #[cfg(test)]

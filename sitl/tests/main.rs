@@ -3,6 +3,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod handler_fuzz;
+mod inject_failure;
 mod lockstep_over_udp;
 mod lockstep_resend;
 mod refused_controls;

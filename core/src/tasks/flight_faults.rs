@@ -4,6 +4,7 @@
 
 use crate::error::ParamError;
 use crate::faults::catalogue::Target;
+use crate::faults::px4::Injection;
 use crate::faults::{Conditions, FaultPlan, FaultState, Reach, SensorId};
 use crate::quadrotor::{Motors, Quadrotor};
 use crate::tasks::{InfoRef, InfoVisitor};
@@ -111,7 +112,24 @@ impl FlightFaults {
         }
     }
 
+    /// A run-time injection (MAV_CMD_INJECT_FAILURE) now, `dt` being the control period:
+    /// the fault fires in a new slot, or the unit's active faults clear. It lasts until the
+    /// episode ends (a reset draws the plan's faults again).
+    pub fn inject(&mut self, injection: Injection, dt: f64) {
+        let time = self.steps as f64 * dt;
+        match injection {
+            Injection::Fire(spec) => self.state.inject(spec, time),
+            Injection::Clear { motor, sensor } => self.state.clear(motor, sensor, time),
+        }
+        self.refresh_info(dt);
+    }
+
     fn refresh_info(&mut self, _dt: f64) {
+        // Injected faults add slots to the schedule.
+        let slots = self.state.schedule().len();
+        for values in &mut self.info {
+            values.resize(slots, 0.0);
+        }
         let [kind, target, time, active] = &mut self.info;
         for (i, spec) in self.state.schedule().iter().enumerate() {
             kind[i] = spec.as_ref().map_or(-1.0, |s| s.kind as usize as f64);

@@ -27,6 +27,8 @@ use super::flight::{FlightParams, base_bounds, base_observation, write_base_obse
 use super::flight_faults::FlightFaults;
 use super::randomization::{Randomization, VehicleParams};
 use crate::error::ParamError;
+use crate::faults::FaultPlan;
+use crate::faults::px4::Injection;
 use crate::frames::{attitude_ned, enu_to_ned, flu_to_frd};
 use crate::params::Parameters;
 use crate::quadrotor::model::hover_motor_state;
@@ -205,6 +207,39 @@ impl FlightLink {
     /// Mutable access to the faults (the task's waypoint, run-time injection).
     pub fn faults_mut(&mut self) -> Option<&mut FlightFaults> {
         self.faults.as_mut()
+    }
+
+    /// Injects PX4's failure code (`unit`, `failure`, `instance`: 1 = first motor, 0 = all)
+    /// now; a healthy vehicle gets an empty fault state first. Returns what was done (the
+    /// fault's label, or what was cleared). An error names the field of a code the catalogue
+    /// has no fault for, or a motor the frame lacks.
+    pub fn inject_px4(
+        &mut self,
+        unit: u8,
+        failure: u8,
+        instance: u8,
+    ) -> Result<String, ParamError> {
+        let rotors = self.rotor_count();
+        let injection = crate::faults::px4::from_px4(unit, failure, instance, rotors)?;
+        let faults = match &mut self.faults {
+            Some(f) => f,
+            None => {
+                let f = &self.nominal.flight;
+                let duration = f64::from(f.max_steps) * f.dt;
+                self.faults
+                    .insert(FlightFaults::new(FaultPlan::default(), rotors, duration)?)
+            }
+        };
+        let done = match &injection {
+            Injection::Fire(spec) => format!("fault injected: {}", spec.label()),
+            Injection::Clear {
+                sensor: Some(s), ..
+            } => format!("fault cleared: {}", s.name()),
+            Injection::Clear { motor: 0, .. } => "fault cleared: all motors".to_string(),
+            Injection::Clear { motor, .. } => format!("fault cleared: motor {motor}"),
+        };
+        faults.inject(injection, self.flight.dt);
+        Ok(done)
     }
 
     /// Number of rotors (motor commands of the motor interface).

@@ -73,6 +73,16 @@ impl FlightVehicle {
         self.link.faults_mut()
     }
 
+    /// Injects PX4's failure code now (see [`FlightLink::inject_px4`]).
+    pub fn inject_px4(
+        &mut self,
+        unit: u8,
+        failure: u8,
+        instance: u8,
+    ) -> Result<String, ParamError> {
+        self.link.inject_px4(unit, failure, instance)
+    }
+
     /// Whether actions are thrust + body rates.
     pub fn rates_interface(&self) -> bool {
         self.link.rates_interface()

@@ -91,6 +91,11 @@ impl Hover {
         &self.vehicle
     }
 
+    /// The vehicle, for run-time fault injection.
+    pub fn vehicle_mut(&mut self) -> &mut FlightVehicle {
+        &mut self.vehicle
+    }
+
     pub fn target(&self) -> Vector3<f64> {
         self.target
     }

@@ -151,6 +151,11 @@ impl Waypoints {
         &self.vehicle
     }
 
+    /// The vehicle, for run-time fault injection.
+    pub fn vehicle_mut(&mut self) -> &mut FlightVehicle {
+        &mut self.vehicle
+    }
+
     /// The episode's waypoints, in order.
     pub fn waypoints(&self) -> &[Vector3<f64>] {
         &self.waypoints

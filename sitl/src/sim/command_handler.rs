@@ -66,6 +66,7 @@ impl Sim {
                 }
                 self.ack_all(link, out, targets, header, c.command, result);
             }
+            MavCmd::MAV_CMD_INJECT_FAILURE => self.on_inject_failure(link, header, c, targets, out),
             MavCmd::MAV_CMD_REQUEST_MESSAGE | MavCmd::MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES => {
                 self.on_message_request(link, header, c, targets, out);
             }
@@ -105,6 +106,49 @@ impl Sim {
                     self.refuse_reset(link, out, i, header, MavResult::MAV_RESULT_DENIED, &why);
                 }
             }
+        }
+    }
+
+    /// MAV_CMD_INJECT_FAILURE (param1 FAILURE_UNIT, param2 FAILURE_TYPE, param3 instance in
+    /// PX4's numbering: 1 = first motor, 0 = all): each vehicle in `targets` fires the fault
+    /// now, acknowledged ACCEPTED with a STATUSTEXT naming it; a code the catalogue lacks is
+    /// UNSUPPORTED, a parameter that is no code DENIED, each with a STATUSTEXT naming the field.
+    fn on_inject_failure(
+        &mut self,
+        link: Link,
+        header: MavHeader,
+        c: &COMMAND_LONG_DATA,
+        targets: Range<usize>,
+        out: &mut Vec<u8>,
+    ) {
+        let code = crate::commands::failure_code(c);
+        for i in targets {
+            let (result, severity, text) = match code {
+                Err(ref e) => (
+                    MavResult::MAV_RESULT_DENIED,
+                    MavSeverity::MAV_SEVERITY_ERROR,
+                    format!("inject failure refused: {e}"),
+                ),
+                Ok((unit, failure, instance)) => {
+                    match self.vehicles[i].task.inject_px4(unit, failure, instance) {
+                        Ok(done) => (
+                            MavResult::MAV_RESULT_ACCEPTED,
+                            MavSeverity::MAV_SEVERITY_WARNING,
+                            done,
+                        ),
+                        Err(e) => (
+                            MavResult::MAV_RESULT_UNSUPPORTED,
+                            MavSeverity::MAV_SEVERITY_ERROR,
+                            format!("inject failure refused: {e}"),
+                        ),
+                    }
+                }
+            };
+            if result != MavResult::MAV_RESULT_ACCEPTED {
+                self.stats.refused_requests += 1;
+            }
+            self.ack(link, out, i, header, c.command, result);
+            self.push_text(link, out, i, severity, &text);
         }
     }
 

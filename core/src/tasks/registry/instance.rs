@@ -119,6 +119,27 @@ impl TaskInstance {
         self.action_bounds().0
     }
 
+    /// Injects PX4's failure code (MAV_CMD_INJECT_FAILURE: `unit` FAILURE_UNIT, `failure`
+    /// FAILURE_TYPE, `instance` 1 = first motor, 0 = all) into the flight tasks' vehicle now;
+    /// returns what was done, for the STATUSTEXT.
+    /// An error names the field: a code the catalogue lacks, a motor the frame lacks, or a
+    /// task without faults (the lander).
+    pub fn inject_px4(
+        &mut self,
+        unit: u8,
+        failure: u8,
+        instance: u8,
+    ) -> Result<String, ParamError> {
+        match self {
+            TaskInstance::Hover(t) => t.vehicle_mut().inject_px4(unit, failure, instance),
+            TaskInstance::Waypoints(t) => t.vehicle_mut().inject_px4(unit, failure, instance),
+            TaskInstance::Landing(_) => Err(ParamError::Parse(
+                "failure_unit: the lander has no faults; the flight tasks (hover, waypoints) do"
+                    .to_string(),
+            )),
+        }
+    }
+
     /// Remaining battery as a fraction of the full charge, if the model has a battery.
     pub fn battery_fraction(&self) -> Option<f64> {
         match self {
