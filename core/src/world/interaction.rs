@@ -56,7 +56,9 @@ pub fn contact_force(
 
 /// The downwash force on a vehicle `below` the rotors of a vehicle of propeller radius
 /// `radius` whose thrust is `thrust_ratio` times its weight: (downward magnitude, N). Zero
-/// outside the wake (not below, deeper than the range, or beyond 3β off its axis).
+/// outside the wake (not below, deeper than the range, or beyond 3β off its axis). The
+/// fitted (r / 4Δz)² grows without bound as Δz → 0, where the fit has no data and two
+/// vehicles side by side would be thrown apart: the depth is floored at the propeller radius.
 pub fn downwash_force(
     params: &WorldParams,
     below: f64,
@@ -72,7 +74,7 @@ pub fn downwash_force(
     if off_axis > 3.0 * width {
         return 0.0;
     }
-    let strength = params.downwash_strength * (radius / (4.0 * below)).powi(2);
+    let strength = params.downwash_strength * (radius / (4.0 * below.max(radius))).powi(2);
     strength * (-0.5 * (off_axis / width).powi(2)).exp() * thrust_ratio
 }
 
@@ -128,6 +130,21 @@ mod tests {
         // Where the fitted β crosses zero (Δz = 0.6875 m) the reference gives NaN on the axis.
         let f = downwash_force(&p, 0.6875, 0.0, r, 1.0);
         assert!(f.is_finite() && f > 0.0, "{f}");
+    }
+
+    /// Regression: a vehicle passing level under another (collisions off) got a force of
+    /// c₁(r/4Δz)² with Δz → 0 and its state went NaN. Within one propeller radius of the
+    /// rotor plane the depth is the radius.
+    #[test]
+    fn downwash_just_below_the_rotors_is_bounded() {
+        let p = WorldParams::default();
+        let r = 0.0231;
+        let at_radius = downwash_force(&p, r, 0.0, r, 1.0);
+        assert_eq!(at_radius, p.downwash_strength / 16.0);
+        for below in [1e-300, 1e-9, 1e-4, 0.5 * r] {
+            assert_eq!(downwash_force(&p, below, 0.0, r, 1.0), at_radius, "{below}");
+        }
+        assert!(downwash_force(&p, 2.0 * r, 0.0, r, 1.0) < at_radius);
     }
 
     #[test]
