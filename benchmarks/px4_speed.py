@@ -73,14 +73,13 @@ def main() -> None:
     if args.view:
         truth = _free_port(socket.SOCK_DGRAM)
         view_args = ["--view", f"127.0.0.1:{truth}"]
+    binary = find_sitl_binary()
     preset_args, mixer = [], {}
     if args.config is not None:
         # The autopilot's mixer for the preset's frame (as tests/px4/test_px4_frames.py).
         preset_args = ["--config", str(args.config)]
-        mixer = px4_support.autopilot_params(find_sitl_binary(), args.config, "px4")
-    flyloop = px4_support.Flyloop(
-        find_sitl_binary(), instance, work, *preset_args, *(view_args or []), speed=0
-    )
+        mixer = px4_support.autopilot_params(binary, args.config, "px4")
+    flyloop = px4_support.Flyloop(binary, instance, work, *preset_args, *(view_args or []), speed=0)
     px4 = None
     try:
         px4 = px4_support.Px4(root, instance, px4_support.fresh_dir("px4-work-"), **mixer)

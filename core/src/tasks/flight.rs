@@ -105,6 +105,13 @@ static FLIGHT_SPECS: [ParamSpec<FlightParams>; 18] = [
     param!(real obs_noise_rates, "rad/s", 0.0, 100.0, "Rates interface: observed body rate noise (std)"),
 ];
 
+impl FlightParams {
+    /// An episode's length at the time limit, `max_steps · dt`, s.
+    pub fn episode_duration(&self) -> f64 {
+        f64::from(self.max_steps) * self.dt
+    }
+}
+
 impl Parameters for FlightParams {
     fn specs() -> &'static [ParamSpec<Self>] {
         &FLIGHT_SPECS

@@ -135,8 +135,7 @@ impl FlightLink {
         let faults = if nominal.faults.is_empty() {
             None
         } else {
-            let f = &nominal.flight;
-            let duration = f64::from(f.max_steps) * f.dt;
+            let duration = nominal.flight.episode_duration();
             let rotors = nominal.frame.rotor_count();
             Some(FlightFaults::new(nominal.faults.clone(), rotors, duration)?)
         };
@@ -224,8 +223,7 @@ impl FlightLink {
         let faults = match &mut self.faults {
             Some(f) => f,
             None => {
-                let f = &self.nominal.flight;
-                let duration = f64::from(f.max_steps) * f.dt;
+                let duration = self.nominal.flight.episode_duration();
                 self.faults
                     .insert(FlightFaults::new(FaultPlan::default(), rotors, duration)?)
             }

@@ -118,7 +118,7 @@ impl Waypoints {
         let vehicle = FlightVehicle::new(nominal, randomization)?;
         let bound = waypoint_out_of_bounds_distance(&flight);
         let (mut obs_low, mut obs_high) = vehicle.observation_bounds(bound);
-        let max_time = f64::from(flight.max_steps) * flight.dt;
+        let max_time = flight.episode_duration();
         obs_low.extend([-bound as f32; 3]);
         obs_high.extend([bound as f32; 3]);
         obs_low.push(0.0);

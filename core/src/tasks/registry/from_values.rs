@@ -94,7 +94,7 @@ pub fn from_values_ranges_and_faults<'a>(
         }
         let f = &config.flight;
         faults.check(&Reach {
-            duration: Some(f64::from(f.max_steps) * f.dt),
+            duration: Some(f.episode_duration()),
             waypoints: (task == TaskKind::Waypoints).then_some(config.waypoints.max_num_waypoints),
             // The frame's motors: a motor fault on a hexa addresses 1..=6.
             rotors: config.frame.rotor_count(),
