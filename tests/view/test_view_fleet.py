@@ -74,7 +74,10 @@ def test_the_fleet_drawn_in_the_browser(tmp_path):
         env.reset(seed=0)
         browser.open(env.viewer.url)
         fly(env, 50)
-        shot, n = browser.wait_for_vehicle(4 * 30, timeout=90)  # the wasm loads (~20 s)
+        # The wasm loads (~20 s), then the viewer catches up with the stream: every hub drawn.
+        shot, n = browser.wait_for_vehicle(
+            AGENTS * 30, timeout=120, until=lambda px: clusters(px) == AGENTS
+        )
         (tmp_path / "fleet.png").write_bytes(shot)
     finally:
         browser.close()

@@ -11,6 +11,7 @@ import os
 import shutil
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -101,14 +102,23 @@ class Browser:
     def screenshot(self, path: str | Path | None = None) -> bytes:
         return self.page.screenshot(path=str(path) if path else None)
 
-    def wait_for_vehicle(self, min_pixels: int = 30, timeout: float = 90.0) -> tuple[bytes, int]:
-        """Screenshots until the hub shows (at least `min_pixels`) or `timeout` passes;
-        returns the last screenshot and its hub pixel count."""
+    def wait_for_vehicle(
+        self,
+        min_pixels: int = 30,
+        timeout: float = 90.0,
+        until: Callable[[np.ndarray], bool] | None = None,
+    ) -> tuple[bytes, int]:
+        """Screenshots until the hub shows (at least `min_pixels`, and `until(hub pixels)`
+        holds when given) or `timeout` passes; returns the last screenshot and its hub pixel
+        count. `until` is for a fleet: the viewer ingests a stream in order, so the first
+        vehicles can show seconds before the last."""
         end = time.monotonic() + timeout
         while True:
             shot = self.screenshot()
-            n = len(hub_pixels(shot))
-            if n >= min_pixels or time.monotonic() > end:
+            pixels = hub_pixels(shot)
+            n = len(pixels)
+            done = n >= min_pixels and (until is None or until(pixels))
+            if done or time.monotonic() > end:
                 return shot, n
             time.sleep(2.0)
 
