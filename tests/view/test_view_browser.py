@@ -31,6 +31,13 @@ def test_live_view_draws_the_vehicle_where_it_is_and_replays(binary, tmp_path):
     flight = Flight(binary, gcs, record=tmp_path / "run.tlog")
     browser = Browser()
     try:
+        _fly_watch_and_replay(browser, view, flight, tmp_path)
+    finally:  # a failed check must not leave the page open: the next test needs the loop
+        browser.close()
+
+
+def _fly_watch_and_replay(browser, view, flight, tmp_path) -> None:
+    try:
         browser.open(view.url)
         low, n_low = browser.wait_for_vehicle(MIN_PIXELS, timeout=90)  # the wasm loads (~20 s)
         (tmp_path / "low.png").write_bytes(low)
@@ -74,5 +81,4 @@ def test_live_view_draws_the_vehicle_where_it_is_and_replays(binary, tmp_path):
         (tmp_path / "replay.png").write_bytes(shot)
         assert n >= MIN_PIXELS, f"the replay draws no vehicle: {tmp_path / 'replay.png'}"
     finally:
-        browser.close()
         replay.stop()
