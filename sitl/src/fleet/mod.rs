@@ -6,7 +6,8 @@
 //! - [`lockstep`]: the barrier that lets autopilots of different step lengths share the
 //!   world's clock,
 //! - [`px4_member`], [`ardupilot_member`]: each autopilot's protocol, without sockets,
-//! - [`server`]: the sockets, the wall clock, the timeouts.
+//! - [`sockets`]: every autopilot's socket on one poll,
+//! - [`server`]: the wall clock, the timeouts.
 //!
 //! [`Fleet`] ties them together without sockets: bytes from autopilot i in, bytes for it
 //! out, so the tests drive it directly.
@@ -16,6 +17,7 @@ pub mod file;
 pub mod lockstep;
 pub mod px4_member;
 pub mod server;
+pub mod sockets;
 
 use ardupilot_member::{ArduPilotMember, Frame};
 use file::{Autopilot, FleetSpec};
