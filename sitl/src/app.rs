@@ -178,9 +178,9 @@ fn start_px4(args: Args) -> Result<(), StartError> {
 /// lockstep until a signal.
 fn start_fleet(args: Args) -> Result<(), StartError> {
     use crate::fleet::{self, file};
-    if args.track.is_some() || args.view.is_some() {
+    if args.view.is_some() {
         return Err(StartError::Options(
-            "--track and --view fly one autopilot; fleet mode has neither yet".to_string(),
+            "--view flies one autopilot; fleet mode has no view yet".to_string(),
         ));
     }
     let mut spec = match &args.fleet {
@@ -220,6 +220,7 @@ fn start_fleet(args: Args) -> Result<(), StartError> {
     let fleet = fleet::Fleet::new(&spec, args.seed, step_us)?;
     let sockets = fleet::server::bind(&fleet)
         .map_err(|(name, addr, source)| StartError::FleetBind { name, addr, source })?;
+    let outputs = fleet_outputs(&args, &fleet)?;
     let ports: Vec<String> = (fleet.members().iter())
         .map(|m| {
             format!(
@@ -253,7 +254,8 @@ fn start_fleet(args: Args) -> Result<(), StartError> {
     serve_until_signal(
         |shutdown| {
             Ok(async move {
-                let (_, summary) = fleet::server::run(fleet, sockets, options, shutdown).await?;
+                let (_, summary) =
+                    fleet::server::run(fleet, sockets, options, outputs, shutdown).await?;
                 Ok(summary)
             })
         },
@@ -320,6 +322,23 @@ fn track(args: &Args, rotors: usize) -> Result<Option<Track>, StartError> {
         }
     })?;
     Ok(Some(track))
+}
+
+/// What fleet mode writes beside the flight, as asked for: `--track`.
+fn fleet_outputs(
+    args: &Args,
+    fleet: &crate::fleet::Fleet,
+) -> Result<crate::fleet::outputs::Outputs, StartError> {
+    let mut outputs = crate::fleet::outputs::Outputs::default();
+    if let Some(path) = &args.track {
+        let track = crate::fleet::track::FleetTrack::create(path, args.track_interval_us, fleet)
+            .map_err(|source| StartError::Track {
+                path: path.clone(),
+                source,
+            })?;
+        outputs.track = Some(track);
+    }
+    Ok(outputs)
 }
 
 /// What an autopilot session writes beside the flight, as asked for: `--track`, `--view`,

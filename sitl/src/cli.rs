@@ -115,8 +115,8 @@ pub struct Args {
     #[arg(long, default_value_t = 1.0, value_parser = parse_speed)]
     pub speed_factor: f64,
 
-    /// PX4 and ArduPilot modes: write the ground-truth track (CSV, by default 50 Hz of
-    /// simulation time) to this file.
+    /// PX4, ArduPilot and fleet modes: write the ground-truth track (CSV, by default 50 Hz
+    /// of simulation time; in fleet mode a row per vehicle, docs/fleet.md) to this file.
     #[arg(long)]
     pub track: Option<PathBuf>,
 
@@ -132,8 +132,8 @@ pub struct Args {
     #[arg(long)]
     pub record: Option<PathBuf>,
 
-    /// PX4 and ArduPilot modes: simulation time between two rows of the track, µs (4000 =
-    /// every PX4 step).
+    /// PX4, ArduPilot and fleet modes: simulation time between two rows of the track, µs
+    /// (4000 = every PX4 step).
     #[arg(long, default_value_t = crate::track::TRACK_INTERVAL_US, value_parser = clap::value_parser!(u64).range(1..))]
     pub track_interval_us: u64,
 

@@ -21,10 +21,45 @@ pub const TRACK_INTERVAL_US: u64 = 20_000;
 
 /// The CSV header line of a vehicle with `rotors` rotors.
 pub fn header(rotors: usize) -> String {
+    format!("connection,time_us,{}", state_header(rotors))
+}
+
+/// The columns of a vehicle's state (after `connection,time_us`), `rotors` motor columns.
+pub fn state_header(rotors: usize) -> String {
     let motors: Vec<String> = (0..rotors).map(|i| format!("m{i}")).collect();
     format!(
-        "connection,time_us,north,east,down,vn,ve,vd,roll,pitch,yaw,{},grounded,p,q,r",
+        "north,east,down,vn,ve,vd,roll,pitch,yaw,{},grounded,p,q,r",
         motors.join(",")
+    )
+}
+
+/// `vehicle`'s state as the columns of [`state_header`]`(rotors)`, each after a comma (a
+/// vehicle with fewer rotors leaves the last motor columns empty), and the line's end.
+pub fn write_state(out: &mut impl Write, vehicle: &dyn Vehicle, rotors: usize) -> io::Result<()> {
+    let k = vehicle.kinematics();
+    let p = k.position_ned();
+    let v = k.velocity_ned();
+    let (roll, pitch, yaw) = attitude_ned(&k.attitude).euler_angles();
+    let w = k.body_rates_frd();
+    write!(
+        out,
+        ",{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.5},{:.5},{:.5}",
+        p.x, p.y, p.z, v.x, v.y, v.z, roll, pitch, yaw,
+    )?;
+    let motors = vehicle.actuator_states();
+    for m in &motors {
+        write!(out, ",{m:.4}")?;
+    }
+    for _ in motors.len()..rotors {
+        write!(out, ",")?;
+    }
+    writeln!(
+        out,
+        ",{},{:.5},{:.5},{:.5}",
+        u8::from(vehicle.is_grounded()),
+        w.x,
+        w.y,
+        w.z
     )
 }
 
@@ -64,27 +99,8 @@ impl Track {
             return Ok(());
         }
         self.next_us = time_us + self.interval_us;
-        let k = vehicle.kinematics();
-        let p = k.position_ned();
-        let v = k.velocity_ned();
-        let (roll, pitch, yaw) = attitude_ned(&k.attitude).euler_angles();
-        let w = k.body_rates_frd();
-        write!(
-            self.out,
-            "{},{time_us},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.5},{:.5},{:.5}",
-            self.connection, p.x, p.y, p.z, v.x, v.y, v.z, roll, pitch, yaw,
-        )?;
-        for m in vehicle.actuator_states() {
-            write!(self.out, ",{m:.4}")?;
-        }
-        writeln!(
-            self.out,
-            ",{},{:.5},{:.5},{:.5}",
-            u8::from(vehicle.is_grounded()),
-            w.x,
-            w.y,
-            w.z
-        )
+        write!(self.out, "{},{time_us}", self.connection)?;
+        write_state(&mut self.out, vehicle, 0)
     }
 
     /// Writes buffered rows out.

@@ -6,6 +6,7 @@ tests/sitl/processes.py."""
 
 from __future__ import annotations
 
+import csv
 import os
 import subprocess
 import sys
@@ -101,3 +102,15 @@ def land_all(px4s, timeout: float = 120) -> None:
             timeout,
             "HEARTBEAT",
         )
+
+
+def read_track(path: Path) -> dict[str, list[dict[str, float]]]:
+    """A fleet track (`--track` in fleet mode): each vehicle's rows by its name, every other
+    column a number (an empty motor column of a vehicle with fewer rotors is left out)."""
+    by_vehicle: dict[str, list[dict[str, float]]] = {}
+    with open(path) as f:
+        for row in csv.DictReader(f):
+            name = row.pop("vehicle")
+            values = {k: float(v) for k, v in row.items() if v != ""}
+            by_vehicle.setdefault(name, []).append(values)
+    return by_vehicle

@@ -1,14 +1,14 @@
 """PX4s flying one flyloop world: each PX4 instance i on TCP 4560 + i with MAV_SYS_ID i + 1,
-all in one lockstep; a PX4 that stops answering does not hang the others; two PX4s sent into
-each other collide, and flyloop says so."""
+all in one lockstep, every vehicle's truth in one track; a PX4 that stops answering does not
+hang the others; two PX4s sent into each other collide, and flyloop says so."""
 
 from __future__ import annotations
 
 import signal
 import time
 
-from fleet_support import FleetSitl, free_block, land_all, px4_ports_free
-from px4_support import Px4, collect, fresh_dir, launch, settle
+from fleet_support import FleetSitl, free_block, land_all, px4_ports_free, read_track
+from px4_support import Px4, collect, fresh_dir, launch, settle, truth_vs_estimate
 
 TAKEOFF_ALT = 5.0
 
@@ -40,15 +40,18 @@ def start_fleet(started, sitl_binary, px4_dir, n: int, *args: str, talk=True, **
 
 
 def test_two_px4s_share_one_world_each_with_its_own_sysid(started, sitl_binary, px4_dir):
-    sitl, px4s = start_fleet(started, sitl_binary, px4_dir, 2)
+    track = fresh_dir("flyloop-fleet-track-") / "track.csv"
+    sitl, px4s = start_fleet(started, sitl_binary, px4_dir, 2, "--track", str(track))
     assert [p.target for p in px4s] == [p.instance + 1 for p in px4s]
     targets = []
     for p in px4s:
         targets.append(launch(p))
     for p, (_, target) in zip(px4s, targets, strict=False):
         settle(p, target, 0.3, 90)
+    holds = []
     for p, (_, target) in zip(px4s, targets, strict=False):
         hold = collect(p, 2.0)
+        holds.append(hold)
         horizontal, vertical = hold.worst(target)
         assert vertical < 0.3 and horizontal < 0.3, (p.instance, horizontal, vertical)
     land_all(px4s)
@@ -56,6 +59,34 @@ def test_two_px4s_share_one_world_each_with_its_own_sysid(started, sitl_binary, 
     counters = sitl.counters()
     assert counters["collisions"] == "0", counters
     assert "silent" not in sitl.stderr()
+    check_fleet_track(track, px4s, [frame for frame, _ in targets], holds)
+
+
+def check_fleet_track(track, px4s, frames, holds) -> None:
+    """The fleet's track: the single-vehicle columns after `vehicle,sysid`, a row per vehicle
+    at the same world times 20 ms (+ at most one PX4 step) apart, each vehicle's truth where
+    its own PX4 estimated it (< 0.5 m over the hold), 3 m apart at the start, landed at the
+    end."""
+    header = track.read_text().splitlines()[0]
+    assert header == (
+        "vehicle,sysid,connection,time_us,north,east,down,vn,ve,vd,roll,pitch,yaw,"
+        "m0,m1,m2,m3,grounded,p,q,r"
+    ), header
+    rows = read_track(track)
+    assert sorted(rows) == ["px4-000", "px4-001"], sorted(rows)
+    times = [[r["time_us"] for r in rows[name]] for name in sorted(rows)]
+    assert times[0] == times[1] and len(times[0]) > 100, len(times[0])
+    gaps = {b - a for a, b in zip(times[0], times[0][1:], strict=False)}
+    assert min(gaps) >= 20_000 and max(gaps) <= 24_000, sorted(gaps)
+    for name, p, frame, hold in zip(sorted(rows), px4s, frames, holds, strict=True):
+        mine = rows[name]
+        assert {r["sysid"] for r in mine} == {p.target}, (name, {r["sysid"] for r in mine})
+        assert mine[0]["connection"] == 0 and mine[-1]["connection"] == 1, name
+        error = truth_vs_estimate(mine, hold, 1, frame)
+        assert error < 0.5, f"{name}: truth vs its PX4's estimate {error:.3f} m"
+        assert mine[-1]["grounded"] == 1.0 and mine[-1]["m0"] < 0.01, mine[-1]
+    first = [rows[name][0] for name in sorted(rows)]
+    assert abs(first[1]["east"] - first[0]["east"] - 3.0) < 1e-3, first
 
 
 def test_a_silent_px4_does_not_hang_the_others_and_rejoins(started, sitl_binary, px4_dir):

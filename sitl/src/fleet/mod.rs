@@ -7,7 +7,8 @@
 //!   world's clock,
 //! - [`px4_member`], [`ardupilot_member`]: each autopilot's protocol, without sockets,
 //! - [`sockets`]: every autopilot's socket on one poll,
-//! - [`server`]: the wall clock, the timeouts.
+//! - [`server`]: the wall clock, the timeouts,
+//! - [`outputs`], [`track`]: what is written beside the flight (`--track`).
 //!
 //! [`Fleet`] ties them together without sockets: bytes from autopilot i in, bytes for it
 //! out, so the tests drive it directly.
@@ -15,9 +16,11 @@
 pub mod ardupilot_member;
 pub mod file;
 pub mod lockstep;
+pub mod outputs;
 pub mod px4_member;
 pub mod server;
 pub mod sockets;
+pub mod track;
 
 use ardupilot_member::{ArduPilotMember, Frame};
 use file::{Autopilot, FleetSpec};
@@ -59,6 +62,8 @@ pub struct Member {
     pub out: Vec<u8>,
     /// Rotor count of its vehicle.
     rotors: usize,
+    /// Connections of its autopilot so far (a reconnect or restart counts again).
+    pub connections: u32,
 }
 
 /// Something worth a log line and a STATUSTEXT.
@@ -128,6 +133,7 @@ impl Fleet {
                 link,
                 out: Vec::new(),
                 rotors: c.frame.rotor_count(),
+                connections: 0,
             });
             vehicles.push((v.name.clone(), quad));
         }
@@ -159,6 +165,11 @@ impl Fleet {
 
     pub fn member_mut(&mut self, i: usize) -> &mut Member {
         &mut self.members[i]
+    }
+
+    /// Vehicle i's truth (member i flies it).
+    pub fn vehicle(&self, i: usize) -> &dyn flyloop_core::vehicle::Vehicle {
+        self.world.vehicle(i)
     }
 
     /// The notices since the last call.
@@ -198,6 +209,7 @@ impl Fleet {
     pub fn px4_connected(&mut self, i: usize) {
         self.reset_vehicle(i);
         self.lockstep.connect(i, false);
+        self.members[i].connections += 1;
         let now = self.lockstep.now_us();
         let epoch = self.gps_epoch_us;
         let k = self.world.kinematics(i);
@@ -314,6 +326,7 @@ impl Fleet {
                     let restarted = self.lockstep.slot(i).phase != Phase::Absent;
                     self.reset_vehicle(i);
                     self.lockstep.connect(i, true);
+                    self.members[i].connections += 1;
                     let text = format!(
                         "{}: ArduPilot {} at t={:.3} s from {from}, vehicle at its start",
                         self.members[i].name,

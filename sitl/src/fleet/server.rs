@@ -6,6 +6,7 @@
 
 use super::file::Autopilot;
 use super::lockstep::{Hold, Phase};
+use super::outputs::Outputs;
 use super::sockets::{Received, Sockets};
 use super::{Fleet, Link, Notice};
 use crate::pacer::{self, Anchor, Pacing};
@@ -39,11 +40,13 @@ fn unix_now_us() -> u64 {
         .map_or(0, |d| d.as_micros() as u64)
 }
 
-/// Serves the fleet until SIGINT / SIGTERM; returns it and its stop line.
+/// Serves the fleet until SIGINT / SIGTERM, writing `outputs` as it flies; returns it and
+/// its stop line.
 pub async fn run(
     fleet: Fleet,
     sockets: Vec<Socket>,
     options: FleetOptions,
+    outputs: Outputs,
     mut shutdown: Shutdown,
 ) -> io::Result<(Fleet, String)> {
     let sockets = Sockets::new(sockets)?;
@@ -52,8 +55,9 @@ pub async fn run(
         None => None,
     };
     let work = move |stop: &AtomicBool| {
-        let mut state = Serving::new(fleet, sockets, gcs, options);
+        let mut state = Serving::new(fleet, sockets, gcs, options, outputs);
         state.serve(stop);
+        state.outputs.flush();
         let summary = state.summary();
         (state.fleet, summary)
     };
@@ -70,6 +74,7 @@ pub async fn run(
 struct Serving {
     fleet: Fleet,
     sockets: Sockets,
+    outputs: Outputs,
     gcs: Option<(UdpSocket, SocketAddr)>,
     encoder: Encoder,
     options: FleetOptions,
@@ -91,14 +96,17 @@ impl Serving {
         sockets: Sockets,
         gcs: Option<(UdpSocket, SocketAddr)>,
         options: FleetOptions,
+        mut outputs: Outputs,
     ) -> Self {
         let n = fleet.members().len();
         let free_step = options.pacing.free_step(super::PX4_STEP_US);
         let mut fleet = fleet;
         fleet.gps_epoch_us = unix_now_us();
+        outputs.after_step(&fleet);
         Serving {
             fleet,
             sockets,
+            outputs,
             gcs,
             encoder: Encoder::default(),
             options,
@@ -182,6 +190,7 @@ impl Serving {
                 Err(Hold::Waiting(_) | Hold::Idle) => return,
             };
             self.steps += 1;
+            self.outputs.after_step(&self.fleet);
             let lockstep = (0..self.fleet.lockstep().len())
                 .any(|i| self.fleet.lockstep().slot(i).phase == Phase::Lockstep);
             if !lockstep {
