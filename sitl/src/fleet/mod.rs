@@ -7,7 +7,7 @@
 //!   world's clock,
 //! - [`px4_member`], [`ardupilot_member`]: each autopilot's protocol, without sockets,
 //! - [`sockets`]: every autopilot's socket on one poll,
-//! - [`server`]: the wall clock, the timeouts,
+//! - [`server`]: the wall clock, the timeouts, [`priority`]: the fleet thread's,
 //! - [`outputs`], [`track`]: what is written beside the flight (`--track`).
 //!
 //! [`Fleet`] ties them together without sockets: bytes from autopilot i in, bytes for it
@@ -17,6 +17,7 @@ pub mod ardupilot_member;
 pub mod file;
 pub mod lockstep;
 pub mod outputs;
+pub mod priority;
 pub mod px4_member;
 pub mod server;
 pub mod sockets;

@@ -55,6 +55,7 @@ pub async fn run(
         None => None,
     };
     let work = move |stop: &AtomicBool| {
+        super::priority::favour_this_thread();
         let mut state = Serving::new(fleet, sockets, gcs, options, outputs);
         state.serve(stop);
         state.outputs.flush();
@@ -297,11 +298,12 @@ impl Serving {
         let t = self.fleet.lockstep().now_us() as f64 * 1e-6;
         let wall = self.started.elapsed().as_secs_f64();
         format!(
-            "world_steps={} time_s={t:.3} wall_s={wall:.3} real_time_factor={:.3} collisions={} stale_controls={}",
+            "world_steps={} time_s={t:.3} wall_s={wall:.3} real_time_factor={:.3} collisions={} stale_controls={} unannounced_reads={}",
             self.steps,
             t / wall.max(1e-9),
             self.fleet.collisions,
-            self.fleet.stale_controls
+            self.fleet.stale_controls,
+            self.sockets.unannounced
         )
     }
 }

@@ -46,6 +46,8 @@ pub enum Received {
 /// Bytes a PX4 connection may hold unsent before more are dropped (a PX4 that stopped
 /// reading; the timeout silences it).
 const QUEUE_LIMIT: usize = 1 << 20;
+/// A wait at least this long that ends with no event is followed by a [`Sockets::sweep`].
+const SWEEP_AFTER: Duration = Duration::from_millis(10);
 /// Largest read of one socket at a time.
 const READ_CHUNK: usize = 16_384;
 
@@ -79,6 +81,8 @@ pub struct Sockets {
     bytes: Vec<u8>,
     /// The last poll's events (token, writable), kept to spare an allocation per poll.
     ready: Vec<(Token, bool)>,
+    /// Quiet waits after which a [`Sockets::sweep`] found bytes.
+    pub unannounced: u64,
 }
 
 fn port_token(i: usize) -> Token {
@@ -122,6 +126,7 @@ impl Sockets {
             received: Vec::new(),
             bytes: Vec::new(),
             ready: Vec::new(),
+            unannounced: 0,
         })
     }
 
@@ -135,7 +140,20 @@ impl Sockets {
     pub fn poll(&mut self, timeout: Duration) -> &[Received] {
         self.received.clear();
         self.bytes.clear();
-        if let Err(e) = self.poll.poll(&mut self.events, Some(timeout)) {
+        // epoll waits whole milliseconds (mio rounds up): a shorter wait (the free clock's
+        // 400 µs steps before lockstep) looks, then sleeps the rest and looks again.
+        let polled = if timeout >= Duration::from_millis(1) {
+            self.poll.poll(&mut self.events, Some(timeout))
+        } else {
+            match self.poll.poll(&mut self.events, Some(Duration::ZERO)) {
+                Ok(()) if self.events.is_empty() => {
+                    std::thread::sleep(timeout);
+                    self.poll.poll(&mut self.events, Some(Duration::ZERO))
+                }
+                polled => polled,
+            }
+        };
+        if let Err(e) = polled {
             if e.kind() != io::ErrorKind::Interrupted {
                 tracing::warn!(error = %e, "polling the fleet's sockets failed");
             }
@@ -155,7 +173,29 @@ impl Sockets {
                 self.read_connection(i);
             }
         }
+        if self.ready.is_empty() && timeout >= SWEEP_AFTER {
+            self.sweep();
+        }
         &self.received
+    }
+
+    /// After a quiet wait: reads every socket anyway. Edge-triggered readiness that went
+    /// missing would otherwise leave an answer unread until the autopilot sends again
+    /// (a PX4's next heartbeat: a second), stalling the whole fleet; counted and logged.
+    fn sweep(&mut self) {
+        for i in 0..self.ports.len() {
+            match self.ports[i] {
+                Port::Px4 { .. } => self.read_connection(i),
+                Port::ArduPilot(_) => self.read_port(i),
+            }
+        }
+        if !self.received.is_empty() {
+            self.unannounced += 1;
+            tracing::warn!(
+                reads = self.received.len(),
+                "read bytes that came without a readiness event"
+            );
+        }
     }
 
     fn read_port(&mut self, i: usize) {
