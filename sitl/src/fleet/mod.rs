@@ -6,8 +6,7 @@
 //! - [`lockstep`]: the barrier that lets autopilots of different step lengths share the
 //!   world's clock,
 //! - [`px4_member`], [`ardupilot_member`]: each autopilot's protocol, without sockets,
-//! - [`sockets`]: every autopilot's socket on one poll,
-//! - [`server`]: the wall clock, the timeouts, [`priority`]: the fleet thread's,
+//! - [`server`]: the sockets, the wall clock, the timeouts,
 //! - [`outputs`], [`track`]: what is written beside the flight (`--track`).
 //!
 //! [`Fleet`] ties them together without sockets: bytes from autopilot i in, bytes for it
@@ -17,10 +16,8 @@ pub mod ardupilot_member;
 pub mod file;
 pub mod lockstep;
 pub mod outputs;
-pub mod priority;
 pub mod px4_member;
 pub mod server;
-pub mod sockets;
 pub mod track;
 
 use ardupilot_member::{ArduPilotMember, Frame};
