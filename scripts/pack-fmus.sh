@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the FMU library and tools (release) and packs dist/fmu/Quadrotor.fmu, Lander2D.fmu,
-# Hexacopter.fmu and RateController.fmu (FMI 2.0) and their FMI 3.0 twins dist/fmu/<Model>-fmi3.fmu.
+# Hexacopter.fmu, RateController.fmu and AttitudeController.fmu (FMI 2.0) and their FMI 3.0 twins dist/fmu/<Model>-fmi3.fmu.
 # Usage: bash scripts/pack-fmus.sh [out-dir]    (honours CARGO_TARGET_DIR)
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -80,6 +80,9 @@ fn write_units(out: &mut String, variables: &[Variable3]) {
                 for (name, e) in BASE_UNITS.iter().zip(exponents).filter(|(_, e)| *e != 0) {
                     let _ = write!(out, " {name}=\"{e}\"");
                 }
+                if let Some(factor) = units::factor(unit) {
+                    let _ = write!(out, " factor=\"{factor:?}\"");
+                }
                 out.push_str("/>\n    </Unit>\n");
             }
             None => out.push_str("/>\n"),

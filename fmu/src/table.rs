@@ -264,7 +264,7 @@ mod tests {
 
     #[test]
     fn motor_commands_are_one_array_and_every_model_value_has_one_home() {
-        let [quad, lander, hexa, rates] = tables();
+        let [quad, lander, hexa, rates, _attitude] = tables();
         let command = by_name(quad, "motor_command");
         assert_eq!(command.value_reference, 0);
         assert_eq!(command.dimension, Some(4));

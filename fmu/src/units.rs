@@ -11,6 +11,8 @@ pub const BASE_UNITS: [&str; 8] = ["kg", "m", "s", "A", "K", "mol", "cd", "rad"]
 static UNITS: &[(&str, Option<Exponents>)] = &[
     ("1", Some([0, 0, 0, 0, 0, 0, 0, 0])),
     ("m", Some([0, 1, 0, 0, 0, 0, 0, 0])),
+    ("1/m", Some([0, -1, 0, 0, 0, 0, 0, 0])),
+    ("s/m", Some([0, -1, 1, 0, 0, 0, 0, 0])),
     ("m2", Some([0, 2, 0, 0, 0, 0, 0, 0])),
     ("s", Some([0, 0, 1, 0, 0, 0, 0, 0])),
     ("1/s", Some([0, 0, -1, 0, 0, 0, 0, 0])),
@@ -27,11 +29,17 @@ static UNITS: &[(&str, Option<Exponents>)] = &[
     ("1/(N.s)", Some([-1, -1, 1, 0, 0, 0, 0, 0])),
     ("rad", Some([0, 0, 0, 0, 0, 0, 0, 1])),
     ("rad/s", Some([0, 0, -1, 0, 0, 0, 0, 1])),
+    ("deg/s", Some([0, 0, -1, 0, 0, 0, 0, 1])),
     ("rad/s2", Some([0, 0, -2, 0, 0, 0, 0, 1])),
     ("N.m.s/rad", Some([1, 2, -1, 0, 0, 0, 0, -1])),
     ("N.m.s2/rad2", Some([1, 2, 0, 0, 0, 0, 0, -2])),
     ("m/s/s0.5", None),
 ];
+
+/// Factor from a unit to its base units where it is not 1 (PX4's deg/s rate bounds).
+pub fn factor(unit: &str) -> Option<f64> {
+    (unit == "deg/s").then_some(std::f64::consts::PI / 180.0)
+}
 
 /// The base-unit exponents of `unit`: `None` if the unit is unknown, `Some(None)` if it
 /// has no integer-exponent form.

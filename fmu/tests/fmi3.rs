@@ -186,8 +186,8 @@ fn fmi2_outputs(model: Model) -> Vec<u32> {
 #[test]
 fn fmi3_co_simulation_equals_fmi2_bit_for_bit_with_wind_and_arrays() {
     for model in Model::ALL {
-        // The rate controller has no weather: its inputs are the setpoint and the body rates.
-        let controller = model == Model::RateController;
+        // The controllers have no weather: their inputs are setpoints and the plant's outputs.
+        let controller = matches!(model, Model::RateController | Model::AttitudeController);
         let weather: &[(&str, f64)] = if controller {
             &[]
         } else {

@@ -15,6 +15,7 @@ fn run(fmu: &Fmu, t: &mut f64, end: f64, h: f64) -> Vec<Vec<u64>> {
         Model::Quadrotor | Model::Hexacopter => "motor_command_1",
         Model::Lander2D => "motor_command_right",
         Model::RateController => "roll_rate",
+        Model::AttitudeController => "roll",
     };
     let mut outputs = Vec::new();
     while *t < end - 1e-9 {
@@ -40,6 +41,11 @@ fn started(model: Model) -> Fmu {
             // A thrust the allocator passes on; the roll rate setpoint moves the motors.
             assert_eq!(fmu.set("thrust", 0.6), fmi2OK);
             assert_eq!(fmu.set("wx", 0.3), fmi2OK);
+        }
+        Model::AttitudeController => {
+            // The time is its state: a yaw step inside the run changes the yaw rate.
+            assert_eq!(fmu.set("step_time", 1.2), fmi2OK);
+            assert_eq!(fmu.set("target_yaw", 0.5), fmi2OK);
         }
         _ => {
             assert_eq!(fmu.set("seed", 21.0), fmi2OK);

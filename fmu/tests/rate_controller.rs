@@ -206,13 +206,92 @@ fn bad_inputs_and_parameters_are_refused_naming_them() {
         c.last_message()
     );
     let fresh = Fmu::new(Model::RateController);
-    assert_eq!(fresh.set("roll_rate_p", -1.0), fmi2Error);
+    assert_eq!(fresh.set("MC_ROLLRATE_P", -1.0), fmi2Error);
     assert!(
-        fresh.last_message().contains("`roll_rate_p` = -1"),
+        fresh.last_message().contains("`MC_ROLLRATE_P` = -1"),
         "{}",
         fresh.last_message()
     );
     assert_eq!(fresh.set("rate_loop_period", 0.0), fmi2Error);
     let message = fresh.last_message();
     assert!(message.contains("`rate_loop_period` = 0 s"), "{message}");
+    // The core's name is not a variable: PX4's is.
+    assert!(
+        Model::RateController
+            .table()
+            .by_name("roll_rate_p")
+            .is_none()
+    );
+    // Rotors that cannot make roll torque: the allocator's refusal names PX4's parameters,
+    // and the last rotor keeps its value.
+    for name in ["CA_ROTOR0_PY", "CA_ROTOR1_PY", "CA_ROTOR2_PY"] {
+        assert_eq!(fresh.set(name, 0.0), fmi2OK, "{name}");
+    }
+    assert_eq!(fresh.set("CA_ROTOR3_PY", 0.0), fmi2Error);
+    let message = fresh.last_message();
+    assert!(message.contains("`CA_ROTOR0..3_PX/PY/KM`"), "{message}");
+    assert_eq!(fresh.setup(0.0, None), fmi2OK);
+    assert_eq!(fresh.enter_init(), fmi2OK);
+    assert_eq!(fresh.get("CA_ROTOR3_PY"), 0.1875);
+}
+
+/// The PX4 parameter names, their none_iris defaults in PX4's units, and the core field
+/// each one sets (rad/s for PX4's deg/s rates).
+#[test]
+fn parameters_carry_px4s_names_units_and_none_iris_defaults() {
+    let c = Fmu::started(Model::RateController, 0.0, &[]);
+    let defaults = [
+        ("MC_ROLLRATE_P", 0.15),
+        ("MC_ROLLRATE_I", 0.2),
+        ("MC_ROLLRATE_D", 0.003),
+        ("MC_ROLLRATE_K", 1.0),
+        ("MC_RR_INT_LIM", 0.3),
+        ("MC_PITCHRATE_P", 0.15),
+        ("MC_YAWRATE_P", 0.2),
+        ("MC_YAWRATE_I", 0.1),
+        ("MC_ROLLRATE_MAX", 220.0),
+        ("MC_YAWRATE_MAX", 200.0),
+        ("IMU_GYRO_CUTOFF", 40.0),
+        ("IMU_DGYRO_CUTOFF", 30.0),
+        ("MC_YAW_TQ_CUTOFF", 2.0),
+        ("THR_MDL_FAC", 0.0),
+        ("CA_ROTOR0_PX", 0.1515),
+        ("CA_ROTOR0_PY", 0.245),
+        ("CA_ROTOR1_PY", -0.1875),
+        ("CA_ROTOR3_PY", 0.1875),
+        ("CA_ROTOR2_KM", -0.05),
+        ("CA_ROTOR3_KM", -0.05),
+        ("rate_loop_period", 0.004),
+        ("output_quantum", 0.001),
+    ];
+    for (name, value) in defaults {
+        assert!(
+            (c.get(name) - value).abs() < 1e-12,
+            "{name} = {}",
+            c.get(name)
+        );
+    }
+    // MC_ROLLRATE_MAX in deg/s clips the roll rate input in rad/s: 57.29578 deg/s = 1 rad/s.
+    let clipped = Fmu::started(
+        Model::RateController,
+        0.0,
+        &[("MC_ROLLRATE_MAX", 180.0 / std::f64::consts::PI)],
+    );
+    let one = Fmu::started(
+        Model::RateController,
+        0.0,
+        &[("roll_rate", 1.0), ("thrust", 0.5)],
+    );
+    assert_eq!(clipped.set("thrust", 0.5), fmi2OK);
+    assert_eq!(clipped.set("roll_rate", 3.0), fmi2OK);
+    assert_eq!(MOTORS.map(|m| clipped.get(m)), MOTORS.map(|m| one.get(m)));
+    // A wider front pair mixes roll with less on the front motors than none_iris.
+    let wide = Fmu::started(
+        Model::RateController,
+        0.0,
+        &[("CA_ROTOR0_PY", 0.4), ("CA_ROTOR2_PY", -0.4)],
+    );
+    assert_eq!(wide.set("thrust", 0.5), fmi2OK);
+    assert_eq!(wide.set("roll_rate", 1.0), fmi2OK);
+    assert_ne!(MOTORS.map(|m| wide.get(m)), MOTORS.map(|m| one.get(m)));
 }

@@ -19,7 +19,7 @@ ROOT = Path(__file__).resolve().parents[2]
 def fmus() -> dict[str, Path]:
     out = ROOT / "dist" / "fmu"
     subprocess.run(["bash", str(ROOT / "scripts" / "pack-fmus.sh"), str(out)], cwd=ROOT, check=True)
-    names = ("Quadrotor", "Lander2D", "Hexacopter", "RateController")
+    names = ("Quadrotor", "Lander2D", "Hexacopter", "RateController", "AttitudeController")
     names += tuple(f"{name}-fmi3" for name in names)
     paths = {name: out / f"{name}.fmu" for name in names}
     for path in paths.values():

@@ -1,11 +1,14 @@
 //! The FMUs this one library serves, and the choice between them by GUID: each is a
 //! declaration (a name, and for the multirotor its frame) whose table is built on first use.
 
+mod attitude_controller;
 mod lander2d;
 mod multirotor;
+mod px4_rate_params;
 mod quadrotor;
 mod rate_controller;
 
+pub use attitude_controller::AttitudeController;
 pub use multirotor::Multirotor;
 pub use rate_controller::RateController;
 
@@ -51,13 +54,19 @@ static HEXACOPTER: LazyLock<Table<Quadrotor>> = LazyLock::new(|| {
 /// RateController.fmu: the core's PX4 rate loop and allocation.
 static RATE_CONTROLLER: LazyLock<Table<RateController>> = LazyLock::new(rate_controller::table);
 
-/// The tables of every FMU: Quadrotor, Lander2D, Hexacopter, RateController.
-pub fn tables() -> [&'static ModelTable; 4] {
+/// AttitudeController.fmu: a PD attitude controller over RateController.fmu (examples/ssp).
+static ATTITUDE_CONTROLLER: LazyLock<Table<AttitudeController>> =
+    LazyLock::new(attitude_controller::table);
+
+/// The tables of every FMU: Quadrotor, Lander2D, Hexacopter, RateController,
+/// AttitudeController.
+pub fn tables() -> [&'static ModelTable; 5] {
     [
         &QUADROTOR.table,
         &LANDER2D.table,
         &HEXACOPTER.table,
         &RATE_CONTROLLER.table,
+        &ATTITUDE_CONTROLLER.table,
     ]
 }
 
@@ -75,4 +84,5 @@ pub fn simulation_for(api: Api, token: &str) -> Option<Result<Box<dyn Simulation
         .or_else(|| of(&LANDER2D, api, token))
         .or_else(|| of(&HEXACOPTER, api, token))
         .or_else(|| of(&RATE_CONTROLLER, api, token))
+        .or_else(|| of(&ATTITUDE_CONTROLLER, api, token))
 }

@@ -13,12 +13,11 @@
 //! to PX4's FRD here; the setpoint is PX4's (thrust in [0, 1], rates body FRD) and is clipped
 //! into the rates action's bounds as the gym clips an action.
 
+use super::px4_rate_params::Px4RateParams;
 use crate::model::{FmuModel, Table};
 use crate::table::{Array, ModelInfo};
 use flyloop_core::params::{ParamSpec, Parameters};
-use flyloop_core::quadrotor::{Frame, QuadrotorParams};
-use flyloop_core::rate_loop::px4_rotors::{Px4Rotor, px4_rotors};
-use flyloop_core::rate_loop::{RateLoop, RateLoopParams, RatesSetpoint};
+use flyloop_core::rate_loop::{RateLoop, RatesSetpoint};
 use flyloop_core::snapshot;
 use flyloop_core::variables::{InputRow, OutputRow, Rows, VariableTable};
 use flyloop_core::{InputError, ParamError, SnapshotError};
@@ -29,13 +28,16 @@ use std::cell::Cell;
 
 /// Times closer than this are the same instant on the loop's grid, s (the gym's tolerance).
 const TIME_TOLERANCE: f64 = 1e-9;
-const SNAPSHOT_TAG: &[u8; 8] = b"FLYRTC01";
+// 02: the parameters under PX4's names (with the rotor geometry) are kept next to the loop.
+const SNAPSHOT_TAG: &[u8; 8] = b"FLYRTC02";
 
 /// The rate loop with the inputs in effect and its place on its grid.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct RateController {
     /// The loop as it is before its next tick.
     rate_loop: RateLoop,
+    /// The loop's parameters as the FMU names them (PX4's names), equal to `rate_loop`'s.
+    px4_params: Px4RateParams,
     /// Ticks done since the start (the next is at `ticks · rate_loop_period`).
     ticks: u64,
     /// Seconds since the start time of the last communication point.
@@ -52,7 +54,7 @@ pub struct RateController {
     due: Cell<Option<[f64; 4]>>,
 }
 
-/// RateController.fmu has no start values besides its parameters.
+/// No start values besides the parameters (RateController.fmu, AttitudeController.fmu).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct NoStartValues;
 
@@ -64,15 +66,11 @@ impl Parameters for NoStartValues {
     }
 }
 
-/// PX4's rotors for the quad X (the none_iris mixer the gym's rates interface mixes for).
-fn quad_x_rotors() -> Vec<Px4Rotor> {
-    px4_rotors(&Frame::quad_x(), &QuadrotorParams::default())
-}
-
 impl RateController {
-    pub fn new(params: RateLoopParams) -> Result<Self, ParamError> {
+    pub fn new(params: Px4RateParams) -> Result<Self, ParamError> {
         Ok(RateController {
-            rate_loop: RateLoop::new(params, &quad_x_rotors())?,
+            rate_loop: params.rate_loop()?,
+            px4_params: params,
             ticks: 0,
             now: 0.0,
             setpoint: [0.0; 4],
@@ -181,7 +179,7 @@ static INPUTS: [InputRow<RateController>; 7] = [
     InputRow::new(
         "roll_rate",
         "rad/s",
-        "Roll rate setpoint, body FRD (clipped into +-roll_pitch_rate_max)",
+        "Roll rate setpoint, body FRD (clipped into +-MC_ROLLRATE_MAX)",
         [-RATE_RANGE, RATE_RANGE, 0.0],
         |c| c.setpoint[1],
         set_setpoint::<1>,
@@ -189,7 +187,7 @@ static INPUTS: [InputRow<RateController>; 7] = [
     InputRow::new(
         "pitch_rate",
         "rad/s",
-        "Pitch rate setpoint, body FRD (clipped into +-roll_pitch_rate_max)",
+        "Pitch rate setpoint, body FRD (clipped into +-MC_ROLLRATE_MAX)",
         [-RATE_RANGE, RATE_RANGE, 0.0],
         |c| c.setpoint[2],
         set_setpoint::<2>,
@@ -197,7 +195,7 @@ static INPUTS: [InputRow<RateController>; 7] = [
     InputRow::new(
         "yaw_rate",
         "rad/s",
-        "Yaw rate setpoint, body FRD (clipped into +-yaw_rate_max)",
+        "Yaw rate setpoint, body FRD (clipped into +-MC_YAWRATE_MAX)",
         [-RATE_RANGE, RATE_RANGE, 0.0],
         |c| c.setpoint[3],
         set_setpoint::<3>,
@@ -243,7 +241,7 @@ static OUTPUTS: [OutputRow<RateController>; 4] = [
 ];
 
 impl VariableTable for RateController {
-    type Params = RateLoopParams;
+    type Params = Px4RateParams;
     type Initial = NoStartValues;
     type Shape = ();
 
@@ -259,15 +257,16 @@ impl VariableTable for RateController {
         &()
     }
 
-    fn params(&self) -> &RateLoopParams {
-        self.rate_loop.params()
+    fn params(&self) -> &Px4RateParams {
+        &self.px4_params
     }
 
     /// Rebuilds the loop (at rest) with the parameter changed; nothing changes on an error.
     fn set_parameter(&mut self, name: &'static str, value: f64) -> Result<(), ParamError> {
-        let mut params = self.rate_loop.params().clone();
+        let mut params = self.px4_params.clone();
         params.set(name, value)?;
-        self.rate_loop = RateLoop::new(params, &quad_x_rotors())?;
+        self.rate_loop = params.rate_loop()?;
+        self.px4_params = params;
         self.due.set(None);
         Ok(())
     }
@@ -321,7 +320,7 @@ fn info() -> ModelInfo {
 
 impl FmuModel for RateController {
     fn build(_: &(), previous: Option<&Self>, _: &NoStartValues) -> Result<Self, ParamError> {
-        let params = previous.map(|c| c.rate_loop.params().clone());
+        let params = previous.map(|c| c.px4_params.clone());
         RateController::new(params.unwrap_or_default())
     }
 

@@ -14,15 +14,17 @@ pub enum Model {
     Lander2D,
     Hexacopter,
     RateController,
+    AttitudeController,
 }
 
 impl Model {
     /// Every FMU the library serves.
-    pub const ALL: [Model; 4] = [
+    pub const ALL: [Model; 5] = [
         Model::Quadrotor,
         Model::Lander2D,
         Model::Hexacopter,
         Model::RateController,
+        Model::AttitudeController,
     ];
     /// The plants (the FMUs with motor commands as inputs).
     pub const PLANTS: [Model; 3] = [Model::Quadrotor, Model::Lander2D, Model::Hexacopter];
@@ -39,6 +41,7 @@ impl Model {
             Model::Lander2D => tables()[1],
             Model::Hexacopter => tables()[2],
             Model::RateController => tables()[3],
+            Model::AttitudeController => tables()[4],
         }
     }
 
