@@ -4,6 +4,7 @@
 
 mod support;
 
+mod attitude_controller;
 mod fmi3;
 mod fmu_state;
 mod frame_in_test;
