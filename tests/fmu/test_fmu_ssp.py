@@ -21,15 +21,15 @@ ROOT = Path(__file__).resolve().parents[2]
 SSP = ROOT / "examples" / "ssp"
 
 
-def load(name):
+def load(file):
     sys.path.insert(0, str(SSP))
-    spec = importlib.util.spec_from_file_location(name, SSP / f"{name}.py")
+    spec = importlib.util.spec_from_file_location(file.removesuffix(".py"), SSP / file)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
 
 
-build, engines, systems = load("build"), load("engines"), load("systems")
+build, engines, systems = load("build.py"), load("engines.py"), load("systems.py")
 
 
 @pytest.fixture(scope="module")
@@ -127,3 +127,10 @@ def test_the_archive_holds_the_ssd_and_each_fmu_once(runs, fmus, tmp_path):
         "resources/Quadrotor.fmu",
         "resources/RateController.fmu",
     ]
+
+
+def test_the_plot_shows_both_systems_in_both_engines(fmus, tmp_path):
+    out = load("plot.py").main(
+        ["--fmus", str(fmus["Quadrotor"].parent), "--out", str(tmp_path / "p.png")]
+    )
+    assert out.stat().st_size > 30_000

@@ -1,0 +1,58 @@
+"""Cost of the examples/ssp systems per simulated second in each engine (fmpy's SSP support,
+ecos), wall clock, best of a few rounds (engines alternate each round, so a load change hits
+both). Each system runs for its stop time T and for 2T: the difference over T is the cost of
+simulating (per simulated second), the rest of the T run the fixed cost of unpacking, loading
+and instantiating the FMUs.
+
+    bash scripts/pack-fmus.sh && .venv/bin/python benchmarks/ssp_engines.py [--rounds N]
+"""
+
+import argparse
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "examples" / "ssp"))
+import build  # noqa: E402
+import engines  # noqa: E402
+from systems import SYSTEMS  # noqa: E402
+
+
+def main(argv=None) -> dict:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--fmus", type=Path, default=ROOT / "dist" / "fmu")
+    parser.add_argument("--rounds", type=int, default=3)
+    args = parser.parse_args(argv)
+    best = {}  # (system, engine, T or 2T) -> best wall seconds
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, system in SYSTEMS.items():
+            ssp = build.build(system, args.fmus, Path(tmp))
+            for _ in range(args.rounds):
+                for engine in engines.ENGINES:
+                    for span in (1, 2):
+                        stop = span * system.stop_time
+                        wall = engines.run(ssp, engine, stop, system.step_size, system.watch)[
+                            "wall"
+                        ]
+                        key = (name, engine, span)
+                        best[key] = min(best.get(key, wall), wall)
+    print(f"load average {os.getloadavg()[0]:.1f} (1 min) on {os.cpu_count()} cores")
+    result = {}
+    for name, system in SYSTEMS.items():
+        for engine in engines.ENGINES:
+            once, twice = best[name, engine, 1], best[name, engine, 2]
+            per_second = (twice - once) / system.stop_time
+            setup = once - per_second * system.stop_time
+            steps = round(1 / system.step_size)
+            result[name, engine] = (per_second, setup)
+            print(
+                f"{name:15s} {engine:5s} {1000 * per_second:6.1f} ms per simulated second "
+                f"({len(system.components)} FMUs x {steps} steps), {1000 * setup:6.1f} ms to load"
+            )
+    return result
+
+
+if __name__ == "__main__":
+    main()
