@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from fmpy.validation import validate_fmu
 
 ROOT = Path(__file__).resolve().parents[2]
 SSP = ROOT / "examples" / "ssp"
@@ -134,3 +135,26 @@ def test_the_plot_shows_both_systems_in_both_engines(fmus, tmp_path):
         ["--fmus", str(fmus["Quadrotor"].parent), "--out", str(tmp_path / "p.png")]
     )
     assert out.stat().st_size > 30_000
+
+
+def test_attitude_controller_validates_in_fmpy(fmus):
+    for name in ("AttitudeController", "AttitudeController-fmi3"):
+        assert validate_fmu(str(fmus[name])) == [], name
+
+
+def test_engines_refuse_a_connection_to_a_missing_variable_naming_it(fmus, tmp_path):
+    good = build.build(systems.SYSTEMS["attitude_hover"], fmus["Quadrotor"].parent, tmp_path)
+    with zipfile.ZipFile(good) as z:
+        files = {n: z.read(n) for n in z.namelist()}
+    ssd = files["SystemStructure.ssd"].decode()
+    wire = 'startConnector="yaw" endElement="attitude"'
+    assert wire in ssd
+    files["SystemStructure.ssd"] = ssd.replace(wire, 'startConnector="yaww" endElement="attitude"')
+    bad = tmp_path / "bad.ssp"
+    with zipfile.ZipFile(bad, "w") as z:
+        for name, data in files.items():
+            z.writestr(name, data)
+    with pytest.raises(Exception, match="No connector named: 'yaww' defined for element: 'plant'"):
+        engines.run(bad, "ecos", 0.1, 0.004, ["plant.z"])
+    with pytest.raises(KeyError, match="attitude_hover.plant.yaww"):
+        engines.run(bad, "fmpy", 0.1, 0.004, ["plant.z"])
