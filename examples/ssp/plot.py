@@ -1,4 +1,4 @@
-"""Runs the examples/ssp systems in fmpy and in ecos and plots them: height, horizontal
+"""Runs the examples/ssp systems in fmpy, ecos and libcosim and plots them: height, horizontal
 position and yaw over time, one colour per engine.
 
 Usage: .venv/bin/python examples/ssp/plot.py [--fmus dist/fmu] [--out runs/ssp/closed_loops.png]
@@ -20,7 +20,11 @@ import engines  # noqa: E402
 from systems import SYSTEMS  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
-STYLE = {"fmpy": {"color": "tab:blue"}, "ecos": {"color": "tab:orange", "linestyle": "--"}}
+STYLE = {
+    "fmpy": {"color": "tab:blue"},
+    "ecos": {"color": "tab:orange", "linestyle": "--"},
+    "libcosim": {"color": "tab:green", "linestyle": ":"},
+}
 
 
 def main(argv=None) -> Path:
@@ -53,7 +57,7 @@ def main(argv=None) -> Path:
     for ax in axes.flat:
         ax.legend(fontsize=7, loc="best")
     fig.suptitle(
-        "flyloop SSP systems in fmpy and ecos: Quadrotor.fmu + RateController.fmu"
+        "flyloop SSP systems in fmpy, ecos and libcosim: Quadrotor.fmu + RateController.fmu"
         " (+ AttitudeController.fmu)"
     )
     fig.tight_layout()

@@ -1,5 +1,6 @@
 """examples/ssp: the SSP systems built from the packed FMUs hold their targets in fmpy's SSP
-support and in ecos (ecospy), and the two engines agree.
+support, in ecos (ecospy) and in libcosim (libcosimpy), and the engines agree: ecos and
+libcosim bit for bit (the same fixed-step master), fmpy within a tolerance.
 
 Tolerance between engines: final positions within 1 mm and yaw within 1 mrad (measured:
 0.14 mm, 0.03 mrad). The engines start differently: fmpy's connectors start at 0, so its
@@ -67,6 +68,13 @@ def test_attitude_controller_holds_the_hover_and_the_yaw_step(runs, engine):
     assert abs(final(run, "plant.yaw") - 0.5) < 1e-3
     for name, target in (("plant.x", 0.0), ("plant.y", 0.0), ("plant.z", 1.0)):
         assert abs(final(run, name) - target) < 1e-2, (name, final(run, name))
+
+
+@pytest.mark.parametrize("system", list(systems.SYSTEMS))
+def test_ecos_and_libcosim_fly_the_same_bits(runs, system):
+    ecos, libcosim = runs[system, "ecos"], runs[system, "libcosim"]
+    for name in systems.SYSTEMS[system].watch:
+        assert ecos[name].tobytes() == libcosim[name].tobytes(), name
 
 
 def test_both_engines_end_the_attitude_step_alike(runs):
