@@ -57,7 +57,14 @@ def connections(system: System, tables: dict[str, dict]) -> list[tuple[str, str,
                     f"system {system.name}: input `{name}` of {sink.fmu} is an output of "
                     f"{', '.join(sources)}; wiring by name needs exactly one"
                 )
-            found += [(sources[0], name, sink.name, name)] if sources else []
+            if sources:
+                found.append((sources[0], name, sink.name, name))
+            elif name not in sink.parameters and name not in sink.open_inputs:
+                raise WiringError(
+                    f"system {system.name}: input `{name}` of {sink.fmu} ({sink.name}) is fed by "
+                    "no output and bound by no parameter; list it in open_inputs to keep its "
+                    "start value"
+                )
     return found
 
 
@@ -100,6 +107,8 @@ def parameter_xml(component: Component, table: dict[str, tuple[str, str]]) -> st
 
 def ssd(system: System, tables: dict[str, dict]) -> str:
     """SystemStructure.ssd of `system`."""
+    # Parameters first: a misspelt parameter is named as such, not as an unfed input.
+    bindings = {c.name: parameter_xml(c, tables[c.name]) for c in system.components}
     wires = connections(system, tables)
     watched = {tuple(w.split(".", 1)) for w in system.watch}
     for component, name in watched:
@@ -120,7 +129,7 @@ def ssd(system: System, tables: dict[str, dict]) -> str:
             f'source="resources/{c.fmu}">\n      <ssd:Connectors>\n'
             + "\n".join(connectors)
             + "\n      </ssd:Connectors>\n"
-            + parameter_xml(c, tables[c.name])
+            + bindings[c.name]
             + "    </ssd:Component>"
         )
     lines = [

@@ -18,7 +18,10 @@ START_Z = 1.0  # m: both systems start at rest at this height
 class Component:
     name: str  # instance name in the SSP
     fmu: str  # file name in the FMU folder (dist/fmu)
-    parameters: dict[str, float] = field(default_factory=dict)
+    parameters: dict[str, float] = field(default_factory=dict)  # parameters and input start values
+    # Inputs that may stay unconnected and keep their start values; any other input no output
+    # feeds and no parameter binds is refused (a misnamed variable would otherwise sit at 0).
+    open_inputs: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -35,6 +38,7 @@ PLANT = Component(
     "plant",
     "Quadrotor.fmu",
     {"seed": 1, "initial_z": START_Z, "initial_motor": HOVER, "wind_enabled": 0},
+    open_inputs=("wind_input_x", "wind_input_y", "wind_input_z"),  # no external wind
 )
 RATES = Component("rates", "RateController.fmu")
 

@@ -119,6 +119,15 @@ def test_a_system_that_cannot_be_wired_is_refused_naming_the_variable(fmus, tmp_
         match="input `motor_command_0` of Quadrotor.fmu is an output of rates, r2",
     ):
         build.build(twice, folder, tmp_path)
+    # An input nothing feeds: refused unless bound or listed as open.
+    alone = systems.System(
+        "alone", "", (systems.PLANT, systems.Component("a", "AttitudeController.fmu")), 1.0, 0.004
+    )
+    with pytest.raises(
+        build.WiringError,
+        match="input `motor_command_0` of Quadrotor.fmu \\(plant\\) is fed by no output",
+    ):
+        build.build(alone, folder, tmp_path)
     missing = systems.System(
         "missing", "", (systems.PLANT, systems.Component("p", "Policy.fmu")), 1.0, 0.004
     )
