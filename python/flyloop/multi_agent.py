@@ -104,7 +104,9 @@ def native_config(
     return config
 
 
-def _batch(env_id: str, num_worlds: int, num_threads: int, kwargs: dict[str, Any]):
+def _batch(
+    env_id: str, num_worlds: int, num_threads: int, kwargs: dict[str, Any], backend="native"
+):
     from . import _native
 
     if env_id not in ENV_TASKS:
@@ -114,6 +116,11 @@ def _batch(env_id: str, num_worlds: int, num_threads: int, kwargs: dict[str, Any
         kwargs["interface"] = kwargs.pop("action_interface")
     if "randomize" in kwargs:
         kwargs["domain_randomization"] = kwargs.pop("randomize")
+    if backend == "sitl":
+        from .multi_sitl import SitlMultiBatch
+
+        link = {k: kwargs.pop(k) for k in ("sitl_path", "timeout") if k in kwargs}
+        return SitlMultiBatch(ENV_TASKS[env_id], native_config(**kwargs), **link)
     return _native.MultiBatch(ENV_TASKS[env_id], native_config(**kwargs), num_worlds, num_threads)
 
 
@@ -174,11 +181,18 @@ def _parallel_env_class():
 
         metadata = {"name": "flyloop_multi_v0", "render_modes": [], "is_parallelizable": True}
 
-        def __init__(self, env_id: str, render_mode: str | None = None, **kwargs: Any) -> None:
+        def __init__(
+            self,
+            env_id: str,
+            render_mode: str | None = None,
+            backend: str = "native",
+            **kwargs: Any,
+        ) -> None:
             if render_mode is not None:
                 raise ValueError(f"render_mode must be None, got {render_mode!r}")
             self.render_mode = None
-            self._batch = _batch(env_id, 1, 1, kwargs)
+            self.backend = backend
+            self._batch = _batch(env_id, 1, 1, kwargs, backend)
             self._arrays = _Arrays(self._batch)
             self._obs_space, self._act_space, d = _spaces(self._batch)
             self._info_layout = d["info_layout"]
@@ -245,23 +259,21 @@ def _parallel_env_class():
             return p.reshape(-1, 3), t.reshape(-1, 3)
 
         def close(self) -> None:
-            pass
+            close = getattr(self._batch, "close", None)  # the SITL backend's process
+            if close is not None:
+                close()
 
     return FlyloopParallelEnv
 
 
 def parallel_env(env_id: str, num_agents: int = 4, backend: str = "native", **kwargs: Any):
     """The multi-agent env `env_id` ("flyloop/MultiHover-v0", "flyloop/Swap-v0" or "-v1") as a
-    PettingZoo ParallelEnv (module docs for the spaces, reward, ends and arguments)."""
-    if backend == "sitl":
-        raise NotImplementedError(
-            "backend='sitl' for the multi-agent envs needs the SITL to serve a multi-agent "
-            "task in one datagram exchange (issue 34 item 5, not built yet); use "
-            "backend='native'"
-        )
-    if backend != "native":
+    PettingZoo ParallelEnv (module docs for the spaces, reward, ends and arguments), its world
+    in this process (backend "native") or in a flyloop-sitl it starts (backend "sitl", the
+    same bits: flyloop.multi_sitl; `sitl_path=`, `timeout=`)."""
+    if backend not in ("native", "sitl"):
         raise ValueError(f"backend must be 'native' or 'sitl', got {backend!r}")
-    return _parallel_env_class()(env_id, num_agents=num_agents, **kwargs)
+    return _parallel_env_class()(env_id, num_agents=num_agents, backend=backend, **kwargs)
 
 
 class MultiAgentVectorEnv(gymnasium.vector.VectorEnv):

@@ -142,8 +142,8 @@ def test_bad_input_names_the_item():
         flyloop.parallel_env("flyloop/Swap-v0", massss=1.0)
     with pytest.raises(ValueError, match="flyloop/Nope-v0"):
         flyloop.parallel_env("flyloop/Nope-v0")
-    with pytest.raises(NotImplementedError, match="backend='native'"):
-        flyloop.parallel_env("flyloop/Swap-v0", backend="sitl")
+    with pytest.raises(ValueError, match="backend must be 'native' or 'sitl', got 'px4'"):
+        flyloop.parallel_env("flyloop/Swap-v0", backend="px4")
     env = flyloop.parallel_env("flyloop/Swap-v0", num_agents=3)
     env.reset(seed=0)
     hover = np.full(4, 0.5, np.float32)

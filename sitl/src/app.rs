@@ -7,12 +7,13 @@ use crate::config::{self, AutopilotVehicle, ConfigError};
 use crate::px4::server::Pacing;
 use crate::px4::session::{Session, SessionOptions};
 use crate::server::{self, GcsLink};
-use crate::sim::{Sim, SimOptions};
+use crate::sim::{Mode, Sim, SimOptions, WorldTask};
 use crate::track::Track;
 use crate::{ardupilot, px4};
 use crate::{param_table, starter_config, task_frame};
 use clap::Parser;
 use flyloop_core::ParamError;
+use flyloop_core::tasks::multi::{MultiError, Scenario};
 use flyloop_core::tasks::registry::{ModelKind, TaskConfig, TaskInstance, TaskKind};
 use std::io::IsTerminal;
 use std::net::SocketAddr;
@@ -453,6 +454,9 @@ fn start(args: Args) -> Result<(), StartError> {
     if args.ardupilot {
         return start_ardupilot(args);
     }
+    if let Some(scenario) = args.world_task() {
+        return start_world(args, scenario);
+    }
     let task = args.task().map_err(StartError::Options)?;
     let config = match &args.config {
         Some(path) => config::load(task, path)?,
@@ -462,7 +466,7 @@ fn start(args: Args) -> Result<(), StartError> {
         print!("{text}");
         return Ok(());
     }
-    start_mavlink(args, task, config)
+    start_mavlink(args, task, config, None)
 }
 
 /// What `--list-params` or `--describe-frame` prints instead of running, if asked for.
@@ -479,9 +483,41 @@ fn printout(
     })
 }
 
-/// The MAVLink SITL (lockstep or real time): the vehicles, the sockets, then datagrams until
-/// a signal.
-fn start_mavlink(args: Args, task: TaskKind, config: TaskConfig) -> Result<(), StartError> {
+/// A multi-agent task as one world of `--vehicles` quadrotors on the lockstep MAVLink link
+/// (docs/protocol.md section 14).
+fn start_world(args: Args, scenario: Scenario) -> Result<(), StartError> {
+    let not_here = [
+        (args.mode() != Mode::Lockstep, "--realtime"),
+        (args.record.is_some(), "--record"),
+        (args.list_params.is_some(), "--list-params"),
+        (args.describe_frame, "--describe-frame"),
+    ];
+    if let Some((_, option)) = not_here.iter().find(|(set, _)| *set) {
+        return Err(StartError::Options(format!(
+            "{option} is not available for the multi-agent task `{}` (a lockstep world; docs/protocol.md section 14)",
+            scenario.name()
+        )));
+    }
+    let config = config::load_world(args.config.as_deref(), args.vehicles)?;
+    let world = WorldTask::new(scenario, config, args.seed).map_err(|e| match e {
+        MultiError::Param(p) => StartError::Parameters(p),
+        other => StartError::Options(other.to_string()),
+    })?;
+    start_mavlink(args, TaskKind::Hover, TaskConfig::default(), Some(world))
+}
+
+/// The MAVLink SITL (lockstep or real time): the vehicles (or the multi-agent `world`), the
+/// sockets, then datagrams until a signal.
+fn start_mavlink(
+    args: Args,
+    task: TaskKind,
+    config: TaskConfig,
+    world: Option<WorldTask>,
+) -> Result<(), StartError> {
+    let task_name = match &world {
+        Some(w) => w.flight.scenario().name(),
+        None => task.frame_name(),
+    };
     let mut options = SimOptions::new(task);
     options.vehicles = args.vehicles;
     options.seed = args.seed;
@@ -491,7 +527,10 @@ fn start_mavlink(args: Args, task: TaskKind, config: TaskConfig) -> Result<(), S
     options.state_in_reply = !args.no_state_reply;
     options.failsafe_timeout = args.failsafe_timeout();
     options.state_rate_hz = args.state_rate;
-    let mut sim = Sim::new(options, Instant::now())?;
+    let mut sim = match world {
+        Some(w) => Sim::new_world(options, w, Instant::now())?,
+        None => Sim::new(options, Instant::now())?,
+    };
     if let Some(path) = &args.record {
         let recorder =
             crate::record::Recorder::create(path).map_err(|source| StartError::Record {
@@ -515,7 +554,7 @@ fn start_mavlink(args: Args, task: TaskKind, config: TaskConfig) -> Result<(), S
         "flyloop-sitl ready listen={listen} gcs={gcs_text} mode={} model={} task={} vehicles={} seed={}",
         args.mode().name(),
         args.model().name(),
-        task.frame_name(),
+        task_name,
         args.vehicles,
         args.seed
     );

@@ -4,6 +4,7 @@ use crate::kinematics::Home;
 use crate::sim::Mode;
 use clap::Parser;
 use clap::builder::{PossibleValuesParser, TypedValueParser};
+use flyloop_core::tasks::multi::Scenario;
 use flyloop_core::tasks::registry::{ModelKind, TaskKind};
 use std::net::SocketAddr;
 use std::path::PathBuf;
@@ -22,9 +23,11 @@ pub struct Args {
     #[arg(long, value_parser = model_parser())]
     pub model: Option<ModelKind>,
 
-    /// Task flown on the model [default: hover for quadrotor, landing for lander2d].
+    /// Task flown on the model [default: hover for quadrotor, landing for lander2d]; the
+    /// multi-agent tasks `multi_hover` and `swap` fly `--vehicles` quadrotors in ONE world
+    /// (lockstep; docs/protocol.md section 14).
     #[arg(long, value_parser = task_parser())]
-    pub task: Option<TaskKind>,
+    pub task: Option<TaskArg>,
 
     /// Controller link: UDP address to listen on (port 0 picks a free port; see the first
     /// stdout line).
@@ -182,10 +185,37 @@ fn model_parser() -> impl TypedValueParser<Value = ModelKind> {
         .try_map(|name| ModelKind::from_name(&name).ok_or("unknown model"))
 }
 
-/// `--task`'s values: the core's task names.
-fn task_parser() -> impl TypedValueParser<Value = TaskKind> {
-    PossibleValuesParser::new(TaskKind::ALL.map(TaskKind::frame_name))
-        .try_map(|name| TaskKind::from_name(&name).ok_or("unknown task"))
+/// A `--task`: a single-vehicle task (one per vehicle) or a multi-agent world.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TaskArg {
+    Single(TaskKind),
+    World(Scenario),
+}
+
+impl TaskArg {
+    fn model(self) -> ModelKind {
+        match self {
+            TaskArg::Single(t) => t.model(),
+            TaskArg::World(_) => ModelKind::Quadrotor,
+        }
+    }
+}
+
+/// `--task`'s values: the core's task names, then the multi-agent tasks'.
+fn task_parser() -> impl TypedValueParser<Value = TaskArg> {
+    let worlds = [Scenario::MultiHover, Scenario::Swap].map(Scenario::name);
+    PossibleValuesParser::new(
+        TaskKind::ALL
+            .map(TaskKind::frame_name)
+            .into_iter()
+            .chain(worlds),
+    )
+    .try_map(|name| {
+        TaskKind::from_name(&name)
+            .map(TaskArg::Single)
+            .or(Scenario::from_name(&name).map(TaskArg::World))
+            .ok_or("unknown task")
+    })
 }
 
 /// How `--list-params` prints.
@@ -269,14 +299,23 @@ impl Args {
     /// The model, from `--model` or the task's model.
     pub fn model(&self) -> ModelKind {
         self.model
-            .or(self.task.map(TaskKind::model))
+            .or(self.task.map(TaskArg::model))
             .unwrap_or(ModelKind::Quadrotor)
     }
 
     /// The task, from `--task` or the model's default.
     pub fn task(&self) -> Result<TaskKind, String> {
         let model = self.model();
-        let task = self.task.unwrap_or(TaskKind::default_for(model));
+        let task = match self.task {
+            Some(TaskArg::World(s)) => {
+                return Err(format!(
+                    "task `{}` is a multi-agent world, not one vehicle's task",
+                    s.name()
+                ));
+            }
+            Some(TaskArg::Single(t)) => t,
+            None => TaskKind::default_for(model),
+        };
         if task.model() != model {
             return Err(format!(
                 "task `{}` does not run on model `{}`: quadrotor flies hover or waypoints, lander2d flies landing",
@@ -285,6 +324,14 @@ impl Args {
             ));
         }
         Ok(task)
+    }
+
+    /// The multi-agent task `--task` names, if it names one.
+    pub fn world_task(&self) -> Option<Scenario> {
+        match self.task {
+            Some(TaskArg::World(s)) => Some(s),
+            _ => None,
+        }
     }
 
     pub fn mode(&self) -> Mode {

@@ -202,6 +202,38 @@ pub fn load(task: TaskKind, path: &Path) -> Result<TaskConfig, ConfigError> {
     read(path, |text| parse(task, text))
 }
 
+/// A multi-agent world's parameters for `vehicles` agents from the file at `path` (or the
+/// defaults): a flat table by the multi-agent task's core names (the names
+/// `flyloop.parallel_env` takes) and a `[randomize]` table of per-agent ranges.
+pub fn load_world(
+    path: Option<&Path>,
+    vehicles: u8,
+) -> Result<flyloop_core::tasks::multi::MultiConfig, ConfigError> {
+    use crate::sim::world_config;
+    match path {
+        None => world_config(vehicles, &[], Vec::new()).map_err(|source| ConfigError::Invalid {
+            path: PathBuf::from("(defaults)"),
+            source,
+        }),
+        Some(path) => read(path, |text| {
+            let table: toml::Table = toml::from_str(text)?;
+            let mut pairs = Vec::with_capacity(table.len());
+            let mut ranges = Vec::new();
+            for (key, value) in &table {
+                if key == RANDOMIZE_TABLE {
+                    ranges = parse_ranges(value)?;
+                    continue;
+                }
+                let number = toml_number(value).ok_or_else(|| {
+                    ParamError::Parse(format!("parameter `{key}` must be a number or a boolean"))
+                })?;
+                pairs.push((key.clone(), number));
+            }
+            world_config(vehicles, &pairs, ranges)
+        }),
+    }
+}
+
 /// The autopilot modes' vehicle from the file at `path`.
 pub fn load_autopilot_vehicle(path: &Path) -> Result<AutopilotVehicle, ConfigError> {
     read(path, AutopilotVehicle::parse)

@@ -47,6 +47,9 @@ pub struct Stats {
     pub refusal_texts: u64,
     /// Refused controls left unanswered by the per-peer rate limit of those texts.
     pub refusal_texts_held: u64,
+    /// A multi-agent world: datagrams that ended with some, not all, commands of a step in
+    /// (the step waits for the rest; answered by a STATUSTEXT naming the missing vehicles).
+    pub held_steps: u64,
     /// Wall time from a datagram's arrival to its reply being sent (controller link).
     pub busy: Duration,
     /// Of which in the handler (decoding, physics, encoding; no socket calls).
@@ -91,7 +94,7 @@ impl fmt::Display for Stats {
              unknown_message={} malformed={} garbage={} refused_controls={} clamped_controls={} \
              unknown_vehicle={} ignored_messages={} refused_requests={} io_errors={} \
              repeated_steps={} stale_controls={} unflagged_controls={} gcs_controls={} \
-             refusal_texts={} refusal_texts_held={} \
+             refusal_texts={} refusal_texts_held={} held_steps={} \
              busy_us_per_datagram={:.2} handling_us_per_datagram={:.2} physics_us_per_step={:.2}",
             self.datagrams,
             self.gcs_datagrams,
@@ -116,6 +119,7 @@ impl fmt::Display for Stats {
             self.gcs_controls,
             self.refusal_texts,
             self.refusal_texts_held,
+            self.held_steps,
             us_per(self.busy, self.datagrams),
             us_per(self.handling, self.datagrams),
             us_per(self.physics, self.steps),

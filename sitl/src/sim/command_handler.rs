@@ -9,7 +9,7 @@ use mavlink::dialects::common::{
 use std::ops::Range;
 
 impl Sim {
-    fn ack(
+    pub(super) fn ack(
         &mut self,
         link: Link,
         out: &mut Vec<u8>,
@@ -229,7 +229,7 @@ impl Sim {
 
     /// SET_MESSAGE_INTERVAL: on the controller link it chooses what the sending peer gets
     /// (HIL_STATE_QUATERNION, DEBUG_FLOAT_ARRAY); on the ground-station link it sets a stream.
-    fn set_message_interval(
+    pub(super) fn set_message_interval(
         &mut self,
         link: Link,
         message: f32,

@@ -28,22 +28,31 @@ pub(crate) enum StepName {
 /// Classifies `step` (a lockstep command's `time_usec`) for vehicle `v`. Only a command
 /// equal to the last step's name is a repeat; names at or above the clock step.
 pub(crate) fn step_name(v: &Vehicle, step: u64) -> StepName {
+    classify_step(v.last_step, v.last_reply.is_some(), v.clock_us, step)
+}
+
+/// [`step_name`] for anything that steps by name: its last step's name, whether that
+/// step's reply is cached (not since dropped by a reset) and its clock, µs.
+pub(crate) fn classify_step(
+    last_step: Option<u64>,
+    cached: bool,
+    clock_us: u64,
+    step: u64,
+) -> StepName {
     if step == 0 {
         return StepName::New;
     }
-    if v.last_step == Some(step) {
-        return match v.last_reply {
-            Some(_) => StepName::Repeat,
-            None => StepName::Late(Refusal::BeforeReset { step }),
+    if last_step == Some(step) {
+        return if cached {
+            StepName::Repeat
+        } else {
+            StepName::Late(Refusal::BeforeReset { step })
         };
     }
-    if step >= v.clock_us {
+    if step >= clock_us {
         StepName::New
     } else {
-        StepName::Late(Refusal::LateDuplicate {
-            step,
-            clock_us: v.clock_us,
-        })
+        StepName::Late(Refusal::LateDuplicate { step, clock_us })
     }
 }
 
@@ -165,7 +174,7 @@ impl Sim {
         out: &mut Vec<u8>,
     ) {
         refusal.count(&mut self.stats);
-        let Some(system_id) = self.vehicles.get(i).map(|v| v.system_id) else {
+        let Some(system_id) = self.system_id_of(i) else {
             return;
         };
         // The text is made only when it is logged or sent: a flood is mostly held back.

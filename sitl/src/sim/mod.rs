@@ -21,9 +21,12 @@ mod command_handler;
 mod controls;
 mod realtime;
 mod refusal;
+mod world_handler;
+mod world_task;
 
 use refusal::{Refusal, TextBudget};
 pub use refusal::{TEXT_WINDOW, TEXTS_PER_WINDOW};
+pub use world_task::{EXTRA_VALUES, WorldTask, reward_from_pieces, world_config};
 
 /// How physics is paced.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -143,6 +146,10 @@ pub struct Sim {
     pub stream: Vec<(SocketAddr, Vec<u8>)>,
     /// `--record FILE`: every step of every vehicle.
     pub recorder: Option<crate::record::Recorder>,
+    /// A multi-agent task served as one world (protocol §14); `vehicles` is empty then.
+    pub world: Option<WorldTask>,
+    /// The datagram being handled has had the world's cached reply (a repeated step).
+    world_repeat_sent: bool,
 }
 
 impl Sim {
@@ -178,7 +185,32 @@ impl Sim {
             controller_outbox: Vec::new(),
             stream: Vec::new(),
             recorder: None,
+            world: None,
+            world_repeat_sent: false,
         })
+    }
+
+    /// A simulation serving `world` (a multi-agent task, lockstep) instead of vehicles.
+    pub fn new_world(
+        options: SimOptions,
+        world: WorldTask,
+        now: Instant,
+    ) -> Result<Self, ParamError> {
+        let options = SimOptions {
+            vehicles: 0,
+            ..options
+        };
+        let mut sim = Sim::new(options, now)?;
+        sim.world = Some(world);
+        Ok(sim)
+    }
+
+    /// The system id vehicle (or world agent) index `i` sends as.
+    pub(crate) fn system_id_of(&self, i: usize) -> Option<u8> {
+        match &self.world {
+            Some(w) => (i < w.num_agents()).then(|| (i + 1) as u8),
+            None => self.vehicles.get(i).map(|v| v.system_id),
+        }
     }
 
     fn vehicle_index(&self, system_id: u8) -> Option<usize> {
@@ -211,7 +243,7 @@ impl Sim {
 
     /// Appends `message` from vehicle index `i` on `link`.
     pub(crate) fn push(&mut self, link: Link, out: &mut Vec<u8>, i: usize, message: &MavMessage) {
-        let system_id = self.vehicles[i].system_id;
+        let system_id = self.system_id_of(i).unwrap_or(1);
         self.encoder(link).push(out, system_id, message);
     }
 
@@ -266,6 +298,7 @@ impl Sim {
             Link::Controller => self.stats.datagrams += 1,
             Link::Gcs => self.stats.gcs_datagrams += 1,
         }
+        self.world_repeat_sent = false;
         for frame in wire::frames(datagram) {
             match frame {
                 Ok(incoming) => {
@@ -286,6 +319,9 @@ impl Sim {
                 }
             }
         }
+        if self.world.is_some() {
+            self.end_world_datagram(link, from, now, out);
+        }
     }
 
     fn dispatch(
@@ -297,6 +333,9 @@ impl Sim {
         out: &mut Vec<u8>,
     ) {
         let peer = (link == Link::Controller).then(|| self.peer_index(from, now));
+        if self.world.is_some() {
+            return self.world_dispatch(link, from, incoming, peer, now, out);
+        }
         let Incoming { header, message } = incoming;
         match (&message, peer) {
             (MavMessage::HIL_ACTUATOR_CONTROLS(c), Some(p)) => {
