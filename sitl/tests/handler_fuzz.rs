@@ -107,7 +107,7 @@ fn sim() -> Sim {
 }
 
 /// The messages of a reply, decoded (sequence numbers left out).
-fn decoded(bytes: &[u8]) -> Vec<(u8, MavMessage)> {
+pub(crate) fn decoded(bytes: &[u8]) -> Vec<(u8, MavMessage)> {
     frames(bytes)
         .map(|f| {
             let f = f.unwrap();

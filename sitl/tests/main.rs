@@ -7,3 +7,4 @@ mod inject_failure;
 mod lockstep_over_udp;
 mod lockstep_resend;
 mod refused_controls;
+mod world_lockstep;
