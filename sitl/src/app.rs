@@ -491,6 +491,7 @@ fn start_world(args: Args, scenario: Scenario) -> Result<(), StartError> {
         (args.record.is_some(), "--record"),
         (args.list_params.is_some(), "--list-params"),
         (args.describe_frame, "--describe-frame"),
+        (args.model() != ModelKind::Quadrotor, "--model lander2d"),
     ];
     if let Some((_, option)) = not_here.iter().find(|(set, _)| *set) {
         return Err(StartError::Options(format!(

@@ -383,6 +383,17 @@ mod tests {
     }
 
     #[test]
+    fn a_multi_agent_task_is_a_world_of_quadrotors() {
+        let a = parse(&["--task", "swap", "--vehicles", "4"]).unwrap();
+        assert_eq!(a.world_task(), Some(Scenario::Swap));
+        assert_eq!(a.model(), ModelKind::Quadrotor);
+        assert!(a.task().unwrap_err().contains("multi-agent world"));
+        let a = parse(&["--task", "multi_hover"]).unwrap();
+        assert_eq!(a.world_task(), Some(Scenario::MultiHover));
+        assert_eq!(parse(&["--task", "hover"]).unwrap().world_task(), None);
+    }
+
+    #[test]
     fn bad_options_are_refused() {
         assert!(parse(&["--vehicles", "0"]).is_err());
         assert!(parse(&["--vehicles", "255"]).is_err());
