@@ -10,6 +10,7 @@ mod lander2d_landing;
 mod lander2d_model;
 mod lander2d_reward;
 mod multi_agent;
+mod multi_agent_faults;
 mod multirotor_frames;
 mod parameter_reference;
 mod quadrotor_golden;

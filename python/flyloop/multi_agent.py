@@ -50,12 +50,16 @@ middle and a straight flight always collides (docs/training.md "Swap").
 
 **Info** per agent: distance_to_target, position, target_position, step_count, episode_time,
 distance_progress, crashed, out_of_bounds, collided (this step), collision_speed (m/s),
-collisions (this episode), arrived, all_arrived, success, and randomized (the drawn values)
-with domain randomisation.
+collisions (this episode), arrived, all_arrived, success, randomized (the drawn values)
+with domain randomisation, and with faults the per-table slots (fault_kind, fault_target,
+fault_time, fault_active) and ``faults``, the active ones (docs/faults.md).
 
 **Arguments**: ``num_agents`` (1–65,536), ``interface`` ("motors" | "rates"),
 ``domain_randomization`` ({core parameter: (low, high)}, drawn per agent and episode from the
-seed), and any core parameter by name: the multi-agent task's (``neighbours``,
+seed), ``faults`` and ``fault_randomization`` (as QuadHover's, docs/faults.md; an entry is
+every agent's, or one agent's with ``"agent": "drone_1"``; drawn per agent from the episode's
+seed; the air faults — gust, wind shear — are refused: the world's wind field blows), and any
+core parameter by name: the multi-agent task's (``neighbours``,
 ``collision_penalty``, ``arrival_radius``, ``swap_radius``, ``swap_layer``,
 ``hover_spacing``), the world's (``wind_enabled`` — off by default here —,
 ``wind_speed_max``, ``collisions_enabled``, ``downwash_enabled``, …), the flight task's
@@ -71,6 +75,8 @@ from typing import Any
 import gymnasium
 import numpy as np
 
+from .faults import FAULTS_KEY, add_fault_list, plan_text
+
 ENV_TASKS = {
     "flyloop/MultiHover-v0": "multi_hover",
     "flyloop/Swap-v0": "swap",
@@ -83,18 +89,52 @@ ENV_DEFAULTS: dict[str, dict[str, Any]] = {
 _INTERFACES = ("motors", "rates")
 
 
+def _agent_index(where: str, agent: Any) -> int:
+    """An `agent` key's index: an integer, or an agent's name ``drone_i``."""
+    if isinstance(agent, str) and agent.startswith("drone_") and agent[6:].isdigit():
+        return int(agent[6:])
+    if isinstance(agent, int | np.integer) and not isinstance(agent, bool):
+        return int(agent)
+    raise ValueError(
+        f"{where}['agent'] must be an agent ('drone_0', ...) or its index, got {agent!r}"
+    )
+
+
+def _per_agent(arg: str, entries: Any) -> Any:
+    """`faults` / `fault_randomization` with each `agent` key as the core's index."""
+    if entries is None or isinstance(entries, str):
+        return entries
+    listed = [entries] if isinstance(entries, Mapping) else entries
+    out = []
+    for i, entry in enumerate(listed):
+        if isinstance(entry, Mapping) and "agent" in entry:
+            entry = {**entry, "agent": _agent_index(f"{arg}[{i}]", entry["agent"])}
+        out.append(entry)
+    return out
+
+
 def native_config(
     num_agents: int = 4,
     interface: str = "motors",
     domain_randomization: Mapping[str, tuple[float, float]] | None = None,
+    faults: Any = None,
+    fault_randomization: Any = None,
     **params: Any,
 ) -> dict[str, Any]:
-    """The extension's parameter dict for these arguments (errors name the argument)."""
+    """The extension's parameter dict for these arguments (errors name the argument).
+    `faults` / `fault_randomization` are the single-agent envs' (docs/faults.md), each
+    entry for every agent or, with an ``agent`` key (``"drone_1"`` or 1), for that one; the
+    config's ``faults`` holds their TOML text as a SITL config file does."""
     if isinstance(num_agents, bool) or not isinstance(num_agents, int | np.integer):
         raise TypeError(f"num_agents must be an integer, got {num_agents!r}")
     if interface not in _INTERFACES:
         raise ValueError(f"interface must be 'motors' or 'rates', got {interface!r}")
     config: dict[str, Any] = {"num_agents": int(num_agents), "rates_action": interface == "rates"}
+    text = plan_text(
+        _per_agent("faults", faults), _per_agent("fault_randomization", fault_randomization)
+    )
+    if text is not None:
+        config[FAULTS_KEY] = text
     for name, pair in (domain_randomization or {}).items():
         if not isinstance(pair, tuple | list) or len(pair) != 2:
             raise ValueError(f"domain_randomization[{name!r}] must be (low, high), got {pair!r}")
@@ -213,7 +253,10 @@ def _parallel_env_class():
         def _results(self, agents: list[str]):
             a = self._arrays
             obs = {g: a.obs[self._index[g]].copy() for g in agents}
-            infos = {g: _info_of(a.info[self._index[g]], self._info_layout) for g in agents}
+            infos = {
+                g: add_fault_list(_info_of(a.info[self._index[g]], self._info_layout))
+                for g in agents
+            }
             return obs, infos
 
         def reset(self, seed: int | None = None, options: dict | None = None):

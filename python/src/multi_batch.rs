@@ -8,7 +8,7 @@
 
 use crate::batch::{mut_of, mut_of1, slice_of, slice_of1};
 use flyloop_core::tasks::InfoRef;
-use flyloop_core::tasks::multi::{MultiConfig, MultiFlight, Scenario};
+use flyloop_core::tasks::multi::{AgentFaults, MultiConfig, MultiFlight, Scenario};
 use flyloop_core::tasks::randomization::ParamRange;
 use flyloop_core::tasks::registry::push_info;
 use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2, PyReadwriteArray1, PyReadwriteArray2};
@@ -19,6 +19,9 @@ use rayon::prelude::*;
 
 /// Prefix of a key that holds a randomisation range (as the single-agent tasks').
 const RANGE_PREFIX: &str = "randomize.";
+/// Key of the agents' fault tables: the TOML text of `[[faults]]` / `[[fault_randomization]]`
+/// tables with an optional `agent` (as a SITL config file holds them).
+const FAULTS_KEY: &str = "faults";
 
 /// A flat float64 array handed to Python.
 type Flat<'py> = Bound<'py, PyArray1<f64>>;
@@ -59,15 +62,27 @@ struct WorldRows<'a> {
     active: &'a mut [bool],
 }
 
-/// The config of a multi-agent task from `{core name: number}` and
-/// `{"randomize.<name>": (low, high)}`; errors carry the core's message.
+/// The config of a multi-agent task from `{core name: number}`,
+/// `{"randomize.<name>": (low, high)}` and `{"faults": TOML text}`; errors carry the core's
+/// message.
 fn multi_config(params: Option<&Bound<'_, PyDict>>) -> PyResult<MultiConfig> {
     let mut pairs: Vec<(String, f64)> = Vec::new();
     let mut ranges = Vec::new();
+    let mut faults = AgentFaults::default();
     for (key, value) in params.into_iter().flat_map(|p| p.iter()) {
         let name: String = key
             .extract()
             .map_err(|_| PyTypeError::new_err(format!("parameter names are strings, got {key}")))?;
+        if name == FAULTS_KEY {
+            let text: String = value.extract().map_err(|_| {
+                PyTypeError::new_err(format!(
+                    "`{FAULTS_KEY}` must be the TOML text of [[faults]] / [[fault_randomization]] tables, got {value}"
+                ))
+            })?;
+            faults = AgentFaults::from_toml_str(&text)
+                .map_err(|e| PyValueError::new_err(e.to_string()))?;
+            continue;
+        }
         if let Some(param) = name.strip_prefix(RANGE_PREFIX) {
             let (low, high): (f64, f64) = value.extract().map_err(|_| {
                 PyTypeError::new_err(format!(
@@ -89,6 +104,7 @@ fn multi_config(params: Option<&Bound<'_, PyDict>>) -> PyResult<MultiConfig> {
         pairs.push((name, number));
     }
     MultiConfig::from_values(pairs.iter().map(|(n, v)| (n.as_str(), *v)), ranges)
+        .and_then(|c| c.with_faults(faults))
         .map_err(|e| PyValueError::new_err(e.to_string()))
 }
 

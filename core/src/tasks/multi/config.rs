@@ -1,8 +1,10 @@
 //! Every parameter set a multi-agent task is built from, and the one way to build them from
 //! `(name, value)` pairs.
 
+use super::faults::AgentFaults;
 use super::params::MultiParams;
 use crate::error::ParamError;
+use crate::faults::Reach;
 use crate::params::Parameters;
 use crate::quadrotor::{Frame, QuadrotorParams};
 use crate::rate_loop::RateLoopParams;
@@ -23,6 +25,8 @@ pub struct MultiConfig {
     pub rate_loop: RateLoopParams,
     /// Per-agent, per-episode ranges of vehicle parameters (empty: off).
     pub randomize: Randomization,
+    /// The agents' faults, each table for one agent or all (empty: healthy vehicles).
+    pub faults: AgentFaults,
 }
 
 impl Default for MultiConfig {
@@ -37,6 +41,7 @@ impl Default for MultiConfig {
             quadrotor: QuadrotorParams::default(),
             rate_loop: RateLoopParams::default(),
             randomize: Randomization::none(),
+            faults: AgentFaults::default(),
         }
     }
 }
@@ -110,7 +115,30 @@ impl MultiConfig {
         self.flight.validate()?;
         self.quadrotor.validate()?;
         self.rate_loop.validate()?;
-        self.randomize.check(&self.vehicle())
+        self.randomize.check(&self.vehicle())?;
+        self.faults.check(
+            self.multi.num_agents,
+            &Reach {
+                duration: Some(self.flight.episode_duration()),
+                waypoints: None,
+                rotors: self.vehicle().frame.rotor_count(),
+            },
+        )
+    }
+
+    /// The config with the agents' `faults`, checked against it.
+    pub fn with_faults(mut self, faults: AgentFaults) -> Result<Self, ParamError> {
+        self.faults = faults;
+        self.validate()?;
+        Ok(self)
+    }
+
+    /// Agent `i`'s nominal vehicle with its faults.
+    pub fn agent_vehicle(&self, i: u32) -> VehicleParams {
+        VehicleParams {
+            faults: self.faults.plan(i),
+            ..self.vehicle()
+        }
     }
 
     /// Each agent's nominal vehicle (its own wind off: the world's blows).

@@ -24,11 +24,13 @@
 //! world's name order is the agent order. Same seed ⇒ same episode, bit for bit.
 
 pub mod config;
+pub mod faults;
 pub mod neighbours;
 pub mod params;
 pub mod scenario;
 
 pub use config::MultiConfig;
+pub use faults::AgentFaults;
 pub use params::MultiParams;
 pub use scenario::Scenario;
 
@@ -104,6 +106,8 @@ pub struct MultiFlight {
     out_of_bounds: f64,
     obs_low: Vec<f32>,
     obs_high: Vec<f32>,
+    /// Per agent, its own fault slot for each of the task's (empty without faults).
+    fault_slots: Vec<Vec<Option<usize>>>,
 }
 
 impl MultiFlight {
@@ -114,6 +118,24 @@ impl MultiFlight {
         let n = config.multi.num_agents as usize;
         let vehicle = config.vehicle();
         let (link, template) = FlightLink::new(vehicle.clone(), config.randomize.clone())?;
+        // Each agent flies its own fault plan; without faults they share the one link.
+        let links = if config.faults.is_empty() {
+            vec![link.clone(); n]
+        } else {
+            (0..config.multi.num_agents)
+                .map(|i| {
+                    let v = config.agent_vehicle(i);
+                    FlightLink::new(v, config.randomize.clone()).map(|(l, _)| l)
+                })
+                .collect::<Result<Vec<_>, _>>()?
+        };
+        let fault_slots = if config.faults.is_empty() {
+            Vec::new()
+        } else {
+            (0..config.multi.num_agents)
+                .map(|i| config.faults.slot_map(i))
+                .collect()
+        };
         check_separation(scenario, &config)?;
         let out_of_bounds = scenario.out_of_bounds(&config.multi, &config.flight);
         let (mut obs_low, mut obs_high) = link.observation_bounds(out_of_bounds);
@@ -136,7 +158,8 @@ impl MultiFlight {
         let world = World::new(config.world.clone(), 0, [(agent_name(0), template.clone())])?;
         let mut task = MultiFlight {
             scenario,
-            links: vec![link; n],
+            links,
+            fault_slots,
             template,
             world,
             targets: vec![Vector3::zeros(); n],
@@ -316,8 +339,13 @@ impl MultiFlight {
             if self.status[i].done {
                 let _ = self.world.set_command(i, &[0.0; ACTION_SIZE]);
             } else {
+                let quad = self.world.vehicle_mut(i);
+                // The world sets each vehicle's wind (a link's faults would set their own:
+                // air faults are refused in multi-agent tasks).
+                let wind = quad.external_wind;
                 // Checked in `step`: finite and 4 values.
-                let _ = self.links[i].begin(self.world.vehicle_mut(i), action, dt);
+                let _ = self.links[i].begin(quad, action, dt);
+                quad.external_wind = wind;
             }
         }
         let (mut now, end) = self.links[0].window(dt);
@@ -328,7 +356,7 @@ impl MultiFlight {
                 .fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.min(t))));
             let Some(tick) = next else { break };
             if tick > now {
-                self.world.step(tick - now);
+                self.step_world(tick - now);
                 now = tick;
             }
             for (i, link) in self.links.iter_mut().enumerate() {
@@ -341,12 +369,32 @@ impl MultiFlight {
             }
         }
         if end > now {
-            self.world.step(end - now);
+            self.step_world(end - now);
         }
         self.steps += 1;
         for (i, link) in self.links.iter_mut().enumerate() {
             if self.status[i].active {
                 link.finish(self.world.vehicle(i));
+            }
+        }
+    }
+
+    /// Steps the world by `dt`, the live agents' motors through their actuator fault paths
+    /// (without faults: the world's step alone).
+    fn step_world(&mut self, dt: f64) {
+        if self.fault_slots.is_empty() {
+            self.world.step(dt);
+            return;
+        }
+        for (i, link) in self.links.iter_mut().enumerate() {
+            if self.status[i].active {
+                link.before_advance(self.world.vehicle_mut(i), dt);
+            }
+        }
+        self.world.step(dt);
+        for (i, link) in self.links.iter_mut().enumerate() {
+            if self.status[i].active {
+                link.after_advance(self.world.vehicle_mut(i));
             }
         }
     }
@@ -450,7 +498,9 @@ impl MultiFlight {
     /// (m/s, largest closing speed of this step's collisions), collisions (this episode),
     /// arrived, all_arrived, success (Swap: every agent arrived and no agent collided or
     /// crashed this episode; MultiHover: this agent arrived and never collided), and the
-    /// randomised values when randomisation is on.
+    /// randomised values when randomisation is on, and with faults the fault slots
+    /// (`fault_kind`, `fault_target`, `fault_time`, `fault_active`: one value per table, see
+    /// [`faults`]).
     pub fn visit_info(&self, i: usize, visit: &mut InfoVisitor<'_>) {
         let s = &self.status[i];
         let quad = self.world.vehicle(i);
@@ -466,7 +516,17 @@ impl MultiFlight {
             Scenario::MultiHover => s.arrived && s.collisions == 0,
         };
         visit("success", InfoRef::Flag(success));
-        self.links[i].visit_info(visit);
+        let Some(slots) = self.fault_slots.get(i) else {
+            self.links[i].visit_info(visit);
+            return;
+        };
+        // Every agent reports every table's slot (module `faults`).
+        let mut own = Vec::new();
+        self.links[i].visit_info(&mut |name, value| match value {
+            InfoRef::Vector(v) if faults::is_slot_entry(name) => own.push((name, v.to_vec())),
+            other => visit(name, other),
+        });
+        faults::visit_slots(slots, &own, &mut Vec::new(), visit);
     }
 }
 
