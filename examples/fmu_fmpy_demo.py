@@ -20,11 +20,12 @@ def main(argv: list[str] | None = None) -> None:
     # runs/ is git-ignored: running the demo leaves the checkout clean.
     parser.add_argument("--out", type=Path, default=ROOT / "runs" / "demo" / "fmu_hover.png")
     args = parser.parse_args(argv)
-    # Motor commands, and no external wind (the model's own wind still blows).
+    # Motor commands, no external wind (the model's own wind still blows), healthy motors.
     names = [f"motor_command_{i}" for i in range(4)] + [f"wind_input_{a}" for a in "xyz"]
+    names += [f"motor_effectiveness_{i}" for i in range(4)]
     rows = [(0, *[HOVER] * 4), (2, *[HOVER] * 4), (2, *[HOVER + 0.03] * 4)]
     rows.append((6, *[HOVER + 0.03] * 4))
-    rows = [(*row, 0.0, 0.0, 0.0) for row in rows]
+    rows = [(*row, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0) for row in rows]
     u = np.array(rows, dtype=[("time", float)] + [(n, float) for n in names])
     result = simulate_fmu(
         str(ROOT / "dist" / "fmu" / "Quadrotor.fmu"),

@@ -38,7 +38,13 @@ PLANT = Component(
     "plant",
     "Quadrotor.fmu",
     {"seed": 1, "initial_z": START_Z, "initial_motor": HOVER, "wind_enabled": 0},
-    open_inputs=("wind_input_x", "wind_input_y", "wind_input_z"),  # no external wind
+    # No external wind; healthy motors (the effectiveness inputs keep their start value 1).
+    open_inputs=(
+        "wind_input_x",
+        "wind_input_y",
+        "wind_input_z",
+        *(f"motor_effectiveness_{i}" for i in range(4)),
+    ),
 )
 RATES = Component("rates", "RateController.fmu")
 

@@ -80,7 +80,9 @@ def test_the_hexacopter_has_a_command_and_a_state_per_rotor_after_the_quadrotors
         "wind_input_x",
         "wind_input_y",
         "wind_input_z",
-    ]
+    ] + [f"motor_effectiveness_{i}" for i in range(6)]
+    # The effectiveness inputs after the wind's: the earlier value references stay.
+    assert [vr[f"motor_effectiveness_{i}"] for i in (0, 5)] == [9, 14]
     assert [vr[f"motor_state_{i}"] for i in (0, 5)] == [119, 124]
     assert hexa.numberOfContinuousStates == 27 and hexa.numberOfEventIndicators == 4
     # The same parameters and start values under the same value references.

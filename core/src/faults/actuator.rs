@@ -75,6 +75,12 @@ pub fn motor_commands(
         if !lagged {
             lag.started[i] = false;
         }
-        *o = (command * gain.sqrt()).clamp(0.0, 1.0);
+        *o = weakened(command, gain);
     }
+}
+
+/// The command a motor of effectiveness `eta` gets for `command`: command·√η in [0, 1]
+/// (the vehicle's own per-rotor effectiveness, the FMUs' input, goes through this too).
+pub fn weakened(command: f64, eta: f64) -> f64 {
+    (command * eta.sqrt()).clamp(0.0, 1.0)
 }

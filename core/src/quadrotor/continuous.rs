@@ -102,7 +102,7 @@ impl Quadrotor {
             &self.params,
             self.frame(),
             &self.body,
-            &self.command(),
+            &self.motor_input(),
             &self.surroundings(),
         )
     }

@@ -7,6 +7,7 @@
 pub mod contact;
 pub mod continuous;
 pub mod dynamics;
+mod effectiveness;
 pub mod frame;
 mod mixing;
 pub mod model;

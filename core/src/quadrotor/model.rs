@@ -32,6 +32,9 @@ pub struct Quadrotor {
     pub external_force: Vector3<f64>,
     /// Motor commands in [0, 1], one per rotor, held until changed.
     command: Motors,
+    /// Per-rotor effectiveness η in [0, 1] (the FMU's `motor_effectiveness_i` inputs; see
+    /// `effectiveness.rs`); `None`: every rotor healthy, the motors get the command itself.
+    pub(super) effectiveness: Option<Motors>,
     /// Time since the last point of the physics grid, s, in [0, max_substep): 0 after any
     /// step that ends on the grid (see [`Quadrotor::step`]).
     grid_phase: f64,
@@ -60,6 +63,7 @@ impl Quadrotor {
             external_wind: Vector3::zeros(),
             external_force: Vector3::zeros(),
             command: Motors::from([0.0; 4]),
+            effectiveness: None,
             grid_phase: 0.0,
             rng,
             ou_cache: OuCache::default(),
@@ -73,6 +77,7 @@ impl Quadrotor {
         let n = frame.rotor_count();
         self.body = self.body.with_motor_count(n).unwrap_or(self.body);
         self.command = Motors::uniform(n, self.command[0]).unwrap_or(self.command);
+        self.effectiveness = None;
         self.frame = frame;
         self.constants = ConstantsCache::default();
         self
@@ -109,7 +114,7 @@ impl Quadrotor {
     }
 
     /// Starts a new episode in place: the vehicle at `body`, a fresh wind drawn from `rng`,
-    /// no external wind, the motors commanded to hold their state. The parameters stay as
+    /// no external wind, healthy motors commanded to hold their state. The parameters stay as
     /// they are (validated when the vehicle was built), so a restart cannot fail; the result
     /// is the vehicle `new(params, body, rng)` with that command.
     pub fn restart(&mut self, body: BodyState, mut rng: SimRng) {
@@ -118,6 +123,7 @@ impl Quadrotor {
         let body = body.with_motor_count(n).unwrap_or(body);
         self.command = Motors::uniform(n, body.motors[0].clamp(0.0, 1.0)).unwrap_or(self.command);
         self.body = body;
+        self.effectiveness = None;
         self.external_wind = Vector3::zeros();
         self.external_force = Vector3::zeros();
         self.grid_phase = 0.0;
@@ -198,6 +204,8 @@ impl Quadrotor {
         let sample_slack = GRID_SLACK * p.turbulence_dt;
         let wind_enabled = p.wind_enabled;
         let mut remaining = dt;
+        // What the motors get over the step: the command, or the command of weak motors.
+        let command = self.motor_input();
         loop {
             if grid - self.grid_phase <= grid_slack {
                 self.grid_phase = 0.0;
@@ -222,7 +230,7 @@ impl Quadrotor {
                 &self.frame,
                 constants,
                 &mut self.body,
-                &self.command,
+                &command,
                 &air,
                 piece,
             );
@@ -289,7 +297,7 @@ impl Quadrotor {
             &self.params,
             &self.frame,
             &self.body,
-            &self.command,
+            &self.motor_input(),
             &self.surroundings(),
         )
     }

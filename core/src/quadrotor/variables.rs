@@ -140,6 +140,22 @@ pub const MOTOR_COMMAND_NAMES: [&str; MAX_ROTORS] = [
     "motor_command_11",
 ];
 
+/// Names of the motor effectiveness inputs, by rotor index.
+pub const MOTOR_EFFECTIVENESS_NAMES: [&str; MAX_ROTORS] = [
+    "motor_effectiveness_0",
+    "motor_effectiveness_1",
+    "motor_effectiveness_2",
+    "motor_effectiveness_3",
+    "motor_effectiveness_4",
+    "motor_effectiveness_5",
+    "motor_effectiveness_6",
+    "motor_effectiveness_7",
+    "motor_effectiveness_8",
+    "motor_effectiveness_9",
+    "motor_effectiveness_10",
+    "motor_effectiveness_11",
+];
+
 /// Names of the motor state outputs, by rotor index.
 pub const MOTOR_STATE_NAMES: [&str; MAX_ROTORS] = [
     "motor_state_0",
@@ -163,6 +179,18 @@ type Setter = fn(&mut Quadrotor, f64) -> Result<(), InputError>;
 const GET_COMMAND: [Getter; MAX_ROTORS] = per_rotor!(get_command);
 const SET_COMMAND: [Setter; MAX_ROTORS] = per_rotor!(set_motor);
 const GET_MOTOR_STATE: [Getter; MAX_ROTORS] = per_rotor!(get_motor_state);
+const GET_EFFECTIVENESS: [Getter; MAX_ROTORS] = per_rotor!(get_effectiveness);
+const SET_EFFECTIVENESS: [Setter; MAX_ROTORS] = per_rotor!(set_effectiveness);
+
+fn get_effectiveness<const I: usize>(quad: &Quadrotor) -> f64 {
+    quad.motor_effectiveness(I)
+}
+
+fn set_effectiveness<const I: usize>(quad: &mut Quadrotor, value: f64) -> Result<(), InputError> {
+    check_finite("motor effectiveness", &[value]).map_err(|e| InputError { index: I, ..e })?;
+    quad.set_motor_effectiveness(I, value);
+    Ok(())
+}
 
 fn get_command<const I: usize>(quad: &Quadrotor) -> f64 {
     quad.command().get(I).copied().unwrap_or_default()
@@ -189,6 +217,26 @@ fn motor_commands(frame: &Frame) -> impl Iterator<Item = InputRow<Quadrotor>> + 
             [0.0, 1.0, 0.0],
             GET_COMMAND[i],
             SET_COMMAND[i],
+        )
+    })
+}
+
+/// Motor effectiveness inputs in [0, 1], starting at 1 (healthy), one per rotor of `frame`:
+/// the fault library's loss of effectiveness as an input (after the wind inputs, so the
+/// value references before them stay).
+fn motor_effectiveness(frame: &Frame) -> impl Iterator<Item = InputRow<Quadrotor>> + '_ {
+    (0..frame.rotor_count()).map(|i| InputRow {
+        description: Cow::Owned(format!(
+            "Effectiveness of motor {i} {}: fraction of its healthy thrust and torque at the same command (the motor gets command x sqrt(effectiveness)); 1 = healthy",
+            rotor_text(frame, i)
+        )),
+        ..InputRow::new(
+            MOTOR_EFFECTIVENESS_NAMES[i],
+            "1",
+            "",
+            [0.0, 1.0, 1.0],
+            GET_EFFECTIVENESS[i],
+            SET_EFFECTIVENESS[i],
         )
     })
 }
@@ -235,7 +283,9 @@ impl VariableTable for Quadrotor {
     type Shape = Frame;
 
     fn inputs(frame: &Frame) -> Vec<InputRow<Self>> {
-        motor_commands(frame).chain(WIND_INPUTS.to_vec()).collect()
+        (motor_commands(frame).chain(WIND_INPUTS.to_vec()))
+            .chain(motor_effectiveness(frame))
+            .collect()
     }
 
     fn outputs(frame: &Frame) -> Vec<OutputRow<Self>> {

@@ -116,6 +116,16 @@ impl Multirotor {
                     len: n,
                 },
                 Array {
+                    name: "motor_effectiveness",
+                    description: Cow::Owned(format!(
+                        "Effectiveness of the {count} motors, 0 .. 1 each (order of \
+                         motor_command; 1 = healthy): a weak motor gives this fraction of its \
+                         thrust and torque at the same command"
+                    )),
+                    first: "motor_effectiveness_0",
+                    len: n,
+                },
+                Array {
                     name: "motor_state",
                     description: Cow::Owned(format!(
                         "Lagged states of the {count} motors (order of motor_command)"
