@@ -9,13 +9,17 @@ return.
 The folder holds summary.json (which env and algorithm) and either model.zip and
 vecnormalize.pkl (a train_sb3.py output) or policy.pt (a fast_ppo.py output, OUT/native/):
 a training output or a shipped policy under policies/.
+    .venv/bin/python examples/train/evaluate.py policies/hover --env hover_motor_fault
+                                                             # on another preset's episodes
+
 The policy acts deterministically (the mean of its action distribution). Episode k has seed
 --seed-offset + k (--seed is the same option), so two evaluations with the same seeds fly
 the same episodes; the default seeds (1,000,000 and up) are never among the training seeds.
 
 What counts as a success:
-- hover (QuadHover-v0): the episode reaches the time limit (truncated: no crash, not out of
-  bounds) and ends within 0.5 m of the target;
+- hover, hover_motor_fault (QuadHover-v0; the latter through a weak motor): the episode
+  reaches the time limit (truncated: no crash, not out of bounds) and ends within 0.5 m of
+  the target;
 - lander, lander_moving, lander_v0 (Lander2D-v1 static or moving pad, Lander2D-v0): the
   drone landed on the platform (info['landed']); the touch-down speed relative to the
   platform and |angle| of the landings are reported too.
@@ -104,6 +108,20 @@ class SavedRun:
         return action[0]
 
 
+def preset_of(run: SavedRun | None, env: str | None):
+    """The preset episodes are flown on: `env` when given (a policy may fly another preset
+    of its env id, e.g. the hover policy on hover_motor_fault's faulty episodes), else the
+    run's own (random actions: hover)."""
+    if env is None:
+        return run.preset if run is not None else preset("hover")
+    p = preset(env)
+    if run is not None and p.env_id != run.preset.env_id:
+        raise ValueError(
+            f"--env {env} is {p.env_id}; the policy was trained on {run.preset.env_id}"
+        )
+    return p
+
+
 def evaluate(
     folder: Path | None,
     episodes: int,
@@ -113,13 +131,14 @@ def evaluate(
     backend: str = "native",
 ) -> dict[str, Any]:
     """Runs `episodes` episodes of the saved policy in `folder` (or of uniformly random
-    actions when folder is None; then `env` names the preset) and returns the figures."""
+    actions when folder is None) on the preset `env` (default: the policy's own, or hover)
+    and returns the figures."""
     if folder is not None:
         import torch
 
         torch.set_num_threads(1)
     run = SavedRun(folder) if folder is not None else None
-    p = run.preset if run is not None else preset(env or "hover")
+    p = preset_of(run, env)
     action = run.summary.get("action") if run is not None else None
     rng = np.random.default_rng(seed)
     e = make_env(p.name, action=action, backend=backend)
@@ -197,7 +216,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     )
     parser.add_argument("--random", action="store_true", help="evaluate random actions instead")
     parser.add_argument(
-        "--env", default="hover", help="with --random: hover, lander, lander_moving or lander_v0"
+        "--env",
+        help="the preset to fly (default: the policy's own; with --random hover): e.g. "
+        "hover_motor_fault flies a hover policy through a weak motor",
     )
     parser.add_argument(
         "--backend",
@@ -276,7 +297,7 @@ def record(
     from PIL import Image
 
     run = SavedRun(folder) if folder is not None else None
-    p = run.preset if run is not None else preset(env or "hover")
+    p = preset_of(run, env)
     action = run.summary.get("action") if run is not None else None
     e = make_env(p.name, action=action, render_mode="rgb_array")
     rng = np.random.default_rng(seed)

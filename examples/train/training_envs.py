@@ -190,6 +190,20 @@ PRESETS: dict[str, Preset] = {
 }
 
 
+# QuadHover with a weak motor (issue 35, docs/faults.md): every episode one motor of the quad X,
+# drawn from the episode's seed, loses up to half its effectiveness (thrust and reaction
+# torque at the same command) at a time drawn in the first half of the episode. The policy
+# sees it only through the motor states (the observation's motor commands are what it sent).
+MOTOR_FAULT_RANDOMIZATION = {
+    "kinds": ["motor_effectiveness"],
+    "at": (0.0, 2.5),
+    "effectiveness": (0.5, 1.0),
+}
+PRESETS["hover_motor_fault"] = replace(
+    PRESETS["hover"],
+    name="hover_motor_fault",
+    env_kwargs={**PRESETS["hover"].env_kwargs, "fault_randomization": MOTOR_FAULT_RANDOMIZATION},
+)
 # QuadHover on another of the core's frames (fast_ppo.py --frame): the hover preset with the
 # env's `frame`, one motor command per rotor. The quad X is "hover" itself.
 FRAMES = ("quad_plus", "hexa_x", "octo_x")
