@@ -41,22 +41,29 @@ def test_a_shipped_lander_policy_lands_on_held_back_seeds(name, episodes, requir
     assert result["landing_speed_max_m_s"] < 1.5 and result["landing_angle_max_rad"] < 0.2
 
 
+def held_back_hover(folder: Path, held_out_episodes: int) -> dict:
+    """A shipped fast_ppo hover policy: its summary's held-out evaluation (seeds from
+    1,000,000) must show >= 95 %; it then flies 50 held-back episodes of its own preset."""
+    import evaluate
+
+    summary = json.loads((folder / "summary.json").read_text())
+    assert summary["algo"] == "fast_ppo"
+    held_out = summary["evaluation"]
+    assert held_out["episodes"] == held_out_episodes and held_out["seed"] == 1_000_000
+    assert held_out["success_rate"] >= 0.95, held_out
+    result = evaluate.evaluate(folder, 50, HELD_BACK_SEEDS)
+    print(result)
+    assert result["env_id"] == "flyloop/QuadHover-v0"
+    return {**result, "summary": summary}
+
+
 def test_the_shipped_hexa_hover_policy_holds_its_targets_on_held_back_seeds():
     """policies/hexa_hover: fast_ppo.py --frame hexa_x (seed 0, 2M env steps), QuadHover on
     the hexacopter X with six motor commands. Shipped for 97 % held-out (100 episodes from
     1,000,000); measured 48 of 50 here. A policy meeting 95 % holds >= 43 of 50 with
     probability 0.99."""
-    import evaluate
-
-    folder = POLICIES / "hexa_hover"
-    summary = json.loads((folder / "summary.json").read_text())
-    assert summary["algo"] == "fast_ppo" and summary["env_kwargs"]["frame"] == "hexa_x"
-    held_out = summary["evaluation"]
-    assert held_out["episodes"] == 100 and held_out["seed"] == 1_000_000
-    assert held_out["success_rate"] >= 0.95, held_out
-    result = evaluate.evaluate(folder, 50, HELD_BACK_SEEDS)
-    print(result)
-    assert result["env_id"] == "flyloop/QuadHover-v0"
+    result = held_back_hover(POLICIES / "hexa_hover", 100)
+    assert result["summary"]["env_kwargs"]["frame"] == "hexa_x"
     assert result["success_rate"] >= 0.86, result
 
 
@@ -66,19 +73,11 @@ def test_the_shipped_weak_motor_policy_flies_through_a_weak_motor_on_held_back_s
     0-2.5 s. Shipped for 96 % held-out (200 faulty episodes from 1,000,000; the fault-free
     hover policy holds fewer of them, docs/training.md); 50 held-back faulty episodes here
     (measured 49 of 50). A policy meeting 95 % holds >= 43 of 50 with probability 0.99."""
-    import evaluate
-
-    folder = POLICIES / "hover_motor_fault"
-    summary = json.loads((folder / "summary.json").read_text())
-    assert summary["algo"] == "fast_ppo" and summary["env"] == "hover_motor_fault"
+    result = held_back_hover(POLICIES / "hover_motor_fault", 200)
+    summary = result["summary"]
+    assert summary["env"] == result["env"] == "hover_motor_fault"
     draw = summary["env_kwargs"]["fault_randomization"]
     assert draw["kinds"] == ["motor_effectiveness"] and draw["effectiveness"] == [0.5, 1.0]
-    held_out = summary["evaluation"]
-    assert held_out["episodes"] == 200 and held_out["seed"] == 1_000_000
-    assert held_out["success_rate"] >= 0.95, held_out
-    result = evaluate.evaluate(folder, 50, HELD_BACK_SEEDS)
-    print(result)
-    assert result["env"] == "hover_motor_fault"
     assert result["success_rate"] >= 0.86, result
 
 
