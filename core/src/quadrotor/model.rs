@@ -204,8 +204,9 @@ impl Quadrotor {
         let sample_slack = GRID_SLACK * p.turbulence_dt;
         let wind_enabled = p.wind_enabled;
         let mut remaining = dt;
-        // What the motors get over the step: the command, or the command of weak motors.
-        let command = self.motor_input();
+        // Weak motors get a weakened command (`effectiveness.rs`); healthy ones the command
+        // itself, with no copy made.
+        let weak = (self.effectiveness.as_ref()).map(|eta| Self::weaken(&self.command, eta));
         loop {
             if grid - self.grid_phase <= grid_slack {
                 self.grid_phase = 0.0;
@@ -230,7 +231,7 @@ impl Quadrotor {
                 &self.frame,
                 constants,
                 &mut self.body,
-                &command,
+                weak.as_ref().unwrap_or(&self.command),
                 &air,
                 piece,
             );
@@ -293,11 +294,12 @@ impl Quadrotor {
 
     /// Linear acceleration (world, total force / mass) and angular acceleration (body) now.
     pub fn accelerations(&self) -> (Vector3<f64>, Vector3<f64>) {
+        let weak = (self.effectiveness.as_ref()).map(|eta| Self::weaken(&self.command, eta));
         accelerations(
             &self.params,
             &self.frame,
             &self.body,
-            &self.motor_input(),
+            weak.as_ref().unwrap_or(&self.command),
             &self.surroundings(),
         )
     }
