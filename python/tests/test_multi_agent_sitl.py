@@ -58,6 +58,9 @@ def _info_bytes(info: dict) -> bytes:
     out = []
     for name in sorted(info):
         v = info[name]
+        if name == "faults":  # the active faults: a list of dicts
+            out.append(name.encode() + repr(v).encode())
+            continue
         out.append(name.encode() + np.asarray(v, np.float64).tobytes())
     return b"".join(out)
 
@@ -130,6 +133,32 @@ def test_native_and_sitl_give_the_same_bits_through_a_collision():
         sitl.close()
     assert collided, "no collision in 12 episodes of two vehicles 2 cm apart"
     assert a == b
+
+
+def test_native_and_sitl_give_the_same_bits_with_faults():
+    """The fault tables parallel_env writes into the SITL's --config reach the world as they
+    reach the in-process core (regression: the SITL refused `faults` as a non-number)."""
+    kwargs = dict(
+        num_agents=3,
+        max_steps=80,
+        faults=[{"kind": "motor_off", "motor": 2, "at": 0.2, "agent": "drone_1"}],
+        fault_randomization={"kinds": ["motor_effectiveness"], "at": (0.0, 0.5),
+                             "effectiveness": (0.5, 1.0)},
+    )  # fmt: skip
+    native = flyloop.parallel_env("flyloop/MultiHover-v0", **kwargs)
+    sitl = flyloop.parallel_env("flyloop/MultiHover-v0", backend="sitl", **kwargs)
+    try:
+        a, _ = _trace(native, (5, 6), 80, _random_actions)
+        b, _ = _trace(sitl, (5, 6), 80, _random_actions)
+        sitl.reset(seed=5)
+        for _ in range(40):  # past the written fault's 0.2 s
+            _, _, _, _, infos = sitl.step({ag: np.full(4, 0.6, np.float32) for ag in sitl.agents})
+    finally:
+        sitl.close()
+    assert len(a) > 100
+    assert a == b
+    fired = [f["fault"] for f in infos["drone_1"]["faults"]]
+    assert "motor_off:2" in fired, infos["drone_1"]["faults"]
 
 
 @pytest.mark.parametrize("backend", ["native", "sitl"])

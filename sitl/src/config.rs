@@ -219,9 +219,15 @@ pub fn load_world(
             let table: toml::Table = toml::from_str(text)?;
             let mut pairs = Vec::with_capacity(table.len());
             let mut ranges = Vec::new();
+            let mut faults = flyloop_core::tasks::multi::AgentFaults::default();
             for (key, value) in &table {
                 if key == RANDOMIZE_TABLE {
                     ranges = parse_ranges(value)?;
+                    continue;
+                }
+                // [[faults]] / [[fault_randomization]]: what parallel_env(faults=...) writes.
+                if key == "faults" || key == "fault_randomization" {
+                    faults.add(key, value)?;
                     continue;
                 }
                 let number = toml_number(value).ok_or_else(|| {
@@ -229,7 +235,7 @@ pub fn load_world(
                 })?;
                 pairs.push((key.clone(), number));
             }
-            world_config(vehicles, &pairs, ranges)
+            world_config(vehicles, &pairs, ranges)?.with_faults(faults)
         }),
     }
 }
