@@ -27,24 +27,31 @@ class PlotError(RuntimeError):
     """A file the plot cannot read, in one line."""
 
 
-def series_of_rrd(path: str | Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Entity path -> (sim time s, value) of every scalar series in an .rrd."""
+def _columns(path: str | Path, column: str):
+    """(entity path, sim times s, values) of every chunk of an .rrd on the simulation clock
+    that holds `column` (e.g. "Scalars:scalars")."""
     from .view import read_recording
 
     try:
         chunks = read_recording(path)
     except Exception as e:
         raise PlotError(f"{path}: not a readable Rerun recording ({e})") from None
-    parts: dict[str, list] = defaultdict(list)
     for c in chunks:
         if "sim_time" not in c.timeline_names:
             continue
         batch = c.to_record_batch()
-        if "Scalars:scalars" not in batch.schema.names:
+        if column not in batch.schema.names:
             continue
         t = batch.column("sim_time").cast("int64").to_numpy(zero_copy_only=False) / 1e9
-        v = [x[0] if x else math.nan for x in batch.column("Scalars:scalars").to_pylist()]
-        parts[str(c.entity_path)].append((t, np.asarray(v, float)))
+        yield str(c.entity_path), t, batch.column(column).to_pylist()
+
+
+def series_of_rrd(path: str | Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Entity path -> (sim time s, value) of every scalar series in an .rrd."""
+    parts: dict[str, list] = defaultdict(list)
+    for name, t, values in _columns(path, "Scalars:scalars"):
+        v = [x[0] if x else math.nan for x in values]
+        parts[name].append((t, np.asarray(v, float)))
     out = {}
     for name, pieces in parts.items():
         t = np.concatenate([p[0] for p in pieces])
@@ -54,14 +61,33 @@ def series_of_rrd(path: str | Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     return out
 
 
+def events_of_rrd(path: str | Path) -> list[tuple[float, str, str]]:
+    """(sim time s, entity path, text) of every event (text log line) in an .rrd, in time
+    order: collisions, faults that fired or ended, what a fleet and its autopilots said."""
+    out = []
+    for name, t, texts in _columns(path, "TextLog:text"):
+        out += [(float(ti), name, x[0] if x else "") for ti, x in zip(t, texts, strict=True)]
+    return sorted(out, key=lambda e: e[0])
+
+
 def series_of(path: str | Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """The scalar series of a recording: an .rrd as it is, a .tlog drawn into one first (the
     view's own scene, so the plot shows what the view shows)."""
+    return _read_as_rrd(path, series_of_rrd)
+
+
+def events_of(path: str | Path) -> list[tuple[float, str, str]]:
+    """The events of a recording (see `events_of_rrd`), an .rrd or a .tlog."""
+    return _read_as_rrd(path, events_of_rrd)
+
+
+def _read_as_rrd(path: str | Path, read):
+    """`read(rrd)` of a recording: an .rrd as it is, a .tlog replayed into one first."""
     path = Path(path)
     if not path.is_file():
         raise PlotError(f"{path}: no such file")
     if path.suffix != ".tlog":
-        return series_of_rrd(path)
+        return read(path)
     from .view import Viewer, ViewError
 
     with tempfile.TemporaryDirectory() as tmp:
@@ -73,7 +99,7 @@ def series_of(path: str | Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
             raise PlotError(str(e)) from None
         viewer.close()
         del viewer
-        return series_of_rrd(rrd)
+        return read(rrd)
 
 
 def series_of_ulg(path: str | Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:

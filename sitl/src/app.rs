@@ -179,11 +179,6 @@ fn start_px4(args: Args) -> Result<(), StartError> {
 /// lockstep until a signal.
 fn start_fleet(args: Args) -> Result<(), StartError> {
     use crate::fleet::{self, file};
-    if args.view.is_some() {
-        return Err(StartError::Options(
-            "--view flies one autopilot; fleet mode has no view yet".to_string(),
-        ));
-    }
     let mut spec = match &args.fleet {
         Some(path) => {
             let fleet_err = |source| StartError::FleetFile {
@@ -218,7 +213,8 @@ fn start_fleet(args: Args) -> Result<(), StartError> {
         v.vehicle.sensors.home_altitude = args.home.altitude_m;
     }
     let step_us = (args.px4_step * 1e6).round() as u64;
-    let fleet = fleet::Fleet::new(&spec, args.seed, step_us)?;
+    let mut fleet = fleet::Fleet::new(&spec, args.seed, step_us)?;
+    fleet_view_record(&args, &mut fleet.view_record)?;
     let sockets = fleet::server::bind(&fleet)
         .map_err(|(name, addr, source)| StartError::FleetBind { name, addr, source })?;
     let outputs = fleet_outputs(&args, &fleet)?;
@@ -355,15 +351,41 @@ fn session_outputs(
     if let Some(view) = view_stream(args)? {
         outputs.set_view(view);
     }
-    if let Some(path) = &args.record {
-        let recorder = crate::autopilot_record::AutopilotRecorder::create(path, args.home)
-            .map_err(|source| StartError::Record {
-                path: path.clone(),
-                source,
-            })?;
+    if let Some(recorder) = autopilot_recording(args)? {
         outputs.set_recording(recorder);
     }
     Ok(())
+}
+
+/// The fleet's live view stream and recording, as asked for: `--view`, `--record`.
+fn fleet_view_record(
+    args: &Args,
+    outputs: &mut crate::fleet::view_record::ViewRecord,
+) -> Result<(), StartError> {
+    if let Some(view) = view_stream(args)? {
+        outputs.set_view(view);
+    }
+    if let Some(recorder) = autopilot_recording(args)? {
+        outputs.set_recording(recorder);
+    }
+    Ok(())
+}
+
+/// The recording of the autopilot modes and the fleet (`--record`), if asked for.
+fn autopilot_recording(
+    args: &Args,
+) -> Result<Option<crate::autopilot_record::AutopilotRecorder>, StartError> {
+    let Some(path) = &args.record else {
+        return Ok(None);
+    };
+    let recorder =
+        crate::autopilot_record::AutopilotRecorder::create(path, args.home).map_err(|source| {
+            StartError::Record {
+                path: path.clone(),
+                source,
+            }
+        })?;
+    Ok(Some(recorder))
 }
 
 /// The live view's stream of the autopilot modes (`--view`), if asked for.
@@ -429,11 +451,6 @@ fn start_ardupilot(args: Args) -> Result<(), StartError> {
 
 fn start(args: Args) -> Result<(), StartError> {
     let fleet = args.fleet.is_some() || ((args.px4 || args.ardupilot) && args.vehicles > 1);
-    if fleet && args.record.is_some() {
-        return Err(StartError::Options(
-            "--record records one vehicle's autopilot, not a fleet (yet): use --track".to_string(),
-        ));
-    }
     if let Some(autopilot) = args.print_autopilot_params {
         let vehicle = vehicle_config(&args)?;
         let text = match autopilot {

@@ -10,6 +10,9 @@
 //! HIL_SENSOR and HIL_GPS frames as sent; ArduPilot: the JSON line's IMU as HIL_SENSOR with
 //! only the accel and gyro fields flagged). No task frame: an autopilot flight has no task.
 //! Nothing is encoded when no recording is made.
+//!
+//! Fleet mode ([`crate::fleet::outputs`]) writes the same per vehicle, each from its
+//! autopilot's system id ([`AutopilotRecorder::step_of`]), and the fleet's events.
 
 use crate::kinematics::Home;
 use crate::px4::messages::hil_imu;
@@ -30,8 +33,13 @@ const TRUTH_SYSTEM: u8 = 1;
 pub enum Sent<'a> {
     /// MAVLink frames as sent (PX4: HIL_SENSOR, HIL_GPS, HIL_STATE_QUATERNION if it asked).
     Frames(&'a [u8]),
+    /// The same as messages, encoded here from the vehicle's system id (a fleet's PX4s are
+    /// all sent their sensors from the simulator's system 1).
+    Messages(&'a [MavMessage]),
     /// The IMU values of ArduPilot's JSON line (its other fields are the truth).
     Imu(&'a ImuReading),
+    /// Nothing this step (a fleet vehicle whose autopilot was not due).
+    Nothing,
 }
 
 /// A recording of an autopilot flight being written.
@@ -41,8 +49,8 @@ pub struct AutopilotRecorder {
     encoder: Encoder,
     home: Home,
     frame: Vec<u8>,
-    /// Whether HOME_POSITION is still to be written (at the start of each connection).
-    home_due: bool,
+    /// The systems whose HOME_POSITION is written (since the last connection).
+    homes: Vec<u8>,
 }
 
 impl AutopilotRecorder {
@@ -53,13 +61,13 @@ impl AutopilotRecorder {
             encoder: Encoder::default(),
             home,
             frame: Vec::with_capacity(512),
-            home_due: true,
+            homes: Vec::new(),
         })
     }
 
     /// A new autopilot connection: its clock starts again, HOME_POSITION is written again.
     pub fn connect(&mut self) {
-        self.home_due = true;
+        self.homes.clear();
     }
 
     /// Appends a message the autopilot sent (from `system_id`) at simulation time `time_us`.
@@ -70,15 +78,31 @@ impl AutopilotRecorder {
         self.write();
     }
 
+    /// Appends messages from `system_id` at simulation time `time_us` (the fleet's events).
+    pub fn messages(&mut self, time_us: u64, system_id: u8, messages: &[MavMessage]) {
+        self.frame.clear();
+        for m in messages {
+            self.frame.extend_from_slice(&time_us.to_be_bytes());
+            self.encoder.push(&mut self.frame, system_id, m);
+        }
+        self.write();
+    }
+
     /// Appends the step that ended at `time_us`: truth, motor command, wind, sensor samples.
     pub fn step(&mut self, time_us: u64, vehicle: &dyn Vehicle, sent: Sent<'_>) {
+        self.step_of(TRUTH_SYSTEM, time_us, vehicle, sent);
+    }
+
+    /// [`Self::step`] of the vehicle whose autopilot has system id `system`.
+    pub fn step_of(&mut self, system: u8, time_us: u64, vehicle: &dyn Vehicle, sent: Sent<'_>) {
         self.frame.clear();
         let time = time_us.to_be_bytes();
         let k = vehicle.kinematics();
-        if std::mem::take(&mut self.home_due) {
+        if !self.homes.contains(&system) {
+            self.homes.push(system);
             let home = telemetry::home_position_of(&self.home, time_us);
             self.frame.extend_from_slice(&time);
-            self.encoder.push(&mut self.frame, TRUTH_SYSTEM, &home);
+            self.encoder.push(&mut self.frame, system, &home);
         }
         let mut messages = Vec::with_capacity(4);
         let mut has_state = false;
@@ -90,7 +114,15 @@ impl AutopilotRecorder {
                     self.frame.extend_from_slice(frame);
                 }
             }
+            Sent::Messages(sent) => {
+                for m in sent {
+                    has_state |= matches!(m, MavMessage::HIL_STATE_QUATERNION(_));
+                    self.frame.extend_from_slice(&time);
+                    self.encoder.push(&mut self.frame, system, m);
+                }
+            }
             Sent::Imu(imu) => messages.push(MavMessage::HIL_SENSOR(hil_imu(imu, time_us))),
+            Sent::Nothing => {}
         }
         if !has_state {
             messages.push(telemetry::hil_state_quaternion_of(&k, &self.home, time_us));
@@ -103,7 +135,7 @@ impl AutopilotRecorder {
         messages.push(telemetry::wind_cov_of(&k, time_us));
         for m in &messages {
             self.frame.extend_from_slice(&time);
-            self.encoder.push(&mut self.frame, TRUTH_SYSTEM, m);
+            self.encoder.push(&mut self.frame, system, m);
         }
         self.write();
     }

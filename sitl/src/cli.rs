@@ -124,14 +124,15 @@ pub struct Args {
     pub track: Option<PathBuf>,
 
     /// PX4 and ArduPilot modes: send the ground truth (HIL_STATE_QUATERNION at 50 Hz of
-    /// simulation time) to a live view listening at this UDP address (docs/view.md).
+    /// simulation time) to a live view listening at this UDP address (docs/view.md); in
+    /// fleet mode every vehicle's, with its motor commands, collisions and notices.
     #[arg(long)]
     pub view: Option<SocketAddr>,
 
     /// Record every step of every vehicle (motor command, ground truth, wind; the task frame
     /// in lockstep and real time; PX4 and ArduPilot mode: the sensor samples sent and the
-    /// autopilot's outputs) to this MAVLink telemetry log (.tlog; docs/view.md). Not in fleet
-    /// mode.
+    /// autopilot's outputs; fleet mode: every world step of every vehicle, collisions and
+    /// notices) to this MAVLink telemetry log (.tlog; docs/view.md).
     #[arg(long)]
     pub record: Option<PathBuf>,
 

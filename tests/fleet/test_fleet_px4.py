@@ -13,10 +13,11 @@ from px4_support import Px4, collect, fresh_dir, launch, settle, truth_vs_estima
 TAKEOFF_ALT = 5.0
 
 
-def start_fleet(started, sitl_binary, px4_dir, n: int, *args: str, talk=True, **params):
-    """flyloop-sitl with n PX4 vehicles and the n PX4s; with `talk`, each heard (its first
-    heartbeat: PX4 then answers this test's link only, so leave it out when another program
-    is to command them)."""
+def start_fleet(started, sitl_binary, px4_dir, n: int, *args: str, talk=True, speed=0, **params):
+    """flyloop-sitl with n PX4 vehicles (world time paced at `speed` × real time; 0: as
+    fast as they answer) and the n PX4s; with `talk`, each heard (its first heartbeat: PX4
+    then answers this test's link only, so leave it out when another program is to command
+    them)."""
     base = free_block(n, px4_ports_free, 10, 240)
     sitl = FleetSitl(
         sitl_binary,
@@ -27,6 +28,7 @@ def start_fleet(started, sitl_binary, px4_dir, n: int, *args: str, talk=True, **
         "--px4-listen",
         f"127.0.0.1:{4560 + base}",
         *args,
+        speed=speed,
     )
     started.append(sitl)
     px4s = []

@@ -32,6 +32,20 @@ def _ned(v) -> list[float]:
     return [y, x, -z]
 
 
+def draw_events(scene, name: str, info, position_ned, seen: dict[str, set]) -> None:
+    """The events in one env's (or agent's) info: a collision the world reported
+    (`collided`, `collision_speed`) and the faults that fired or ended since the last step
+    (`faults`, flyloop.faults.active_faults' list); `seen` keeps each name's active faults."""
+    if info.get("collided"):
+        scene.collision(name, position_ned, float(info.get("collision_speed", 0.0)))
+    if "faults" not in info:
+        return
+    active = {f["fault"] for f in info["faults"]}
+    before = seen.get(name, set())
+    scene.faults(name, sorted(active - before), sorted(before - active))
+    seen[name] = active
+
+
 def draw(scene, name: str, s, reward: float | None, terminated: bool, truncated: bool) -> None:
     """Draws one frame of an env (its QuadScene or LanderScene, the env's own render data)."""
     if hasattr(s, "quaternion"):  # the quadrotor, world ENU
@@ -52,6 +66,13 @@ def draw(scene, name: str, s, reward: float | None, terminated: bool, truncated:
         scene.task(name, reward, terminated, truncated)
 
 
+def _position(s) -> list[float]:
+    """The NED position `draw` puts a scene's vehicle at."""
+    if hasattr(s, "quaternion"):
+        return _ned(s.position)
+    return [0.0, float(s.position[0]), -float(s.position[1])]
+
+
 class _Watching:
     """What Watch and WatchVector share: the viewer, the simulation clock, reset and step."""
 
@@ -64,10 +85,12 @@ class _Watching:
         if self.viewer.url:
             print(f"flyloop.view: open {self.viewer.url}", flush=True)
         self._dt, self._t, self._episode = dt, 0.0, -1
+        self._faults: dict[str, set] = {}  # each vehicle's active faults, for their events
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         obs, info = self.env.reset(seed=seed, options=options)
         self._episode += 1
+        self._faults = {}  # a new episode's faults start afresh
         self.viewer.rec.set_time("episode", sequence=self._episode)
         self.viewer.scene.time(self._t)
         self._draw(obs, info, None, None, None)
@@ -101,6 +124,7 @@ class Watch(_Watching, gym.Wrapper):
     def _draw(self, obs, info, reward, terminated, truncated) -> None:
         s = self.env.unwrapped._scene(obs, info, reward)
         draw(self.viewer.scene, "vehicle1", s, reward, bool(terminated), bool(truncated))
+        draw_events(self.viewer.scene, "vehicle1", info, _position(s), self._faults)
 
     def close(self) -> None:
         self.viewer.close()
@@ -135,6 +159,7 @@ class WatchVector(_Watching, gym.vector.VectorWrapper):
         s = vector.SINGLE._scene(owner, obs[i], info, reward)
         ended = (False, False) if terminated is None else (terminated[i], truncated[i])
         draw(self.viewer.scene, f"env{i}", s, reward, bool(ended[0]), bool(ended[1]))
+        draw_events(self.viewer.scene, f"env{i}", info, _position(s), self._faults)
 
     def close(self, **kwargs):
         self.viewer.close()

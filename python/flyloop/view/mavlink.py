@@ -43,6 +43,11 @@ ESTIMATE_STREAMS = (
 GENERIC = mavlink2.MAV_AUTOPILOT_GENERIC
 AUTOPILOTS = {mavlink2.MAV_AUTOPILOT_PX4: "PX4", mavlink2.MAV_AUTOPILOT_ARDUPILOTMEGA: "ArduPilot"}
 ARRAY_LEN = 58  # DEBUG_FLOAT_ARRAY values per message (protocol.md §6)
+FLEET_SYSTEM = 250  # flyloop-sitl's fleet: its STATUSTEXT (docs/fleet.md)
+COLLISION = "collision"  # the NAMED_VALUE_FLOAT a fleet sends for each vehicle in a collision
+TEXT_CHUNK = 50  # STATUSTEXT characters per message: a longer text comes in chunks
+# MAV_SEVERITY → the events log's level
+LEVELS = ("CRITICAL", "CRITICAL", "CRITICAL", "ERROR", "WARN", "INFO", "INFO", "DEBUG")
 
 
 def enu_to_ned(v) -> list[float]:
@@ -86,6 +91,7 @@ class MavlinkScene:
         self.autopilots: dict[tuple, _Autopilot] = {}
         self.truth_messages = 0
         self.estimate_messages = 0
+        self._chunks: dict[tuple, list[str]] = {}  # (key, id) -> a long STATUSTEXT's chunks
 
     def _vehicle(self, sysid: int) -> _Vehicle:
         return self.vehicles.setdefault(sysid, _Vehicle())
@@ -186,6 +192,32 @@ class MavlinkScene:
             if v.frame is None:
                 v.frame = Frame.lander()
             self.scene.target(name, enu_to_ned([info[11], 0.0, info[12]]))
+
+    # ---- events: collisions, what the fleet and the autopilots say ----
+
+    def _on_named_value_float(self, key: tuple, m) -> None:
+        """A fleet's collision: vehicle `key`'s closing speed at the contact's time."""
+        if self.is_autopilot(key) or m.name.rstrip("\0") != COLLISION:
+            return
+        self.scene.time(m.time_boot_ms / 1e3)
+        position = self._vehicle(key[1]).position
+        self.scene.collision(f"vehicle{key[1]}", position, float(m.value))
+
+    def _on_statustext(self, key: tuple, m) -> None:
+        """A line from the fleet (its notices: collisions, autopilots gone, faults) or an
+        autopilot (its own messages), in the events log; chunks of a long one joined."""
+        text = m.text.rstrip("\0") if isinstance(m.text, str) else bytes(m.text).decode()
+        if m.id:
+            parts = self._chunks.setdefault((key, m.id), [])
+            parts.append(text)
+            if len(text) == TEXT_CHUNK:
+                return  # more chunks to come
+            text = "".join(self._chunks.pop((key, m.id)))
+        if self.is_autopilot(key):
+            name = f"vehicle{self._truth_of(key)}_autopilot"
+        else:
+            name = "fleet" if key[1] == FLEET_SYSTEM else f"vehicle{key[1]}"
+        self.scene.event(name, text, LEVELS[min(m.severity, len(LEVELS) - 1)])
 
     # ---- an autopilot's estimate ----
 

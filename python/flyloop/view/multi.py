@@ -1,12 +1,13 @@
 """WatchParallel: every agent of a flyloop multi-agent env (`flyloop.parallel_env`) in the
 live view and/or recorded to .rrd, at once: each vehicle with its trail, target and motor
-commands, its reward and episode end, and a red mark where it collided."""
+commands, its reward and episode end, and a red mark where it collided; collisions and the
+faults that fire or end as events (/events/AGENT)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from .env import _ned, _Watching
+from .env import _ned, _Watching, draw_events
 from .scene import Frame, quat_enu_to_ned
 
 
@@ -45,8 +46,7 @@ class WatchParallel(_Watching):
                 scene.motors(agent + "_command", o[at["motor_commands"]])
             if "target_position" in info:
                 scene.target(agent, _ned(info["target_position"]))
-            if info.get("collided"):
-                scene.collision(agent, position, float(info.get("collision_speed", 0.0)))
+            draw_events(scene, agent, info, position, self._faults)
             if rewards is not None:
                 scene.task(agent, rewards[agent], bool(terminated[agent]), bool(truncated[agent]))
 

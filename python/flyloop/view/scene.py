@@ -108,18 +108,22 @@ def _mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def blueprint() -> rrb.Blueprint:
-    """The layout: the 3D world beside the motor commands, position, attitude and rates over
-    time."""
+    """The layout: the 3D world above the events (collisions, faults, what a fleet and its
+    autopilots say), beside the motor commands, position, attitude, rates and the sensor
+    samples an autopilot was sent, over time."""
     # South-west of home, looking at 2 m up: the rotors show, and a climb to 5 m stays in view.
     eye = rrb.EyeControls3D(position=[-4.5, -4.5, -4.0], look_target=[0.0, 0.0, -2.0])
     world = rrb.Spatial3DView(origin="/world", name="world (NED)", eye_controls=eye)
+    events = rrb.TextLogView(origin="/events", name="events")
     plots = rrb.Vertical(
         rrb.TimeSeriesView(origin="/motors", name="motor commands"),
         rrb.TimeSeriesView(origin="/position", name="position (NED, m)"),
         rrb.TimeSeriesView(origin="/attitude", name="attitude (deg)"),
         rrb.TimeSeriesView(origin="/rates", name="body rates (deg/s)"),
+        rrb.TimeSeriesView(origin="/sensors", name="IMU sent (m/s², deg/s; FRD)"),
     )
-    return rrb.Blueprint(rrb.Horizontal(world, plots, column_shares=[3, 2]), collapse_panels=True)
+    left = rrb.Vertical(world, events, row_shares=[5, 1])
+    return rrb.Blueprint(rrb.Horizontal(left, plots, column_shares=[3, 2]), collapse_panels=True)
 
 
 class Scene:
@@ -225,7 +229,7 @@ class Scene:
 
     def sensors(self, name: str, accel_frd, gyro_frd) -> None:
         """An IMU sample the SITL sent an autopilot (m/s², rad/s as deg/s; body FRD), as
-        series under /sensors (in the recording; no panel of the default layout)."""
+        series under /sensors (the default layout's sensor panel)."""
         for axis, a, g in zip("xyz", accel_frd, gyro_frd, strict=True):
             self._log(f"/sensors/{name}/accel/{axis}", rr.Scalars(float(a)))
             self._log(f"/sensors/{name}/gyro/{axis}", rr.Scalars(math.degrees(float(g))))
@@ -238,6 +242,20 @@ class Scene:
         )
         self._log(f"/world/{name}_collision", mark)
         self._log(f"/task/{name}/collision_speed", rr.Scalars(speed))
+        self.event(name, f"collision, closing at {speed:.2f} m/s", "CRITICAL")
+
+    def event(self, name: str, text: str, level: str = "INFO") -> None:
+        """Something that happened (a fault fired, a collision, an autopilot gone): a line
+        in the events log under /events/`name`."""
+        self._log(f"/events/{name}", rr.TextLog(text, level=level))
+
+    def faults(self, name: str, fired: list[str], ended: list[str]) -> None:
+        """Faults that fired or ended at this time (labels as `flyloop.faults.active_faults`
+        gives them), as events."""
+        for label in fired:
+            self.event(name, f"fault {label} fired", "WARN")
+        for label in ended:
+            self.event(name, f"fault {label} ended")
 
     def target(self, name: str, target_ned) -> None:
         point = rr.Points3D(

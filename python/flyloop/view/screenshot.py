@@ -99,8 +99,10 @@ class Browser:
         except Exception as e:
             raise BrowserError(f"cannot open {url}: {str(e).splitlines()[0]}") from None
 
-    def screenshot(self, path: str | Path | None = None) -> bytes:
-        return self.page.screenshot(path=str(path) if path else None)
+    def screenshot(self, path: str | Path | None = None, timeout: float = 120.0) -> bytes:
+        """The page as PNG. The software rasteriser on a loaded machine can take tens of
+        seconds to finish a frame (playwright's default 30 s timed out at load 25)."""
+        return self.page.screenshot(path=str(path) if path else None, timeout=timeout * 1000)
 
     def wait_for_vehicle(
         self,

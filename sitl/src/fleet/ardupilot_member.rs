@@ -4,7 +4,7 @@ use crate::ardupilot::packet::{self, MAX_PWM, ServoFrame};
 use crate::ardupilot::reply::{self, State};
 use crate::ardupilot::session::frame_step_us;
 use crate::kinematics::attitude_ned;
-use flyloop_core::sensors::Sensors;
+use flyloop_core::sensors::{ImuReading, Sensors};
 use flyloop_core::vehicle::Kinematics;
 use std::net::SocketAddr;
 
@@ -112,8 +112,8 @@ impl ArduPilotMember {
         Some(outputs.iter().map(|&p| packet::motor_command(p)).collect())
     }
 
-    /// The state at `time_us` as the reply to the last frame.
-    pub fn answer(&mut self, k: &Kinematics, time_us: u64) {
+    /// The state at `time_us` as the reply to the last frame; returns the IMU sample in it.
+    pub fn answer(&mut self, k: &Kinematics, time_us: u64) -> ImuReading {
         let dt = (time_us.saturating_sub(self.last_us)).max(1) as f64 * 1e-6;
         self.last_us = time_us;
         let imu = self.sensors.sample_imu(k, dt);
@@ -129,6 +129,7 @@ impl ArduPilotMember {
         reply::write(&mut self.reply, &state);
         self.replied = self.last.map(|(count, _)| count);
         self.stats.steps += 1;
+        imu
     }
 
     /// Gone (timed out and a new ArduPilot expected): the next frame is a first one.

@@ -7,7 +7,8 @@
 //!   world's clock,
 //! - [`px4_member`], [`ardupilot_member`]: each autopilot's protocol, without sockets,
 //! - [`server`]: the sockets, the wall clock, the timeouts,
-//! - [`outputs`], [`track`]: what is written beside the flight (`--track`).
+//! - [`outputs`], [`track`]: what is written beside the flight (`--track`),
+//! - [`view_record`]: the live view's stream and the recording (`--view`, `--record`).
 //!
 //! [`Fleet`] ties them together without sockets: bytes from autopilot i in, bytes for it
 //! out, so the tests drive it directly.
@@ -19,6 +20,7 @@ pub mod outputs;
 pub mod px4_member;
 pub mod server;
 pub mod track;
+pub mod view_record;
 
 use ardupilot_member::{ArduPilotMember, Frame};
 use file::{Autopilot, FleetSpec};
@@ -30,6 +32,7 @@ use lockstep::{Advance, Hold, Lockstep, Phase};
 use mavlink::dialects::common::MavSeverity;
 use px4_member::{Px4Member, Said};
 use std::net::SocketAddr;
+use view_record::{Sample, ViewRecord};
 
 /// Why a fleet cannot start.
 #[derive(Debug, thiserror::Error)]
@@ -86,6 +89,8 @@ pub struct Fleet {
     pub stale_controls: u64,
     /// UNIX time of world time 0 (HIL_GPS stamps), µs.
     pub gps_epoch_us: u64,
+    /// The live view's stream and the recording, if asked for.
+    pub view_record: ViewRecord,
 }
 
 /// PX4's simulator step, µs (`--px4-step`).
@@ -146,6 +151,7 @@ impl Fleet {
             collisions: 0,
             stale_controls: 0,
             gps_epoch_us: 0,
+            view_record: ViewRecord::default(),
         })
     }
 
@@ -182,6 +188,7 @@ impl Fleet {
             }
             _ => tracing::warn!("{text}"),
         }
+        (self.view_record).notice(self.lockstep.now_us(), severity, &text);
         self.notices.push(Notice { severity, text });
     }
 
@@ -371,16 +378,29 @@ impl Fleet {
         }
         self.world.step(dt_us as f64 * 1e-6);
         let now = self.lockstep.now_us();
+        let mut sent = Vec::new();
         for &i in &due {
             let k = self.world.kinematics(i);
             let m = &mut self.members[i];
-            match &mut m.link {
-                Link::Px4(p) => p.emit(&k, now, &mut m.out),
-                Link::ArduPilot(a) => a.answer(&k, now),
+            let from = m.out.len();
+            let sample = match &mut m.link {
+                Link::Px4(p) => {
+                    p.emit(&k, now, &mut m.out);
+                    Sample::Px4From(from)
+                }
+                Link::ArduPilot(a) => Sample::Imu(a.answer(&k, now)),
+            };
+            if self.view_record.is_on() {
+                sent.push((i, sample));
             }
+        }
+        if self.view_record.is_on() {
+            (self.view_record).step(now, &self.world, &self.members, &sent);
         }
         for c in self.world.take_collisions() {
             self.collisions += 1;
+            let (a, b) = (self.members[c.a].sysid, self.members[c.b].sysid);
+            self.view_record.collision(now, c.time, a, b, c.speed);
             let text = format!(
                 "collision {} {} at t={:.3} s, closing at {:.2} m/s",
                 self.members[c.a].name, self.members[c.b].name, c.time, c.speed

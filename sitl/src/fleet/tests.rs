@@ -6,7 +6,7 @@ use mavlink::dialects::common::{
     HIL_ACTUATOR_CONTROLS_DATA, HilActuatorControlsFlags, MavModeFlag,
 };
 
-fn spec(positions: &[[f64; 2]]) -> FleetSpec {
+pub(crate) fn spec(positions: &[[f64; 2]]) -> FleetSpec {
     let base = "127.0.0.1:4560".parse().unwrap();
     let mut s = file::row(
         Autopilot::Px4,
@@ -23,7 +23,7 @@ fn spec(positions: &[[f64; 2]]) -> FleetSpec {
 }
 
 /// Controls answering PX4 i's last sensors.
-fn answer(f: &mut Fleet, i: usize, value: f32) {
+pub(crate) fn answer(f: &mut Fleet, i: usize, value: f32) {
     let t = f.lockstep().slot(i).time_us.max(1);
     f.px4_bytes(i, &controls(value, t));
 }
