@@ -2,8 +2,9 @@
 world with --view and --record; `python -m flyloop.view` hears every vehicle's truth on one
 port and talks to each PX4's ground-station port for its estimate (told apart by system id).
 Headless Chromium must draw both vehicles; the recording must hold both vehicles' truth at
-every world step (equal to what the view drew at its times), each PX4's sensor samples, and
-the collision when one is sent into the other, and the view must show it."""
+every world step (equal to the --track's, and to what the view drew at its times), each
+PX4's sensor samples, and the collision when one is sent into the other, and the view must
+show it."""
 
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from fleet_support import read_track
 from flyloop.plot import series_of
 from flyloop.view.screenshot import Browser, hub_pixels
 from px4_support import collect, launch, settle
@@ -43,8 +45,8 @@ def test_two_px4s_in_the_view_and_the_recording_with_their_collision(
     started, sitl_binary, px4_dir, tmp_path
 ):
     truth_port = free_port()
-    tlog, rrd = tmp_path / "fleet.tlog", tmp_path / "fleet.rrd"
-    view_args = ["--view", f"127.0.0.1:{truth_port}", "--record", str(tlog)]
+    tlog, rrd, track = tmp_path / "fleet.tlog", tmp_path / "fleet.rrd", tmp_path / "track.csv"
+    view_args = ["--view", f"127.0.0.1:{truth_port}", "--record", str(tlog), "--track", str(track)]
     sitl, (a, b) = start_fleet(started, sitl_binary, px4_dir, 2, *view_args, speed=1)
     web, grpc = free_port(socket.SOCK_STREAM), free_port(socket.SOCK_STREAM)
     view = subprocess.Popen(
@@ -101,8 +103,13 @@ def test_two_px4s_in_the_view_and_the_recording_with_their_collision(
     for s in systems:
         assert len(sensors[s]) > 0.4 * len(times[s]), (s, len(sensors[s]))
         assert set(np.diff(sensors[s][-500:])) == {STEP_US}
-    # Both climbed to the takeoff height; a hovered where PX4 estimated it (its local frame).
+    # The truth equals the track's (mm against the CSV's 0.1 mm) at every row of each vehicle.
     ground = homes[one].altitude / 1000
+    for s, rows in zip(systems, read_track(track).values(), strict=True):
+        down = {t: -(m.alt / 1000 - ground) for t, m in states[s]}
+        gap = [abs(down[int(r["time_us"])] - r["down"]) for r in rows if r["time_us"] in down]
+        assert len(gap) > 0.9 * len(rows) and max(gap) < 0.002, (s, len(gap), max(gap))
+    # Both climbed to the takeoff height; a hovered where PX4 estimated it (its local frame).
     height = {s: np.array([m.alt / 1000 - ground for _, m in states[s]]) for s in systems}
     assert height[one].max() > 4.5 and height[two].max() > 4.5
     at_hover = np.searchsorted(times[one], hover_a[0] * 1000)
