@@ -30,7 +30,7 @@ import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-for folder in ("sitl", "px4", "fleet"):
+for folder in ("sitl", "px4", "ardupilot", "fleet"):
     sys.path.insert(0, str(REPO / "tests" / folder))
 sys.path.insert(0, str(REPO / "benchmarks"))
 

@@ -1,6 +1,7 @@
 """Watch: a gym env (or one env of a vector env) in the live view and/or recorded to .rrd:
-the vehicle, its trail and target, wind, motor commands, rewards and episode ends, on the
-simulation clock (the steps' dt added up over the episodes)."""
+the vehicle, its trail and target, wind, motor commands, rewards and episode ends, and the
+faults that fire or end and the collisions its info reports as events, on the simulation
+clock (the steps' dt added up over the episodes)."""
 
 from __future__ import annotations
 
