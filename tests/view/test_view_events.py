@@ -81,3 +81,23 @@ def test_every_collision_of_a_multi_agent_env_is_an_event(tmp_path):
     series = series_of(tmp_path / "swap.rrd")
     for _, a, speed in collisions:
         assert speed in series[f"/task/{a}/collision_speed"][1]
+
+
+def test_a_fault_of_one_agent_is_its_event_only(tmp_path):
+    fault = {"kind": "motor_off", "motor": 3, "at": 0.1, "agent": "drone_1"}
+    env = WatchParallel(
+        flyloop.parallel_env("flyloop/MultiHover-v0", num_agents=2, faults=[fault]),
+        serve=False,
+        save=tmp_path / "multi.rrd",
+    )
+    env.reset(seed=0)
+    t, fired = 0.0, None
+    for _ in range(30):
+        _, _, _, _, infos = env.step({a: np.full(4, 0.5, np.float32) for a in env.agents})
+        t += float(env.dt)
+        if fired is None and infos["drone_1"]["faults"]:
+            fired = round(t, 9)
+        assert infos["drone_0"]["faults"] == []
+    env.close()
+    events = events_of(tmp_path / "multi.rrd")
+    assert events == [(fired, "/events/drone_1", "fault motor_off:3 fired")], events
