@@ -242,7 +242,8 @@ def test_a_rust_panic_becomes_a_python_exception():
 def test_a_hundred_thousand_quadhover_envs_fit_in_one_gigabyte():
     """The issue's memory bound, measured as resident-set growth in a fresh interpreter
     (benchmarks/gym_throughput.py's child): making, resetting and stepping 100,000 envs 5
-    times. Measured 215 MB (2.1 KiB per env) after one step, 511 MB as the peak over 500."""
+    times. Measured 669 MB (regression: 1,004 MB when every vehicle and every nominal
+    parameter set held its own copy of the frame's rotor table)."""
     import subprocess
     import sys
     from pathlib import Path

@@ -18,6 +18,7 @@ use super::mixing::Mixing;
 pub use super::rotor::{MAX_ROTORS, Rotor, Spin};
 use serde::{Deserialize, Serialize};
 use std::fmt;
+use std::sync::Arc;
 
 /// A frame as written: a name and its rotors, in motor order. This is what a config file
 /// holds (`[frame]` with `name` and one `[[frame.rotor]]` per rotor).
@@ -71,13 +72,21 @@ pub enum FrameError {
 #[derive(Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "FrameTable", into = "FrameTable")]
 pub struct Frame {
+    // Shared between clones: a frame is ~1.3 kB and every env holds several copies (the
+    // vehicle's, the nominal parameters', ...), which put 100,000 envs past 1 GB.
+    shared: Arc<FrameParts>,
+}
+
+/// What a frame holds, never changed once checked.
+#[derive(PartialEq)]
+struct FrameParts {
     table: FrameTable,
     mixing: Mixing,
 }
 
 impl fmt::Debug for Frame {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        self.table.fmt(f)
+        self.shared.table.fmt(f)
     }
 }
 
@@ -98,7 +107,7 @@ impl TryFrom<FrameTable> for Frame {
 
 impl From<Frame> for FrameTable {
     fn from(frame: Frame) -> Self {
-        frame.table
+        frame.shared.table.clone()
     }
 }
 
@@ -170,7 +179,9 @@ impl Frame {
             frame: table.name.clone(),
             axis,
         })?;
-        Ok(Frame { table, mixing })
+        Ok(Frame {
+            shared: Arc::new(FrameParts { table, mixing }),
+        })
     }
 
     /// A shipped frame by name: `quad_x`, `quad_plus`, `hexa_x`, `octo_x`.
@@ -212,29 +223,29 @@ impl Frame {
     }
 
     pub fn name(&self) -> &str {
-        &self.table.name
+        &self.shared.table.name
     }
 
     /// The rotors, in motor order.
     pub fn rotors(&self) -> &[Rotor] {
-        &self.table.rotors
+        &self.shared.table.rotors
     }
 
     pub fn rotor_count(&self) -> usize {
-        self.table.rotors.len()
+        self.shared.table.rotors.len()
     }
 
     pub fn table(&self) -> &FrameTable {
-        &self.table
+        &self.shared.table
     }
 
     pub(crate) fn mixing(&self) -> &Mixing {
-        &self.mixing
+        &self.shared.mixing
     }
 
     /// Whether this is the quad X the project flew before frames existed (same table).
     pub fn is_quad_x(&self) -> bool {
-        self.table.rotors == SHIPPED[0].1
+        self.shared.table.rotors == SHIPPED[0].1
     }
 }
 
