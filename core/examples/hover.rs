@@ -85,8 +85,8 @@ fn main() -> ExitCode {
     let mut episode_return = 0.0;
     let mut step = 0u32;
     loop {
-        let quad = task.quadrotor();
-        let action = pd_controller(&quad.params, &quad.body, &task.target());
+        let quad = task.air_vehicle();
+        let action = pd_controller(quad.params(), quad.body(), &task.target());
         let outcome = match task.step(&action) {
             Ok(outcome) => outcome,
             Err(e) => {
@@ -97,8 +97,8 @@ fn main() -> ExitCode {
         episode_return += outcome.reward;
         step += 1;
         if step % 100 == 0 || outcome.terminated || outcome.truncated {
-            let quad = task.quadrotor();
-            let (p, t) = (quad.body.position, task.target());
+            let quad = task.air_vehicle();
+            let (p, t) = (quad.body().position, task.target());
             println!(
                 "{:>6.2} {:>6.2} {:>7.2} {:>7.2} {:>6.2} {:>7.2} {:>7.2} {:>8.3} {:>7.3} {:>6.2}",
                 f64::from(step) * task.dt(),

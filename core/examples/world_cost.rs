@@ -51,7 +51,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         println!(
             "height of the first after {n} steps: {:.6} m",
-            world.vehicle(0).body.position.z
+            world.vehicle(0).body().position.z
         );
     }
     Ok(())

@@ -261,7 +261,7 @@ fn a_height_trigger_fires_when_the_vehicle_climbs_past_it() {
         task.step(&[0.6; 4]).unwrap();
         let t = vector(&task, "fault_time")[0];
         if t >= 0.0 && fired_at.is_none() {
-            fired_at = Some((t, task.quadrotor().body.position.z));
+            fired_at = Some((t, task.air_vehicle().body().position.z));
         }
     }
     let (t, z) = fired_at.unwrap();
@@ -356,7 +356,7 @@ fn a_hexa_loses_its_sixth_motor_and_refuses_a_seventh() {
     for _ in 0..100 {
         task.step(&[0.6; 6]).unwrap();
     }
-    let motors = task.quadrotor().body.motors;
+    let motors = task.air_vehicle().body().motors;
     assert_eq!(motors.len(), 6);
     // Spun down through the motor lag over the 1 s flown (from hover).
     assert!(motors[5] < 1e-4, "{motors:?}");
@@ -365,7 +365,7 @@ fn a_hexa_loses_its_sixth_motor_and_refuses_a_seventh() {
     }
     assert_eq!(vector(&task, "fault_target"), vec![6.0]);
     // The command read back is what was commanded, not what the faulted motor got.
-    assert_eq!(&task.quadrotor().command()[..], &[0.6; 6]);
+    assert_eq!(&task.air_vehicle().motor_command()[..], &[0.6; 6]);
     let e = from_values_ranges_and_faults(
         TaskKind::Hover,
         [],
@@ -396,7 +396,7 @@ fn an_injected_px4_motor_failure_stops_the_rotors_until_the_reset() {
     let TaskInstance::Hover(hover) = &task else {
         unreachable!()
     };
-    let motors = hover.quadrotor().body.motors;
+    let motors = hover.air_vehicle().body().motors;
     assert!(motors.iter().all(|m| *m < 1e-4), "{motors:?}");
     assert_eq!(vector(hover.as_ref(), "fault_active"), vec![1.0]);
     task.reset(0);

@@ -2,6 +2,7 @@
 //! its own binary meant one more link, with LTO in release, per file).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod air_vehicle_seam;
 mod faults;
 mod frame_tasks;
 mod lander2d_golden;

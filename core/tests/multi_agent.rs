@@ -77,13 +77,13 @@ fn same_seed_same_bits_on_both_interfaces_and_a_different_seed_differs() {
 fn swap_starts_on_a_circle_with_the_opposite_point_as_target() {
     let t = task(Scenario::Swap, &[("num_agents", 4.0), ("swap_radius", 2.5)]);
     for i in 0..4 {
-        let p = t.world().vehicle(i).body.position;
+        let p = t.world().vehicle(i).body().position;
         assert!((p.xy().norm() - 2.5).abs() < 1e-12);
         assert!((p.z - 1.5).abs() < 1e-12);
         let target = t.target(i);
         assert!((target.xy() + p.xy()).norm() < 1e-12, "{target} {p}");
         // Evenly spaced: the next agent a quarter turn on.
-        let q = t.world().vehicle((i + 1) % 4).body.position;
+        let q = t.world().vehicle((i + 1) % 4).body().position;
         assert!(((p.xy() - q.xy()).norm() - 2.5 * 2f64.sqrt()).abs() < 1e-9);
     }
 }
@@ -93,7 +93,7 @@ fn swap_layers_put_each_agent_on_its_own_height_from_start_to_target() {
     // 4 agents 0.6 m apart around the 1.5 m start height: 0.6, 1.2, 1.8 and 2.4 m.
     let t = task(Scenario::Swap, &[("num_agents", 4.0), ("swap_layer", 0.6)]);
     for (i, height) in [0.6, 1.2, 1.8, 2.4].into_iter().enumerate() {
-        let p = t.world().vehicle(i).body.position;
+        let p = t.world().vehicle(i).body().position;
         assert!((p.z - height).abs() < 1e-12, "agent {i}: {p}");
         assert!(
             (t.target(i).z - height).abs() < 1e-12,
@@ -117,8 +117,8 @@ fn neighbours_are_nearest_first_and_absent_slots_are_zero() {
     let mut obs = vec![0.0f32; size];
     t.write_observation(0, &mut obs);
     let (p0, p1) = (
-        t.world().vehicle(0).body.position,
-        t.world().vehicle(1).body.position,
+        t.world().vehicle(0).body().position,
+        t.world().vehicle(1).body().position,
     );
     let rel = p1 - p0;
     for k in 0..3 {
@@ -172,14 +172,14 @@ fn collide(scenario: Scenario, agents: f64) -> MultiFlight {
         &[("num_agents", agents), ("collision_penalty", 10.0)],
     );
     let (p0, p1) = (
-        t.world().vehicle(0).body.position,
-        t.world().vehicle(1).body.position,
+        t.world().vehicle(0).body().position,
+        t.world().vehicle(1).body().position,
     );
     let towards = (p0 - p1).normalize();
     // Close to touching, closing at 3 m/s.
     let v1 = t.world_mut().vehicle_mut(1);
-    v1.body.position = p0 - towards * 0.35;
-    v1.body.velocity = towards * 3.0;
+    v1.body_mut().position = p0 - towards * 0.35;
+    v1.body_mut().velocity = towards * 3.0;
     let hover = vec![0.2; 4 * agents as usize];
     for _ in 0..20 {
         t.step(&hover).unwrap();
@@ -222,7 +222,7 @@ fn hovering_in_place_truncates_every_agent_at_max_steps() {
         Scenario::MultiHover,
         &[("num_agents", 4.0), ("max_steps", 5.0)],
     );
-    let hover = t.world().vehicle(0).params.hover_motor_state().unwrap();
+    let hover = t.world().vehicle(0).params().hover_motor_state().unwrap();
     for step in 1..=5 {
         t.step(&[hover; 16]).unwrap();
         assert_eq!((0..4).all(|i| t.outcome(i).truncated), step == 5);
@@ -242,7 +242,7 @@ fn each_agent_draws_its_own_vehicle_and_the_seed_repeats_it() {
             .unwrap();
     let mut t = MultiFlight::new(Scenario::Swap, config).unwrap();
     t.reset(4).unwrap();
-    let masses: Vec<f64> = (0..3).map(|i| t.world().vehicle(i).params.mass).collect();
+    let masses: Vec<f64> = (0..3).map(|i| t.world().vehicle(i).params().mass).collect();
     assert!(
         masses[0] != masses[1] && masses[1] != masses[2],
         "{masses:?}"
@@ -250,7 +250,7 @@ fn each_agent_draws_its_own_vehicle_and_the_seed_repeats_it() {
     assert_eq!(info(&t, 1, "randomized"), format!("{:?}", [masses[1]]));
     t.reset(5).unwrap();
     t.reset(4).unwrap();
-    let again: Vec<f64> = (0..3).map(|i| t.world().vehicle(i).params.mass).collect();
+    let again: Vec<f64> = (0..3).map(|i| t.world().vehicle(i).params().mass).collect();
     assert_eq!(masses, again);
 }
 

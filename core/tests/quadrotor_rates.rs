@@ -63,12 +63,12 @@ fn rates_interface_declares_px4s_action_and_16_observations() {
 fn hover_thrust_and_zero_rates_hold_the_vehicle() {
     let mut task = hover_task(rates_flight(), vec![]);
     task.reset(3);
-    let start = task.quadrotor().body.position;
+    let start = task.air_vehicle().body().position;
     for _ in 0..100 {
         let out = task.step(&[hover_thrust(), 0.0, 0.0, 0.0]).unwrap();
         assert!(!out.terminated);
     }
-    let b = &task.quadrotor().body;
+    let b = task.air_vehicle().body();
     assert!(
         (b.position - start).norm() < 0.05,
         "drifted to {}",
@@ -85,7 +85,7 @@ fn a_roll_rate_step_is_followed_with_px4s_sign() {
     let mut rates = Vec::new();
     for _ in 0..10 {
         task.step(&[hover_thrust(), 1.0, 0.0, 0.0]).unwrap();
-        rates.push(flu_to_frd(&task.quadrotor().body.body_rates));
+        rates.push(flu_to_frd(&task.air_vehicle().body().body_rates));
     }
     let after_100ms = rates[4];
     let after_200ms = rates[9];
@@ -107,7 +107,7 @@ fn a_roll_rate_step_is_followed_with_px4s_sign() {
         for _ in 0..15 {
             task.step(&action).unwrap();
         }
-        let r = flu_to_frd(&task.quadrotor().body.body_rates);
+        let r = flu_to_frd(&task.air_vehicle().body().body_rates);
         assert!(r[axis] > 0.6, "axis {axis}: {r}");
     }
 }
@@ -130,15 +130,15 @@ fn latency_delays_the_setpoint_by_whole_rate_loop_ticks() {
     }
     now.step(&roll).unwrap();
     late.step(&roll).unwrap();
-    assert!(now.quadrotor().body.body_rates.x > 0.05);
+    assert!(now.air_vehicle().body().body_rates.x > 0.05);
     assert!(
-        late.quadrotor().body.body_rates.x.abs() < 1e-3,
+        late.air_vehicle().body().body_rates.x.abs() < 1e-3,
         "{}",
-        late.quadrotor().body.body_rates
+        late.air_vehicle().body().body_rates
     );
     late.step(&roll).unwrap();
     late.step(&roll).unwrap();
-    assert!(late.quadrotor().body.body_rates.x > 0.05);
+    assert!(late.air_vehicle().body().body_rates.x > 0.05);
 }
 
 #[test]
@@ -151,8 +151,8 @@ fn any_control_period_works_on_the_rate_loops_own_grid() {
     for _ in 0..200 {
         task.step(&[hover_thrust(), 0.0, 0.0, 0.0]).unwrap();
     }
-    assert!(task.quadrotor().body.body_rates.norm() < 0.01);
-    assert!((task.quadrotor().body.position.z - 1.5).abs() < 0.05);
+    assert!(task.air_vehicle().body().body_rates.norm() < 0.01);
+    assert!((task.air_vehicle().body().position.z - 1.5).abs() < 0.05);
 }
 
 #[test]
@@ -204,7 +204,7 @@ fn same_seed_same_randomised_vehicle_noise_and_trajectory_bit_for_bit() {
             .find(|(n, _)| *n == "randomized")
             .unwrap()
             .1;
-        (trace, drawn, task.quadrotor().params.mass)
+        (trace, drawn, task.air_vehicle().params().mass)
     };
     let (a, da, ma) = run(11);
     let (b, db, mb) = run(11);
@@ -256,7 +256,7 @@ fn observation_noise_moves_the_observation_not_the_vehicle() {
         let (n, c) = (noisy.observation(), clean.observation());
         diffs.push((n[0] - c[0]) as f64);
     }
-    assert_eq!(noisy.quadrotor().body, clean.quadrotor().body);
+    assert_eq!(noisy.air_vehicle().body(), clean.air_vehicle().body());
     let std = (diffs.iter().map(|d| d * d).sum::<f64>() / diffs.len() as f64).sqrt();
     assert!((std - 0.1).abs() < 0.03, "position noise std {std}");
 }
@@ -277,7 +277,7 @@ fn waypoints_fly_the_rates_interface_with_its_frame() {
     task.step(&[hover_thrust(), 0.0, 0.0, 0.0]).unwrap();
     let obs = task.observation();
     // Next waypoint offset in the heading frame has the same length as in the world.
-    let next = task.next_waypoint() - task.quadrotor().body.position;
+    let next = task.next_waypoint() - task.air_vehicle().body().position;
     let seen = nalgebra::Vector3::new(obs[16] as f64, obs[17] as f64, obs[18] as f64);
     assert!((seen.norm() - next.norm()).abs() < 1e-5, "{seen} vs {next}");
     assert!((seen.z + next.z).abs() < 1e-5, "down is minus up");

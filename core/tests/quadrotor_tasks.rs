@@ -25,7 +25,7 @@ fn info_flag(task: &dyn Task, name: &str) -> bool {
 }
 
 fn hover_command(task: &Hover) -> [f64; 4] {
-    [task.quadrotor().params.hover_motor_state().unwrap(); 4]
+    [task.air_vehicle().params().hover_motor_state().unwrap(); 4]
 }
 
 #[test]
@@ -51,7 +51,7 @@ fn a_step_pays_the_reward_of_the_state_it_ends_in() {
     let mut task = hover_task(FlightParams::default());
     task.reset(3);
     let outcome = task.step(&hover_command(&task)).unwrap();
-    let expected = hover_reward(task.params(), &task.quadrotor().body, &task.target());
+    let expected = hover_reward(task.params(), task.air_vehicle().body(), &task.target());
     assert_eq!(outcome.reward, expected);
     assert!(!outcome.terminated && !outcome.truncated);
 }
@@ -61,16 +61,16 @@ fn reset_samples_the_documented_start_and_target() {
     let mut task = hover_task(FlightParams::default());
     for seed in 0..200 {
         task.reset(seed);
-        let body = task.quadrotor().body;
+        let body = *task.air_vehicle().body();
         assert_eq!(body.position, Vector3::new(0.0, 0.0, 1.5));
         assert_eq!(body.velocity, Vector3::zeros());
         let (roll, pitch, yaw) = body.euler_angles();
         assert!(
             roll.abs() <= 0.1 + 1e-12 && pitch.abs() <= 0.1 + 1e-12 && yaw.abs() <= 0.1 + 1e-12
         );
-        let hover = task.quadrotor().params.hover_motor_state().unwrap();
+        let hover = task.air_vehicle().params().hover_motor_state().unwrap();
         assert_eq!(body.motors, [hover; 4]);
-        assert_eq!(task.quadrotor().command(), [hover; 4]);
+        assert_eq!(task.air_vehicle().motor_command(), [hover; 4]);
         let t = task.target();
         assert!(t.x.abs() <= 1.5 && t.y.abs() <= 1.5 && (0.0..=3.0).contains(&t.z));
         assert!((t - body.position).norm() >= 1.0);
@@ -104,12 +104,14 @@ fn observation_layout_of_a_hand_built_state() {
     task.reset(0);
     task.set_target(Vector3::new(1.0, -1.0, 2.0));
     {
-        let quad = task.quadrotor_mut();
-        quad.body = BodyState::at_rest(Vector3::new(0.5, 0.5, 1.0), 0.0, 0.0, 0.0, 0.3);
-        quad.body.velocity = Vector3::new(1.0, 2.0, -3.0);
-        quad.body.body_rates = Vector3::new(0.1, -0.2, 0.3);
-        quad.external_wind = -quad.wind.velocity() + Vector3::new(2.0, -1.0, 0.5);
-        quad.set_command([0.1, 0.2, 0.3, 0.4]).unwrap();
+        let quad = task.air_vehicle_mut();
+        *quad.body_mut() = BodyState::at_rest(Vector3::new(0.5, 0.5, 1.0), 0.0, 0.0, 0.0, 0.3);
+        quad.body_mut().velocity = Vector3::new(1.0, 2.0, -3.0);
+        quad.body_mut().body_rates = Vector3::new(0.1, -0.2, 0.3);
+        // No external wind after a reset: the total is the vehicle's own.
+        let own = quad.wind_velocity();
+        quad.set_external_wind(-own + Vector3::new(2.0, -1.0, 0.5));
+        quad.set_actuators(&[0.1, 0.2, 0.3, 0.4]).unwrap();
     }
     let obs = task.observation();
     assert_eq!(obs.len(), 33);
@@ -120,7 +122,7 @@ fn observation_layout_of_a_hand_built_state() {
     };
     close(&obs[0..3], &[0.5, -1.5, 1.0]);
     close(&obs[3..6], &[1.0, 2.0, -3.0]);
-    let (acc, ang) = task.quadrotor().accelerations();
+    let (acc, ang) = task.air_vehicle().accelerations();
     close(&obs[6..9], acc.as_slice());
     close(&obs[9..13], &[1.0, 0.0, 0.0, 0.0]);
     close(&obs[13..16], &[0.1, -0.2, 0.3]);
@@ -186,7 +188,7 @@ fn crash_terminates_on_tilt_fall_speed_and_ground() {
     for (name, mutate) in cases {
         task.reset(1);
         task.set_target(Vector3::new(0.0, 0.0, 1.5));
-        mutate(&mut task.quadrotor_mut().body);
+        mutate(task.air_vehicle_mut().body_mut());
         let mut outcome = task.step(&h).unwrap();
         for _ in 0..20 {
             if outcome.terminated {
@@ -200,7 +202,7 @@ fn crash_terminates_on_tilt_fall_speed_and_ground() {
     }
     // 79° is not a crash.
     task.reset(1);
-    task.quadrotor_mut().body = BodyState::at_rest(
+    *task.air_vehicle_mut().body_mut() = BodyState::at_rest(
         Vector3::new(0.0, 0.0, 1.5),
         79f64.to_radians(),
         0.0,
@@ -213,7 +215,7 @@ fn crash_terminates_on_tilt_fall_speed_and_ground() {
         enable_crash_detection: false,
         ..Default::default()
     });
-    lenient.quadrotor_mut().body.velocity.z = -25.0;
+    lenient.air_vehicle_mut().body_mut().velocity.z = -25.0;
     assert!(!lenient.step(&h).unwrap().terminated);
     assert!(!info_flag(&lenient, "crashed"));
 }
@@ -260,7 +262,7 @@ fn target_changes_every_interval() {
     task.step(&h).unwrap();
     let second = task.target();
     assert_ne!(second, first);
-    assert!((second - task.quadrotor().body.position).norm() >= 1.0);
+    assert!((second - task.air_vehicle().body().position).norm() >= 1.0);
 }
 
 #[test]
@@ -323,8 +325,8 @@ fn waypoint_task(params: WaypointParams) -> Waypoints {
 
 /// Puts the vehicle on `position` at rest, motors at hover.
 fn place(task: &mut Waypoints, position: Vector3<f64>) -> [f64; 4] {
-    let h = task.quadrotor().params.hover_motor_state().unwrap();
-    task.quadrotor_mut().body = BodyState::at_rest(position, 0.0, 0.0, 0.0, h);
+    let h = task.air_vehicle().params().hover_motor_state().unwrap();
+    *task.air_vehicle_mut().body_mut() = BodyState::at_rest(position, 0.0, 0.0, 0.0, h);
     [h; 4]
 }
 
@@ -337,7 +339,7 @@ fn checkpoint_bonus_is_paid_on_the_reaching_step() {
     let first = task.waypoints()[0];
     let h = place(&mut task, first);
     let out = task.step(&h).unwrap();
-    let mean_motor = task.quadrotor().body.motors.iter().sum::<f64>() / 4.0;
+    let mean_motor = task.air_vehicle().body().motors.iter().sum::<f64>() / 4.0;
     let expected = (10.0 - 2.0 * 0.01) + 0.5 * mean_motor;
     assert!(
         (out.reward - expected).abs() < 1e-12,
@@ -361,7 +363,7 @@ fn the_bonus_decays_with_time_but_never_below_one() {
     place(&mut task, first);
     let out = task.step(&h).unwrap();
     // 3 s since the start: 10 − 2·3 = 4.
-    let mean_motor = task.quadrotor().body.motors.iter().sum::<f64>() / 4.0;
+    let mean_motor = task.air_vehicle().body().motors.iter().sum::<f64>() / 4.0;
     assert!(
         (out.reward - (4.0 + 0.5 * mean_motor)).abs() < 1e-9,
         "{}",
@@ -377,7 +379,7 @@ fn the_bonus_decays_with_time_but_never_below_one() {
     place(&mut task, second);
     let out = task.step(&h).unwrap();
     assert_eq!(task.waypoints_reached(), 2);
-    let mean_motor = task.quadrotor().body.motors.iter().sum::<f64>() / 4.0;
+    let mean_motor = task.air_vehicle().body().motors.iter().sum::<f64>() / 4.0;
     assert!(
         (out.reward - (1.0 + 0.5 * mean_motor)).abs() < 1e-12,
         "{}",
@@ -392,16 +394,16 @@ fn far_from_the_waypoint_the_reward_is_the_closing_speed_plus_the_motor_bonus() 
     let wp = task.waypoints()[0];
     // Horizontal offsets keep the vehicle clear of the ground whatever the waypoint's height.
     let h = place(&mut task, wp - Vector3::new(2.0, 0.0, 0.0));
-    task.quadrotor_mut().body.velocity = Vector3::new(3.0, 0.0, 0.0);
+    task.air_vehicle_mut().body_mut().velocity = Vector3::new(3.0, 0.0, 0.0);
     let out = task.step(&h).unwrap();
-    let b = task.quadrotor().body;
+    let b = *task.air_vehicle().body();
     let d = wp - b.position;
     let closing = b.velocity.dot(&(d / (d.norm() + 1e-8)));
     let mean_motor = b.motors.iter().sum::<f64>() / 4.0;
     assert!((out.reward - ((closing / 3.0).tanh() + 0.5 * mean_motor)).abs() < 1e-12);
     // Flying away: negative, no motor bonus.
     let h = place(&mut task, wp - Vector3::new(2.0, 0.0, 0.0));
-    task.quadrotor_mut().body.velocity = Vector3::new(-3.0, 0.0, 0.0);
+    task.air_vehicle_mut().body_mut().velocity = Vector3::new(-3.0, 0.0, 0.0);
     let out = task.step(&h).unwrap();
     assert!(out.reward < 0.0 && out.reward > -1.0);
 }
@@ -456,7 +458,7 @@ fn waypoint_observation_appends_next_waypoint_and_time() {
     }
     let obs = task.observation();
     assert_eq!(obs.len(), 37);
-    let p = task.quadrotor().body.position;
+    let p = task.air_vehicle().body().position;
     let current = task.waypoints()[0] - p;
     let next = task.waypoints()[1] - p;
     for i in 0..3 {

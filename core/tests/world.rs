@@ -5,6 +5,7 @@
 
 use flyloop_core::quadrotor::{BodyState, Frame, Quadrotor, QuadrotorParams};
 use flyloop_core::rng::SimRng;
+use flyloop_core::vehicle::AirVehicle;
 use flyloop_core::world::{World, WorldError, WorldParams};
 use nalgebra::Vector3;
 
@@ -36,8 +37,8 @@ fn hovering(
     quad
 }
 
-fn bits(q: &Quadrotor) -> Vec<u64> {
-    let b = &q.body;
+fn bits(q: &dyn AirVehicle) -> Vec<u64> {
+    let b = q.body();
     (b.position
         .iter()
         .chain(&b.velocity)
@@ -188,8 +189,8 @@ fn a_head_on_collision_bounces_conserves_momentum_and_is_reported_once() {
     // They met when 0.3 m apart: after (1 − 0.3) / 4 = 0.175 s, at the grid point after.
     assert!((0.175..0.185).contains(&c.time), "{}", c.time);
     let (va, vb) = (
-        world.vehicle(0).body.velocity,
-        world.vehicle(1).body.velocity,
+        world.vehicle(0).body().velocity,
+        world.vehicle(1).body().velocity,
     );
     assert!(va.x < -0.5 && vb.x > 0.5, "bounced: {va} {vb}");
     assert!((va.x + vb.x).abs() < 1e-9, "momentum {}", va.x + vb.x);
@@ -223,12 +224,12 @@ fn a_wake_pushes_the_vehicle_below_as_the_downwash_model_says() {
     // F = c₁ (r / 4Δz)² at hover thrust, r = 0.5 · 0.1 m, Δz = 1 m; on 1 kg.
     let force = 2267.18 * (0.05_f64 / 4.0).powi(2);
     let expected = 0.5 * force * t * t;
-    let drop = 10.0 - world.vehicle(lower).body.position.z;
+    let drop = 10.0 - world.vehicle(lower).body().position.z;
     assert!(
         (drop - expected).abs() < 0.02 * expected,
         "drop {drop} vs {expected}"
     );
-    assert!((world.vehicle(upper).body.position.z - 11.0).abs() < 1e-9);
+    assert!((world.vehicle(upper).body().position.z - 11.0).abs() < 1e-9);
     // The wake weakens as (1/Δz)²: held at the last grid point, with Δz = 1 m + the drop.
     let now = force / (1.0 + drop).powi(2);
     let held = world.interaction_force(lower).z;
@@ -295,7 +296,7 @@ fn bad_worlds_are_errors_that_name_the_vehicles() {
     ];
     let e = World::new(WorldParams::default(), 1, dup).unwrap_err();
     assert_eq!(e, WorldError::DuplicateName("x".into()));
-    assert!(World::new(WorldParams::default(), 1, Vec::new()).is_err());
+    assert!(World::new(WorldParams::default(), 1, Vec::<(String, Quadrotor)>::new()).is_err());
     let mut world = World::new(WorldParams::default(), 1, two([3.0, 0.0, 5.0])).unwrap();
     let e = world.set_command(1, &[0.5; 4]).unwrap_err().to_string();
     assert!(
@@ -328,6 +329,13 @@ fn a_thousand_vehicles_share_one_world() {
         world.step(0.01);
     }
     assert_eq!(world.len(), 1024);
-    assert!((0..world.len()).all(|i| world.vehicle(i).body.position.iter().all(|v| v.is_finite())));
+    assert!((0..world.len()).all(|i| {
+        world
+            .vehicle(i)
+            .body()
+            .position
+            .iter()
+            .all(|v| v.is_finite())
+    }));
     assert!(world.take_collisions().is_empty());
 }

@@ -8,9 +8,10 @@
 use crate::support;
 
 use flyloop_core::SimRng;
-use flyloop_core::quadrotor::{BodyState, Quadrotor};
+use flyloop_core::quadrotor::BodyState;
 use flyloop_core::tasks::flight_vehicle::FlightVehicle;
 use flyloop_core::tasks::randomization::{Randomization, VehicleParams};
+use flyloop_core::vehicle::AirVehicle;
 use flyloop_fmu::fmi2_types::fmi2Status::{fmi2Error, fmi2OK};
 use nalgebra::Vector3;
 use support::{Fmu, Model};
@@ -70,8 +71,8 @@ const TICKS_PER_STEP: usize = 5;
 const POLICY_STEPS: usize = 400;
 
 /// Position, velocity, attitude and body rates of a quadrotor.
-fn state_bits(q: &Quadrotor) -> Vec<u64> {
-    let (b, att) = (&q.body, q.attitude());
+fn state_bits(q: &dyn AirVehicle) -> Vec<u64> {
+    let (b, att) = (q.body(), q.attitude());
     let values = [b.position, b.velocity, b.body_rates];
     let mut bits: Vec<u64> = values
         .iter()
@@ -87,7 +88,7 @@ fn rate_controller_fmu_flies_the_gym_rates_interface_bit_for_bit() {
     // (k·T − (k−1)·T); the rate loop is RateController.fmu's, wired by name.
     let seed = 7;
     let (mut gym, hover) = gym(seed);
-    let mut plant = gym.quadrotor().clone();
+    let mut plant = gym.air_vehicle().clone_boxed();
     let controller = Fmu::started(Model::RateController, 0.0, &[]);
     let mut moved = 0.0_f64;
     for k in 0..POLICY_STEPS {
@@ -99,19 +100,19 @@ fn rate_controller_fmu_flies_the_gym_rates_interface_bit_for_bit() {
         for j in 0..TICKS_PER_STEP {
             let tick = (k * TICKS_PER_STEP + j) as f64;
             for (i, name) in RATES.iter().enumerate() {
-                assert_eq!(controller.set(name, plant.body.body_rates[i]), fmi2OK);
+                assert_eq!(controller.set(name, plant.body().body_rates[i]), fmi2OK);
             }
             let motors = MOTORS.map(|m| controller.get(m));
-            plant.set_command(motors).unwrap();
-            plant.step((tick + 1.0) * TICK - tick * TICK);
+            plant.set_actuators(&motors).unwrap();
+            plant.advance((tick + 1.0) * TICK - tick * TICK);
             assert_eq!(controller.do_step(tick * TICK, TICK), fmi2OK);
         }
         assert_eq!(
-            state_bits(&plant),
-            state_bits(gym.quadrotor()),
+            state_bits(plant.as_ref()),
+            state_bits(gym.air_vehicle()),
             "policy step {k}"
         );
-        moved = moved.max(plant.body.body_rates.norm());
+        moved = moved.max(plant.body().body_rates.norm());
     }
     assert!(moved > 0.3, "the swings turned the vehicle: {moved} rad/s");
 }
@@ -144,7 +145,7 @@ fn rate_controller_and_quadrotor_fmus_fly_the_gym_rates_interface_closely() {
             co_step(&plant, &controller, &a, t);
             t = plant.time();
         }
-        let b = &gym.quadrotor().body;
+        let b = gym.air_vehicle().body();
         let fmu = Vector3::new(plant.get("x"), plant.get("y"), plant.get("z"));
         worst = worst.max((fmu - b.position).norm());
     }

@@ -262,7 +262,7 @@ impl MultiBatch {
         let mut p = Vec::with_capacity(3 * n);
         let mut t = Vec::with_capacity(3 * n);
         for i in 0..n {
-            p.extend(world.world().vehicle(i).body.position.iter());
+            p.extend(world.world().vehicle(i).body().position.iter());
             t.extend(world.target(i).iter());
         }
         Ok((PyArray1::from_vec(py, p), PyArray1::from_vec(py, t)))

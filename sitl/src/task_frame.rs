@@ -117,7 +117,7 @@ mod tests {
         let TaskInstance::Hover(h) = &task else {
             unreachable!()
         };
-        assert_eq!(v[40], h.quadrotor().body.position.x as f32);
+        assert_eq!(v[40], h.air_vehicle().body().position.x as f32);
         assert_eq!(messages("hover", 10_000, &v).count(), 1);
     }
 

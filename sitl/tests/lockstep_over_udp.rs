@@ -155,8 +155,8 @@ fn check_reply(reply: &[(u8, MavMessage)], hover: &Hover, time_usec: u64, head: 
     else {
         panic!("unexpected reply {reply:?}");
     };
-    let quad = hover.quadrotor();
-    let b = &quad.body;
+    let quad = hover.air_vehicle();
+    let b = quad.body();
     assert_eq!(s.time_usec, time_usec);
     let q = attitude_ned(&quad.attitude());
     assert_eq!(

@@ -21,5 +21,5 @@ pub mod wind;
 pub use frame::{Frame, FrameError, FrameTable, Rotor, Spin};
 pub use model::Quadrotor;
 pub use params::{QuadrotorInitial, QuadrotorParams};
-pub use seam::standing_multirotor;
+pub use seam::{multirotor_at, restore_air_vehicle, standing_multirotor, standing_multirotor_at};
 pub use state::{BodyState, Motors, WindState};

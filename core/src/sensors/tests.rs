@@ -3,8 +3,8 @@
 
 use super::*;
 use crate::quadrotor::contact::rest_height;
-use crate::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
-use crate::vehicle::Vehicle;
+use crate::quadrotor::{BodyState, Frame, QuadrotorParams, multirotor_at};
+use crate::vehicle::AirVehicle;
 use std::f64::consts::FRAC_PI_2;
 
 const DT: f64 = 0.004;
@@ -32,9 +32,9 @@ fn still_air() -> QuadrotorParams {
     }
 }
 
-fn quad_at(position: Vector3<f64>, yaw: f64) -> Quadrotor {
+fn quad_at(position: Vector3<f64>, yaw: f64) -> Box<dyn AirVehicle> {
     let body = BodyState::at_rest(position, 0.0, 0.0, yaw, 0.0);
-    Quadrotor::new(still_air(), body, SimRng::new(1)).unwrap()
+    multirotor_at(still_air(), Frame::quad_x(), body, SimRng::new(1)).unwrap()
 }
 
 fn close(a: &Vector3<f64>, b: &Vector3<f64>, tol: f64) -> bool {
@@ -45,7 +45,7 @@ fn close(a: &Vector3<f64>, b: &Vector3<f64>, tol: f64) -> bool {
 fn at_rest_on_the_ground_the_imu_reads_minus_g_and_no_rotation() {
     // Standing on its feet: the landing gear carries the weight.
     let mut quad = quad_at(Vector3::new(0.0, 0.0, rest_height(&still_air())), 0.7);
-    quad.step(DT);
+    quad.advance(DT);
     assert!(quad.is_grounded());
     let r = Sensors::new(ideal(), 0)
         .unwrap()
@@ -61,7 +61,7 @@ fn at_rest_on_the_ground_the_imu_reads_minus_g_and_no_rotation() {
 #[test]
 fn in_free_fall_the_accelerometer_reads_zero_and_the_gyro_reads_frd_rates() {
     let mut quad = quad_at(Vector3::new(0.0, 0.0, 50.0), 0.0);
-    quad.body.body_rates = Vector3::new(0.1, 0.2, 0.3); // FLU
+    quad.body_mut().body_rates = Vector3::new(0.1, 0.2, 0.3); // FLU
     let r = Sensors::new(ideal(), 0)
         .unwrap()
         .sample(&quad.kinematics(), DT);
@@ -137,7 +137,7 @@ fn the_magnetometer_at_home_reads_the_declared_field() {
 #[test]
 fn gps_reports_the_state_around_home_at_its_rate_and_delay() {
     let mut quad = quad_at(Vector3::new(10.0, 20.0, 5.0), 0.0);
-    quad.body.velocity = Vector3::new(1.0, 2.0, -0.5);
+    quad.body_mut().velocity = Vector3::new(1.0, 2.0, -0.5);
     let mut s = Sensors::new(ideal(), 0).unwrap();
     let f = s
         .gps(&quad.kinematics(), 0.0)
@@ -172,7 +172,7 @@ fn gps_reports_the_state_around_home_at_its_rate_and_delay() {
     assert_eq!(first.0, 50);
     assert_eq!(first.1.measured_at, 0.0);
     // At rest the course is unknown.
-    quad.body.velocity = Vector3::zeros();
+    quad.body_mut().velocity = Vector3::zeros();
     assert_eq!(
         Sensors::new(ideal(), 0)
             .unwrap()
@@ -251,7 +251,7 @@ fn biases_wander_as_their_gauss_markov_process_says() {
     assert!((got / want - 1.0).abs() < 0.06, "{got} vs {want}");
 }
 
-fn stream(s: &mut Sensors, quad: &Quadrotor, steps: u32) -> Vec<u64> {
+fn stream(s: &mut Sensors, quad: &dyn AirVehicle, steps: u32) -> Vec<u64> {
     let mut bits = Vec::new();
     for k in 0..steps {
         let r = s.sample(&quad.kinematics(), DT);
@@ -272,24 +272,30 @@ fn stream(s: &mut Sensors, quad: &Quadrotor, steps: u32) -> Vec<u64> {
 #[test]
 fn same_seed_same_bits_and_a_restored_suite_continues_exactly() {
     let mut quad = quad_at(Vector3::new(1.0, 2.0, 3.0), 0.4);
-    quad.body.velocity = Vector3::new(0.3, -0.2, 0.1);
+    quad.body_mut().velocity = Vector3::new(0.3, -0.2, 0.1);
     let params = SensorParams {
         gps_delay: 0.15,
         ..SensorParams::default()
     };
     let mut a = Sensors::new(params.clone(), 42).unwrap();
     let mut b = Sensors::new(params.clone(), 42).unwrap();
-    assert_eq!(stream(&mut a, &quad, 300), stream(&mut b, &quad, 300));
+    assert_eq!(
+        stream(&mut a, quad.as_ref(), 300),
+        stream(&mut b, quad.as_ref(), 300)
+    );
     let mut other = Sensors::new(params.clone(), 43).unwrap();
     let mut again = Sensors::new(params, 42).unwrap();
-    assert_ne!(stream(&mut other, &quad, 10), stream(&mut again, &quad, 10));
+    assert_ne!(
+        stream(&mut other, quad.as_ref(), 10),
+        stream(&mut again, quad.as_ref(), 10)
+    );
 
     let bytes = a.save().unwrap();
     let mut restored = Sensors::restore(&bytes).unwrap();
     assert_eq!(restored, a);
     assert_eq!(
-        stream(&mut restored, &quad, 300),
-        stream(&mut a, &quad, 300)
+        stream(&mut restored, quad.as_ref(), 300),
+        stream(&mut a, quad.as_ref(), 300)
     );
     assert!(Sensors::restore(&bytes[..bytes.len() - 1]).is_err());
     assert!(Sensors::restore(&quad.save().unwrap()).is_err());
@@ -297,7 +303,10 @@ fn same_seed_same_bits_and_a_restored_suite_continues_exactly() {
     // reset(seed) is a fresh suite with that seed.
     let mut fresh = Sensors::new(a.params().clone(), 9).unwrap();
     a.reset(9);
-    assert_eq!(stream(&mut a, &quad, 100), stream(&mut fresh, &quad, 100));
+    assert_eq!(
+        stream(&mut a, quad.as_ref(), 100),
+        stream(&mut fresh, quad.as_ref(), 100)
+    );
 }
 
 #[test]

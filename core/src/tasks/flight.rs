@@ -6,9 +6,10 @@ use crate::error::ParamError;
 use crate::param;
 use crate::params::{ParamSpec, Parameters};
 use crate::quadrotor::contact::foot_heights;
-use crate::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
+use crate::quadrotor::{BodyState, QuadrotorParams};
 use crate::rng::SimRng;
 use crate::tasks::{InfoRef, InfoVisitor, clip_f32};
+use crate::vehicle::AirVehicle;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -260,13 +261,13 @@ pub fn base_bounds(
 
 /// Writes the base values (25 + 2 per rotor) into `out`, each clipped into `lo..=hi`.
 pub fn write_base_observation(
-    quad: &Quadrotor,
+    quad: &dyn AirVehicle,
     target: &Vector3<f64>,
     lo: &[f32],
     hi: &[f32],
     out: &mut [f32],
 ) {
-    let b = &quad.body;
+    let b = quad.body();
     let (acceleration, angular_acceleration) = quad.accelerations();
     // q and −q are the same attitude: report the hemisphere w >= 0.
     let q = if b.attitude.w < 0.0 {
@@ -278,7 +279,7 @@ pub fn write_base_observation(
     let quaternion = [q.w, q.i, q.j, q.k];
     let normal = b.body_z_axis();
     let wind = quad.wind_velocity();
-    let command = quad.command();
+    let command = quad.motor_command();
     let groups: [&[f64]; 10] = [
         relative.as_slice(),
         b.velocity.as_slice(),
@@ -310,13 +311,13 @@ pub struct FlightStatus {
 /// The info fields every flight task reports (seed 001's DroneEnv info, crash flags always),
 /// for a flight towards `target`.
 pub fn visit_flight_info(
-    quad: &Quadrotor,
+    quad: &dyn AirVehicle,
     target: &Vector3<f64>,
     status: &FlightStatus,
     dt: f64,
     visit: &mut InfoVisitor<'_>,
 ) {
-    let position = quad.body.position;
+    let position = quad.body().position;
     let d = (target - position).norm();
     visit("distance_to_target", InfoRef::Real(d));
     visit("position", InfoRef::Vector(position.as_slice()));

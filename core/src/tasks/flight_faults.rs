@@ -6,8 +6,9 @@ use crate::error::ParamError;
 use crate::faults::catalogue::Target;
 use crate::faults::px4::Injection;
 use crate::faults::{Conditions, FaultPlan, FaultState, Reach, SensorId};
-use crate::quadrotor::{Motors, Quadrotor};
+use crate::quadrotor::Motors;
 use crate::tasks::{InfoRef, InfoVisitor};
+use crate::vehicle::AirVehicle;
 use serde::{Deserialize, Serialize};
 
 /// The faults of a flight vehicle over an episode.
@@ -60,7 +61,7 @@ impl FlightFaults {
     }
 
     /// The episode with `seed` starts: its faults drawn; those due at time 0 fire.
-    pub fn restart(&mut self, seed: u64, quad: &mut Quadrotor, dt: f64) {
+    pub fn restart(&mut self, seed: u64, quad: &mut dyn AirVehicle, dt: f64) {
         self.state.reset(seed);
         self.steps = 0;
         self.waypoint = self.waypoint.map(|_| 0);
@@ -69,16 +70,17 @@ impl FlightFaults {
 
     /// At the start of a control step: fires and clears faults by their triggers, and sets
     /// the air faults' wind for the step.
-    pub fn begin_step(&mut self, quad: &mut Quadrotor, dt: f64) {
+    pub fn begin_step(&mut self, quad: &mut dyn AirVehicle, dt: f64) {
         let time = self.steps as f64 * dt;
         let takeoff = (!quad.is_grounded()).then_some(time);
+        let height = quad.body().position.z;
         self.state.update(&Conditions {
             time,
-            height: quad.body.position.z,
+            height,
             takeoff,
             waypoint: self.waypoint,
         });
-        quad.external_wind = self.state.wind(time, quad.body.position.z);
+        quad.set_external_wind(self.state.wind(time, height));
         self.refresh_info(dt);
     }
 
@@ -90,25 +92,25 @@ impl FlightFaults {
     /// Before the vehicle advances by `dt` (its command set): the actuator fault path puts
     /// what the motors get in place of the command, kept to be restored by
     /// [`FlightFaults::after_advance`]. Nothing happens while no actuator fault acts.
-    pub fn before_advance(&mut self, quad: &mut Quadrotor, dt: f64) {
+    pub fn before_advance(&mut self, quad: &mut dyn AirVehicle, dt: f64) {
         if !self.state.acts_on_motors() {
             self.commanded = None;
             return;
         }
-        let commanded = quad.command();
+        let commanded = quad.motor_command();
         let mut motors = commanded;
         self.state
-            .motor_commands(&commanded, &quad.body.motors, dt, &mut motors);
+            .motor_commands(&commanded, &quad.body().motors, dt, &mut motors);
         // Same length as the frame's command, each value in [0, 1].
-        let _ = quad.set_command(&motors[..]);
+        let _ = quad.set_actuators(&motors[..]);
         self.commanded = Some(commanded);
     }
 
     /// After the vehicle advanced: it holds the commanded values again (what a controller
     /// reads back), not the faulted ones.
-    pub fn after_advance(&mut self, quad: &mut Quadrotor) {
+    pub fn after_advance(&mut self, quad: &mut dyn AirVehicle) {
         if let Some(commanded) = self.commanded.take() {
-            let _ = quad.set_command(&commanded[..]);
+            let _ = quad.set_actuators(&commanded[..]);
         }
     }
 

@@ -31,11 +31,11 @@ use crate::faults::FaultPlan;
 use crate::faults::px4::Injection;
 use crate::frames::{attitude_ned, enu_to_ned, flu_to_frd};
 use crate::params::Parameters;
-use crate::quadrotor::model::hover_motor_state;
-use crate::quadrotor::{BodyState, Quadrotor};
+use crate::quadrotor::{BodyState, multirotor_at};
 use crate::rate_loop::{RateLoop, RatesSetpoint};
 use crate::rng::SimRng;
 use crate::tasks::{ActionError, InfoRef, InfoVisitor, check_action};
+use crate::vehicle::AirVehicle;
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
@@ -104,14 +104,18 @@ impl FlightLink {
     pub fn new(
         nominal: VehicleParams,
         randomization: Randomization,
-    ) -> Result<(Self, Quadrotor), ParamError> {
+    ) -> Result<(Self, Box<dyn AirVehicle>), ParamError> {
         nominal.quadrotor.validate()?;
         nominal.rate_loop.validate()?;
         nominal.flight.validate()?;
         randomization.check(&nominal)?;
         let body = BodyState::at_rest(Vector3::zeros(), 0.0, 0.0, 0.0, 0.0);
-        let quad = Quadrotor::new(nominal.quadrotor.clone(), body, SimRng::new(0))?
-            .with_frame(nominal.frame.clone());
+        let quad = multirotor_at(
+            nominal.quadrotor.clone(),
+            nominal.frame.clone(),
+            body,
+            SimRng::new(0),
+        )?;
         let rates = if nominal.flight.rates_action {
             Some(RatesLink {
                 rate_loop: RateLoop::new(nominal.rate_loop.clone(), &nominal.mixer())?,
@@ -157,10 +161,10 @@ impl FlightLink {
 
     /// Draws the vehicle of the episode with `seed` (nominal when randomisation is off) into
     /// `quad`'s parameters, for the task to sample its start from.
-    pub fn draw(&mut self, quad: &mut Quadrotor, seed: u64) {
+    pub fn draw(&mut self, quad: &mut dyn AirVehicle, seed: u64) {
         let (params, drawn) = self.randomization.draw(&self.nominal, seed);
         self.drawn = drawn;
-        quad.params = params.quadrotor;
+        *quad.params_mut() = params.quadrotor;
         self.flight = params.flight;
         if let Some(link) = &mut self.rates {
             // PX4's mixer is set up for the nominal vehicle (its CA_ROTOR* do not follow
@@ -177,11 +181,11 @@ impl FlightLink {
 
     /// Starts the episode (after [`FlightLink::draw`]): `quad` at `body` with the episode's
     /// generator `rng`; `seed` seeds the observation noise.
-    pub fn restart(&mut self, quad: &mut Quadrotor, body: BodyState, rng: SimRng, seed: u64) {
+    pub fn restart(&mut self, quad: &mut dyn AirVehicle, body: BodyState, rng: SimRng, seed: u64) {
         quad.restart(body, rng);
-        let hover = hover_motor_state(&quad.params, quad.frame()).unwrap_or(0.0);
+        let hover = quad.hover_motor_state().unwrap_or(0.0);
         if let Some(link) = &mut self.rates {
-            link.rate_loop.reset(&flu_to_frd(&quad.body.body_rates));
+            link.rate_loop.reset(&flu_to_frd(&quad.body().body_rates));
             link.pending.clear();
             link.current = RatesSetpoint {
                 thrust: hover,
@@ -286,7 +290,7 @@ impl FlightLink {
     /// setpoint for the rate loop's ticks ([`FlightLink::next_tick`], [`FlightLink::tick`]).
     pub fn begin(
         &mut self,
-        quad: &mut Quadrotor,
+        quad: &mut dyn AirVehicle,
         action: &[f64],
         dt: f64,
     ) -> Result<(), ActionError> {
@@ -298,7 +302,7 @@ impl FlightLink {
         let (lo, hi) = self.action_bounds();
         let Some(link) = &mut self.rates else {
             // Finite and clipped into [0, 1] by the motors, as the bounds say.
-            let _ = quad.set_command(action);
+            let _ = quad.set_actuators(action);
             return Ok(());
         };
         let a: [f64; 4] = std::array::from_fn(|i| action[i].clamp(lo[i], hi[i]));
@@ -321,7 +325,7 @@ impl FlightLink {
 
     /// Runs the rate-loop tick at [`FlightLink::next_tick`] (`quad` brought to that time):
     /// the setpoints due take effect, the loop reads the gyro and commands the motors.
-    pub fn tick(&mut self, quad: &mut Quadrotor) {
+    pub fn tick(&mut self, quad: &mut dyn AirVehicle) {
         let Some(link) = &mut self.rates else {
             return;
         };
@@ -333,22 +337,22 @@ impl FlightLink {
             link.current = sp;
             link.pending.pop_front();
         }
-        let gyro = flu_to_frd(&quad.body.body_rates);
+        let gyro = flu_to_frd(&quad.body().body_rates);
         let motors = link.rate_loop.step(&link.current, &gyro, false);
-        let _ = quad.set_command(&motors[..]);
+        let _ = quad.set_actuators(&motors[..]);
         link.ticks += 1;
     }
 
     /// Before `quad` advances by `dt` within the step: the actuator faults put what the
     /// motors get in place of its command (nothing without faults).
-    pub fn before_advance(&mut self, quad: &mut Quadrotor, dt: f64) {
+    pub fn before_advance(&mut self, quad: &mut dyn AirVehicle, dt: f64) {
         if let Some(faults) = &mut self.faults {
             faults.before_advance(quad, dt);
         }
     }
 
     /// After `quad` advanced: it holds the commanded values again.
-    pub fn after_advance(&mut self, quad: &mut Quadrotor) {
+    pub fn after_advance(&mut self, quad: &mut dyn AirVehicle) {
         if let Some(faults) = &mut self.faults {
             faults.after_advance(quad);
         }
@@ -357,14 +361,14 @@ impl FlightLink {
     /// Advances a lone `quad` by `dt` within the step, through the actuator fault path when
     /// it has faults (a world steps its vehicles together between
     /// [`FlightLink::before_advance`] and [`FlightLink::after_advance`]).
-    pub fn advance(&mut self, quad: &mut Quadrotor, dt: f64) {
+    pub fn advance(&mut self, quad: &mut dyn AirVehicle, dt: f64) {
         self.before_advance(quad, dt);
-        quad.step(dt);
+        quad.advance(dt);
         self.after_advance(quad);
     }
 
     /// Ends the step (`quad` at the step's end): the estimator's view is updated.
-    pub fn finish(&mut self, quad: &Quadrotor) {
+    pub fn finish(&mut self, quad: &dyn AirVehicle) {
         if let Some(link) = &mut self.rates {
             link.steps += 1;
             link.estimate = estimate(quad, &self.flight, &mut link.noise);
@@ -376,9 +380,9 @@ impl FlightLink {
 
     /// `point` (world ENU) relative to the observed position, in the observation's frame:
     /// world ENU for the motor interface, the heading frame for the rates interface.
-    pub fn observed_offset(&self, quad: &Quadrotor, point: &Vector3<f64>) -> Vector3<f64> {
+    pub fn observed_offset(&self, quad: &dyn AirVehicle, point: &Vector3<f64>) -> Vector3<f64> {
         match &self.rates {
-            None => point - quad.body.position,
+            None => point - quad.body().position,
             Some(link) => {
                 let e = &link.estimate;
                 heading_frame(e.yaw, &(enu_to_ned(point) - e.position_ned))
@@ -390,11 +394,11 @@ impl FlightLink {
     /// (as [`FlightLink::observed_offset`]).
     pub fn observed_relative_velocity(
         &self,
-        quad: &Quadrotor,
+        quad: &dyn AirVehicle,
         velocity: &Vector3<f64>,
     ) -> Vector3<f64> {
         match &self.rates {
-            None => velocity - quad.body.velocity,
+            None => velocity - quad.body().velocity,
             Some(link) => {
                 let e = &link.estimate;
                 heading_frame(e.yaw, &(enu_to_ned(velocity) - e.velocity_ned))
@@ -432,7 +436,7 @@ impl FlightLink {
     /// estimator values (rates interface, see the module docs).
     pub fn write_observation(
         &self,
-        quad: &Quadrotor,
+        quad: &dyn AirVehicle,
         target: &Vector3<f64>,
         lo: &[f32],
         hi: &[f32],
@@ -489,8 +493,8 @@ fn heading_frame(yaw: f64, v: &Vector3<f64>) -> Vector3<f64> {
 }
 
 /// What the estimator reports now: the true state plus the configured noise.
-fn estimate(quad: &Quadrotor, flight: &FlightParams, rng: &mut SimRng) -> Estimate {
-    let b = &quad.body;
+fn estimate(quad: &dyn AirVehicle, flight: &FlightParams, rng: &mut SimRng) -> Estimate {
+    let b = quad.body();
     let mut noise = |sigma: f64| -> Vector3<f64> {
         if sigma > 0.0 {
             Vector3::new(rng.normal(), rng.normal(), rng.normal()) * sigma

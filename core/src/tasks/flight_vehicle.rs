@@ -1,22 +1,30 @@
-//! The vehicle a lone flight task flies: a quadrotor and its [`FlightLink`] (the action
+//! The vehicle a lone flight task flies: an air vehicle (any multirotor frame, held through
+//! the seam, [`crate::vehicle::AirVehicle`]) and its [`FlightLink`] (the action
 //! interface, randomisation and, on the rates interface, PX4's rate loop; see that module).
 
 use super::flight_faults::FlightFaults;
 use super::flight_link::FlightLink;
 use super::randomization::{Randomization, VehicleParams};
 use crate::error::ParamError;
-use crate::quadrotor::model::hover_motor_state;
-use crate::quadrotor::{BodyState, Quadrotor};
+use crate::quadrotor::BodyState;
 use crate::rng::SimRng;
 use crate::tasks::{ActionError, InfoVisitor};
+use crate::vehicle::AirVehicle;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-/// A quadrotor with its action interface and per-episode randomisation.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// An air vehicle with its action interface and per-episode randomisation.
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct FlightVehicle {
     link: FlightLink,
-    quad: Quadrotor,
+    quad: Box<dyn AirVehicle>,
+}
+
+// By hand: a derived `==` on a boxed trait object tries to move it (rust-lang/rust#31740).
+impl PartialEq for FlightVehicle {
+    fn eq(&self, other: &Self) -> bool {
+        self.link == other.link && self.quad.same_as(other.quad.as_ref())
+    }
 }
 
 impl FlightVehicle {
@@ -30,8 +38,8 @@ impl FlightVehicle {
     /// Draws the vehicle of the episode with `seed` (nominal when randomisation is off) and
     /// returns its hover motor state (0 if it cannot hover), for the task's start.
     pub fn draw(&mut self, seed: u64) -> f64 {
-        self.link.draw(&mut self.quad, seed);
-        hover_motor_state(&self.quad.params, self.quad.frame()).unwrap_or(0.0)
+        self.link.draw(self.quad.as_mut(), seed);
+        self.quad.hover_motor_state().unwrap_or(0.0)
     }
 
     /// Number of action values: one per rotor (motor interface) or four (rates interface).
@@ -47,15 +55,17 @@ impl FlightVehicle {
     /// Starts the episode (after [`FlightVehicle::draw`]) at `body` with the episode's
     /// generator `rng`; `seed` seeds the observation noise.
     pub fn restart(&mut self, body: BodyState, rng: SimRng, seed: u64) {
-        self.link.restart(&mut self.quad, body, rng, seed);
+        self.link.restart(self.quad.as_mut(), body, rng, seed);
     }
 
-    pub fn quadrotor(&self) -> &Quadrotor {
-        &self.quad
+    /// The vehicle flown.
+    pub fn air_vehicle(&self) -> &dyn AirVehicle {
+        self.quad.as_ref()
     }
 
-    pub fn quadrotor_mut(&mut self) -> &mut Quadrotor {
-        &mut self.quad
+    /// The vehicle flown, to place it by hand.
+    pub fn air_vehicle_mut(&mut self) -> &mut dyn AirVehicle {
+        self.quad.as_mut()
     }
 
     /// The action interface.
@@ -96,26 +106,26 @@ impl FlightVehicle {
     /// Applies a 4-value action (clipped into the bounds) for `dt` seconds: the vehicle
     /// integrates from one rate-loop tick to the next (none on the motor interface).
     pub fn apply(&mut self, action: &[f64], dt: f64) -> Result<(), ActionError> {
-        self.link.begin(&mut self.quad, action, dt)?;
+        self.link.begin(self.quad.as_mut(), action, dt)?;
         let (mut now, end) = self.link.window(dt);
         while let Some(tick) = self.link.next_tick(end) {
             if tick > now {
-                self.link.advance(&mut self.quad, tick - now);
+                self.link.advance(self.quad.as_mut(), tick - now);
                 now = tick;
             }
-            self.link.tick(&mut self.quad);
+            self.link.tick(self.quad.as_mut());
         }
         if end > now {
-            self.link.advance(&mut self.quad, end - now);
+            self.link.advance(self.quad.as_mut(), end - now);
         }
-        self.link.finish(&self.quad);
+        self.link.finish(self.quad.as_ref());
         Ok(())
     }
 
     /// `point` (world ENU) relative to the observed position, in the observation's frame:
     /// world ENU for the motor interface, the heading frame for the rates interface.
     pub fn observed_offset(&self, point: &Vector3<f64>) -> Vector3<f64> {
-        self.link.observed_offset(&self.quad, point)
+        self.link.observed_offset(self.quad.as_ref(), point)
     }
 
     /// Number of values of the interface's observation.
@@ -142,7 +152,8 @@ impl FlightVehicle {
         hi: &[f32],
         out: &mut [f32],
     ) {
-        self.link.write_observation(&self.quad, target, lo, hi, out);
+        self.link
+            .write_observation(self.quad.as_ref(), target, lo, hi, out);
     }
 
     /// Info entries of the vehicle: the values drawn this episode, when randomised; the

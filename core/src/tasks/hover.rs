@@ -23,9 +23,10 @@ use super::flight_vehicle::FlightVehicle;
 use super::randomization::{Randomization, VehicleParams};
 use super::{InfoVisitor, StepOutcome, Task};
 use crate::error::ParamError;
-use crate::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
+use crate::quadrotor::{BodyState, QuadrotorParams};
 use crate::rng::SimRng;
 use crate::tasks::ActionError;
+use crate::vehicle::AirVehicle;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -78,13 +79,14 @@ impl Hover {
         &self.params
     }
 
-    pub fn quadrotor(&self) -> &Quadrotor {
-        self.vehicle.quadrotor()
+    /// The vehicle flown (through the seam, [`AirVehicle`]).
+    pub fn air_vehicle(&self) -> &dyn AirVehicle {
+        self.vehicle.air_vehicle()
     }
 
     /// Mutable access for tests and front ends that place the vehicle by hand.
-    pub fn quadrotor_mut(&mut self) -> &mut Quadrotor {
-        self.vehicle.quadrotor_mut()
+    pub fn air_vehicle_mut(&mut self) -> &mut dyn AirVehicle {
+        self.vehicle.air_vehicle_mut()
     }
 
     pub fn vehicle(&self) -> &FlightVehicle {
@@ -103,7 +105,7 @@ impl Hover {
     /// Moves the target (e.g. a user-chosen hover point); distance progress restarts from here.
     pub fn set_target(&mut self, target: Vector3<f64>) {
         self.target = target;
-        self.status.initial_distance = (target - self.quadrotor().body.position).norm();
+        self.status.initial_distance = (target - self.air_vehicle().body().position).norm();
     }
 
     pub fn step_count(&self) -> u32 {
@@ -158,12 +160,12 @@ impl Task for Hover {
         self.vehicle.apply(action, self.params.dt)?;
         self.status.step_count += 1;
 
-        let quad = self.vehicle.quadrotor();
-        let body = &quad.body;
+        let quad = self.vehicle.air_vehicle();
+        let body = quad.body();
         let reward = hover_reward(&self.params, body, &self.target);
         let status = &mut self.status;
         status.crashed =
-            self.params.enable_crash_detection && is_crashed(&self.params, &quad.params, body);
+            self.params.enable_crash_detection && is_crashed(&self.params, quad.params(), body);
         status.out_of_bounds = self.params.enable_out_of_bounds_detection
             && (self.target - body.position).norm() > out_of_bounds_distance(&self.params);
         let terminated = status.crashed || status.out_of_bounds;
@@ -171,8 +173,8 @@ impl Task for Hover {
 
         let interval = self.params.target_change_interval;
         if interval > 0 && status.step_count % interval == 0 {
-            let from = self.quadrotor().body.position;
-            let rng = self.vehicle.quadrotor_mut().rng_mut();
+            let from = self.air_vehicle().body().position;
+            let rng = self.vehicle.air_vehicle_mut().rng_mut();
             let target = sample_target(&self.params, &from, rng);
             self.set_target(target);
         }
@@ -189,7 +191,7 @@ impl Task for Hover {
     }
 
     fn visit_info(&self, visit: &mut InfoVisitor<'_>) {
-        let (quad, dt) = (self.quadrotor(), self.params.dt);
+        let (quad, dt) = (self.air_vehicle(), self.params.dt);
         visit_flight_info(quad, &self.target, &self.status, dt, visit);
         self.vehicle.visit_info(visit);
     }

@@ -22,8 +22,9 @@ use super::{ActionError, InfoRef, InfoVisitor, StepOutcome, Task, clip_f32};
 use crate::error::ParamError;
 use crate::param;
 use crate::params::{ParamSpec, Parameters};
-use crate::quadrotor::{Quadrotor, QuadrotorParams};
+use crate::quadrotor::QuadrotorParams;
 use crate::rng::SimRng;
+use crate::vehicle::AirVehicle;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -139,12 +140,13 @@ impl Waypoints {
         Ok(task)
     }
 
-    pub fn quadrotor(&self) -> &Quadrotor {
-        self.vehicle.quadrotor()
+    /// The vehicle flown (through the seam, [`AirVehicle`]).
+    pub fn air_vehicle(&self) -> &dyn AirVehicle {
+        self.vehicle.air_vehicle()
     }
 
-    pub fn quadrotor_mut(&mut self) -> &mut Quadrotor {
-        self.vehicle.quadrotor_mut()
+    pub fn air_vehicle_mut(&mut self) -> &mut dyn AirVehicle {
+        self.vehicle.air_vehicle_mut()
     }
 
     pub fn vehicle(&self) -> &FlightVehicle {
@@ -222,7 +224,7 @@ impl Task for Waypoints {
         self.reached = 0;
         self.steps_since_checkpoint = 0;
         self.status = FlightStatus {
-            initial_distance: (self.current_waypoint() - self.quadrotor().body.position).norm(),
+            initial_distance: (self.current_waypoint() - self.air_vehicle().body().position).norm(),
             ..FlightStatus::default()
         };
     }
@@ -236,7 +238,7 @@ impl Task for Waypoints {
         self.steps_since_checkpoint += 1;
 
         let waypoint = self.current_waypoint();
-        let (d, _) = distance_and_direction(&self.quadrotor().body, &waypoint);
+        let (d, _) = distance_and_direction(self.air_vehicle().body(), &waypoint);
         let all_reached = self.reached >= self.params.max_num_waypoints;
         let mut reward = if d < self.params.waypoint_reach_threshold_m && !all_reached {
             let bonus = self.params.checkpoint_bonus
@@ -245,21 +247,21 @@ impl Task for Waypoints {
             self.current += 1;
             self.steps_since_checkpoint = 0;
             self.status.initial_distance =
-                (self.current_waypoint() - self.quadrotor().body.position).norm();
+                (self.current_waypoint() - self.air_vehicle().body().position).norm();
             bonus.max(1.0)
         } else {
-            velocity_reward(&self.flight, &self.quadrotor().body, &waypoint)
+            velocity_reward(&self.flight, self.air_vehicle().body(), &waypoint)
         };
         if reward > 0.0 {
-            let mean_motor = self.quadrotor().body.motors.iter().sum::<f64>() / 4.0;
+            let mean_motor = self.air_vehicle().body().motors.iter().sum::<f64>() / 4.0;
             reward += 0.5 * mean_motor;
         }
 
-        let d_now = (self.current_waypoint() - self.quadrotor().body.position).norm();
-        let quad = self.vehicle.quadrotor();
+        let d_now = (self.current_waypoint() - self.air_vehicle().body().position).norm();
+        let quad = self.vehicle.air_vehicle();
         let status = &mut self.status;
         status.crashed = self.flight.enable_crash_detection
-            && is_crashed(&self.flight, &quad.params, &quad.body);
+            && is_crashed(&self.flight, quad.params(), quad.body());
         status.out_of_bounds = self.flight.enable_out_of_bounds_detection
             && d_now > waypoint_out_of_bounds_distance(&self.flight);
         let truncated = status.step_count >= self.flight.max_steps
@@ -291,7 +293,7 @@ impl Task for Waypoints {
 
     fn visit_info(&self, visit: &mut InfoVisitor<'_>) {
         let current = self.current_waypoint();
-        let (quad, dt) = (self.quadrotor(), self.flight.dt);
+        let (quad, dt) = (self.air_vehicle(), self.flight.dt);
         visit_flight_info(quad, &current, &self.status, dt, visit);
         visit(
             "waypoints_reached",

@@ -29,10 +29,9 @@ pub use wind_field::WindField;
 
 use crate::error::{CommandError, ParamError};
 use crate::params::Parameters;
-use crate::quadrotor::{Quadrotor, WindState};
 use crate::rng::SimRng;
 use crate::snapshot::{self, SnapshotError};
-use crate::vehicle::{Kinematics, Vehicle};
+use crate::vehicle::{AirVehicle, Kinematics};
 use interaction::{contact_force, downwash_force, reach};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -85,7 +84,7 @@ pub enum WorldError {
 pub struct World {
     params: WorldParams,
     names: Vec<String>,
-    vehicles: Vec<Quadrotor>,
+    vehicles: Vec<Box<dyn AirVehicle>>,
     shapes: Vec<Shape>,
     wind: WindField,
     /// The interaction force on each vehicle held since the last grid point, world ENU, N.
@@ -106,16 +105,17 @@ pub struct World {
 }
 
 impl World {
-    /// A world of `vehicles` (name, vehicle) with its wind drawn from `SimRng::new(seed)`.
-    /// The wind belongs to the world: each vehicle's own wind is turned off (its
-    /// `wind_enabled` parameter set false, its wind state cleared).
-    pub fn new(
+    /// A world of `vehicles` (name, vehicle: any [`AirVehicle`], boxed or not) with its wind
+    /// drawn from `SimRng::new(seed)`. The wind belongs to the world: each vehicle's own wind
+    /// is turned off ([`AirVehicle::join_world`]).
+    pub fn new<V: Into<Box<dyn AirVehicle>>>(
         params: WorldParams,
         seed: u64,
-        vehicles: impl IntoIterator<Item = (String, Quadrotor)>,
+        vehicles: impl IntoIterator<Item = (String, V)>,
     ) -> Result<Self, WorldError> {
         params.validate()?;
-        let mut listed: Vec<(String, Quadrotor)> = vehicles.into_iter().collect();
+        let mut listed: Vec<(String, Box<dyn AirVehicle>)> =
+            (vehicles.into_iter()).map(|(n, v)| (n, v.into())).collect();
         if listed.is_empty() || listed.len() > MAX_VEHICLES {
             return Err(WorldError::VehicleCount(listed.len()));
         }
@@ -123,14 +123,15 @@ impl World {
         if let Some(w) = listed.windows(2).find(|w| w[0].0 == w[1].0) {
             return Err(WorldError::DuplicateName(w[0].0.clone()));
         }
-        let (names, mut vehicles): (Vec<String>, Vec<Quadrotor>) = listed.into_iter().unzip();
+        let (names, mut vehicles): (Vec<String>, Vec<Box<dyn AirVehicle>>) =
+            listed.into_iter().unzip();
         for v in &mut vehicles {
-            v.params.wind_enabled = false;
-            v.wind = WindState::default();
-            v.external_wind = Vector3::zeros();
-            v.external_force = Vector3::zeros();
+            v.join_world();
         }
-        let shapes = vehicles.iter().map(|v| shape(&params, v)).collect();
+        let shapes = vehicles
+            .iter()
+            .map(|v| shape(&params, v.as_ref()))
+            .collect();
         let mut rng = SimRng::new(seed);
         let wind = WindField::new(&params, &mut rng);
         let n = vehicles.len();
@@ -173,7 +174,8 @@ impl World {
         let xy = self.horizontal_positions();
         for (i, j) in broad_phase::candidate_pairs(&xy, self.reach) {
             let (i, j) = (i as usize, j as usize);
-            let distance = (self.vehicles[i].body.position - self.vehicles[j].body.position).norm();
+            let distance =
+                (self.vehicles[i].body().position - self.vehicles[j].body().position).norm();
             let needed = self.shapes[i].hull_radius + self.shapes[j].hull_radius;
             if distance < needed {
                 return Err(WorldError::Overlap {
@@ -189,7 +191,7 @@ impl World {
 
     fn horizontal_positions(&self) -> Vec<[f64; 2]> {
         (self.vehicles.iter())
-            .map(|v| [v.body.position.x, v.body.position.y])
+            .map(|v| [v.body().position.x, v.body().position.y])
             .collect()
     }
 
@@ -220,17 +222,25 @@ impl World {
     }
 
     /// Vehicle `i` (panics past the end, like a slice: indices come from this world).
-    pub fn vehicle(&self, i: usize) -> &Quadrotor {
-        &self.vehicles[i]
+    pub fn vehicle(&self, i: usize) -> &dyn AirVehicle {
+        self.vehicles[i].as_ref()
     }
 
     /// Vehicle `i`, to change its parameters or state between steps.
-    pub fn vehicle_mut(&mut self, i: usize) -> &mut Quadrotor {
-        &mut self.vehicles[i]
+    pub fn vehicle_mut(&mut self, i: usize) -> &mut dyn AirVehicle {
+        self.vehicles[i].as_mut()
+    }
+
+    /// Puts `vehicle` in place of vehicle `i` (a fleet's vehicle back at its start); it
+    /// hands its air to the world ([`AirVehicle::join_world`]) and feels the held
+    /// interaction force from the next grid point on, as the one it replaces did.
+    pub fn replace_vehicle(&mut self, i: usize, mut vehicle: Box<dyn AirVehicle>) {
+        vehicle.join_world();
+        self.vehicles[i] = vehicle;
     }
 
     /// Every vehicle, in name order.
-    pub fn vehicles(&self) -> &[Quadrotor] {
+    pub fn vehicles(&self) -> &[Box<dyn AirVehicle>] {
         &self.vehicles
     }
 
@@ -294,7 +304,7 @@ impl World {
             let at_grid = to_grid <= remaining + slack;
             let piece = if at_grid { to_grid } else { remaining };
             for v in &mut self.vehicles {
-                v.step(piece);
+                v.advance(piece);
             }
             if at_grid {
                 self.grid_phase = 0.0;
@@ -314,12 +324,13 @@ impl World {
                 self.wind.sample(&self.params, &mut self.rng);
             }
             for v in &mut self.vehicles {
-                v.external_wind = self.wind.at(&v.body.position);
+                let wind = self.wind.at(&v.body().position);
+                v.set_external_wind(wind);
             }
         }
         self.interact();
         for (v, f) in self.vehicles.iter_mut().zip(&self.forces) {
-            v.external_force = *f;
+            v.set_external_force(*f);
         }
     }
 
@@ -333,10 +344,13 @@ impl World {
         }
         let time = self.time();
         let bodies: Vec<Body> = (self.vehicles.iter())
-            .map(|v| Body {
-                position: v.body.position,
-                velocity: v.body.velocity,
-                thrust_ratio: v.thrust() / (v.params.mass * v.params.gravity),
+            .map(|v| {
+                let (b, p) = (v.body(), v.params());
+                Body {
+                    position: b.position,
+                    velocity: b.velocity,
+                    thrust_ratio: v.thrust() / (p.mass * p.gravity),
+                }
             })
             .collect();
         let mut touching = Vec::new();
@@ -403,12 +417,10 @@ impl World {
                 "world arrays of unequal length, a non-finite wind, or a time off its grid".into(),
             ));
         }
-        for v in &mut world.vehicles {
-            // Each vehicle through its own checks (finite state, valid parameters, frame).
-            *v = Quadrotor::restore(&v.save()?)?;
-        }
+        // Each vehicle went through its own checks (finite state, valid parameters, frame)
+        // as it was decoded ([`crate::vehicle::air::restore`]).
         for (v, f) in world.vehicles.iter_mut().zip(&world.forces) {
-            v.external_force = *f;
+            v.set_external_force(*f);
         }
         world.reach = world.interaction_reach();
         Ok(world)
@@ -416,8 +428,8 @@ impl World {
 }
 
 /// A vehicle's hull and propeller radius: the farthest rotor plus a propeller.
-pub fn shape(params: &WorldParams, vehicle: &Quadrotor) -> Shape {
-    let arm = vehicle.params.arm_length;
+pub fn shape(params: &WorldParams, vehicle: &dyn AirVehicle) -> Shape {
+    let arm = vehicle.params().arm_length;
     let farthest = (vehicle.frame().rotors().iter())
         .map(|r| (r.x * r.x + r.y * r.y).sqrt())
         .fold(0.0, f64::max);

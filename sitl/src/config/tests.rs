@@ -163,9 +163,10 @@ fn the_frame_presets_parse_and_hover_on_their_rotors() {
     ] {
         let v = AutopilotVehicle::parse(text).unwrap();
         assert_eq!(v.frame.rotor_count(), rotors, "{file}");
-        let quad = flyloop_core::quadrotor::Quadrotor::standing(v.quadrotor, 0)
-            .unwrap()
-            .with_frame(v.frame);
+        let quad =
+            flyloop_core::quadrotor::standing_multirotor_at(v.quadrotor, v.frame, 0, [0.0; 2])
+                .unwrap()
+                .take();
         let hover = quad.hover_motor_state().unwrap();
         assert!((0.5..0.65).contains(&hover), "{file}: hover at {hover}");
     }

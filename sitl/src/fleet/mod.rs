@@ -25,8 +25,9 @@ pub mod view_record;
 use ardupilot_member::{ArduPilotMember, Frame};
 use file::{Autopilot, FleetSpec};
 use flyloop_core::ParamError;
-use flyloop_core::quadrotor::Quadrotor;
+use flyloop_core::quadrotor::standing_multirotor_at;
 use flyloop_core::sensors::Sensors;
+use flyloop_core::vehicle::AirVehicleStart;
 use flyloop_core::world::{World, WorldError};
 use lockstep::{Advance, Hold, Lockstep, Phase};
 use mavlink::dialects::common::MavSeverity;
@@ -81,7 +82,7 @@ pub struct Fleet {
     lockstep: Lockstep,
     members: Vec<Member>,
     /// Each vehicle as it started (standing at its start position).
-    start: Vec<Quadrotor>,
+    start: Vec<AirVehicleStart>,
     notices: Vec<Notice>,
     /// Contacts reported.
     pub collisions: u64,
@@ -107,6 +108,7 @@ impl Fleet {
         let mut vehicles = Vec::with_capacity(listed.len());
         let mut members = Vec::with_capacity(listed.len());
         let mut steps = Vec::with_capacity(listed.len());
+        let mut starts = Vec::with_capacity(listed.len());
         for (i, v) in listed.iter().enumerate() {
             let err = |source| FleetStartError::Vehicle {
                 name: v.name.clone(),
@@ -114,11 +116,8 @@ impl Fleet {
             };
             let s = seed.wrapping_add(i as u64);
             let c = &v.vehicle;
-            let mut quad = Quadrotor::standing(c.quadrotor.clone(), s)
-                .map_err(err)?
-                .with_frame(c.frame.clone());
-            quad.body.position.x = v.position[0];
-            quad.body.position.y = v.position[1];
+            let start = standing_multirotor_at(c.quadrotor.clone(), c.frame.clone(), s, v.position)
+                .map_err(err)?;
             let sensors = Sensors::new(c.sensors.clone(), s).map_err(err)?;
             let (link, step) = match v.autopilot {
                 Autopilot::Px4 => (Link::Px4(Box::new(Px4Member::new(sensors))), px4_step_us),
@@ -138,15 +137,15 @@ impl Fleet {
                 rotors: c.frame.rotor_count(),
                 connections: 0,
             });
-            vehicles.push((v.name.clone(), quad));
+            vehicles.push((v.name.clone(), start.take()));
+            starts.push(start);
         }
         let world = World::new(spec.world.clone(), seed, vehicles)?;
-        let start = world.vehicles().to_vec();
         Ok(Fleet {
             world,
             lockstep: Lockstep::new(&steps),
             members,
-            start,
+            start: starts,
             notices: Vec::new(),
             collisions: 0,
             stale_controls: 0,
@@ -206,7 +205,7 @@ impl Fleet {
 
     /// Vehicle i back at its start (standing at its start position, motors off).
     fn reset_vehicle(&mut self, i: usize) {
-        *self.world.vehicle_mut(i) = self.start[i].clone();
+        self.world.replace_vehicle(i, self.start[i].take());
     }
 
     /// PX4 i connected: its vehicle back at its start, the first HIL_SENSOR queued in its
@@ -255,7 +254,7 @@ impl Fleet {
         for s in said {
             let (command, time_usec) = match s {
                 Said::Controls(c, t) => (c, t),
-                Said::BadControls(t) => (self.world.vehicle(i).command().to_vec(), t),
+                Said::BadControls(t) => (self.world.vehicle(i).actuators(), t),
                 Said::Heartbeat(sysid) => {
                     self.check_sysid(i, sysid);
                     continue;
@@ -341,7 +340,7 @@ impl Fleet {
                     self.notice(MavSeverity::MAV_SEVERITY_INFO, text);
                 }
                 self.lockstep.set_step(i, step_us);
-                let command = command.unwrap_or_else(|| self.world.vehicle(i).command().to_vec());
+                let command = command.unwrap_or_else(|| self.world.vehicle(i).actuators());
                 self.answer(i, command);
                 false
             }

@@ -120,7 +120,7 @@ fn a_silent_px4_stops_its_motors_and_the_others_fly_on() {
     answer(&mut f, 0, 0.7);
     assert_eq!(f.advance(false), Err(Hold::Waiting(1)));
     f.silence(1, std::time::Duration::from_secs(3));
-    assert!(f.world().vehicle(1).command().iter().all(|&c| c == 0.0));
+    assert!(f.world().vehicle(1).actuators().iter().all(|&c| c == 0.0));
     let notices = f.take_notices();
     assert!(
         notices
@@ -143,7 +143,7 @@ fn two_vehicles_flown_into_each_other_are_reported() {
     answer(&mut f, 0, 0.0);
     answer(&mut f, 1, 0.0);
     // Push vehicle 1 toward vehicle 0.
-    f.world.vehicle_mut(1).body.velocity.x = -2.0;
+    f.world.vehicle_mut(1).body_mut().velocity.x = -2.0;
     for _ in 0..200 {
         let _ = f.advance(false);
         answer(&mut f, 0, 0.0);

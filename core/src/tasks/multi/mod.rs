@@ -35,8 +35,7 @@ pub use params::MultiParams;
 pub use scenario::Scenario;
 
 use crate::error::ParamError;
-use crate::quadrotor::model::hover_motor_state;
-use crate::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
+use crate::quadrotor::{BodyState, QuadrotorParams, multirotor_at};
 use crate::rng::SimRng;
 use crate::tasks::flight::{
     FlightStatus, is_crashed, sample_start, sample_target, visit_flight_info, wind_bound,
@@ -44,6 +43,7 @@ use crate::tasks::flight::{
 use crate::tasks::flight_link::FlightLink;
 use crate::tasks::hover::hover_reward;
 use crate::tasks::{ActionError, InfoRef, InfoVisitor, StepOutcome, check_action};
+use crate::vehicle::AirVehicle;
 use crate::world::{World, WorldError, shape};
 use nalgebra::Vector3;
 use neighbours::NEIGHBOUR_VALUES;
@@ -96,7 +96,7 @@ pub struct MultiFlight {
     config: MultiConfig,
     links: Vec<FlightLink>,
     /// The nominal vehicle every agent's episode starts from.
-    template: Quadrotor,
+    template: Box<dyn AirVehicle>,
     world: World,
     targets: Vec<Vector3<f64>>,
     status: Vec<AgentStatus>,
@@ -246,10 +246,10 @@ impl MultiFlight {
         for (i, link) in self.links.iter_mut().enumerate() {
             let agent_seed = master.fork_seed();
             let mut quad = self.template.clone();
-            link.draw(&mut quad, agent_seed);
-            quad.params.wind_enabled = false;
+            link.draw(quad.as_mut(), agent_seed);
+            quad.params_mut().wind_enabled = false;
             let mut rng = SimRng::new(agent_seed);
-            let hover = hover_motor_state(&quad.params, quad.frame()).unwrap_or(0.0);
+            let hover = quad.hover_motor_state().unwrap_or(0.0);
             let mut body = sample_start(flight, hover, &mut rng);
             let local = body.position;
             let point = self.scenario.start_point(&self.config.multi, i, n, turn);
@@ -263,14 +263,14 @@ impl MultiFlight {
                 }
                 Scenario::Swap => Vector3::new(-body.position.x, -body.position.y, body.position.z),
             };
-            link.restart(&mut quad, body, rng, agent_seed);
+            link.restart(quad.as_mut(), body, rng, agent_seed);
             vehicles.push((agent_name(i), quad));
         }
         self.world = World::new(self.config.world.clone(), world_seed, vehicles)?;
         self.steps = 0;
         self.failed = false;
         for (i, s) in self.status.iter_mut().enumerate() {
-            let start = self.world.vehicle(i).body.position;
+            let start = self.world.vehicle(i).body().position;
             *s = AgentStatus {
                 flight: FlightStatus {
                     initial_distance: (self.targets[i] - start).norm(),
@@ -421,12 +421,12 @@ impl MultiFlight {
                 continue;
             }
             let quad = self.world.vehicle(i);
-            let body = &quad.body;
+            let body = quad.body();
             let target = &self.targets[i];
             let distance = (target - body.position).norm();
             s.flight.step_count += 1;
             s.flight.crashed =
-                flight.enable_crash_detection && is_crashed(flight, &quad.params, body);
+                flight.enable_crash_detection && is_crashed(flight, quad.params(), body);
             s.flight.out_of_bounds =
                 flight.enable_out_of_bounds_detection && distance > self.out_of_bounds;
             s.arrived = distance <= multi.arrival_radius;
@@ -543,14 +543,15 @@ fn check_separation(scenario: Scenario, config: &MultiConfig) -> Result<(), Para
         .iter()
         .map(|&f| config.randomize.corner(&nominal, f).0.quadrotor)
         .filter_map(|p| {
-            Quadrotor::new(
+            multirotor_at(
                 p,
+                nominal.frame.clone(),
                 BodyState::at_rest(Vector3::zeros(), 0.0, 0.0, 0.0, 0.0),
                 SimRng::new(0),
             )
             .ok()
         })
-        .map(|q| shape(&config.world, &q).hull_radius)
+        .map(|q| shape(&config.world, q.as_ref()).hull_radius)
         .fold(0.0, f64::max);
     let lowest = config.flight.start_height + scenario.layer_offset(&config.multi, 0, n);
     if lowest <= largest {

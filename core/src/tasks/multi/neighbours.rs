@@ -6,9 +6,9 @@
 //! all 7 values 0 — the flag tells it from a neighbour at the agent's own position.
 
 use super::params::MAX_NEIGHBOURS;
-use crate::quadrotor::Quadrotor;
 use crate::tasks::clip_f32;
 use crate::tasks::flight_link::FlightLink;
+use crate::vehicle::AirVehicle;
 
 /// Values per neighbour slot.
 pub const NEIGHBOUR_VALUES: usize = 7;
@@ -18,19 +18,19 @@ const RELATIVE_VELOCITY_BOUND: f64 = 80.0;
 /// The `k` (≤ [`MAX_NEIGHBOURS`]) vehicles nearest to vehicle `i`, nearest first, ties to
 /// the lower index; `None` past the number of others.
 pub fn nearest(
-    vehicles: &[Quadrotor],
+    vehicles: &[Box<dyn AirVehicle>],
     i: usize,
     k: usize,
 ) -> [Option<usize>; MAX_NEIGHBOURS as usize] {
     let mut found: [(f64, usize); MAX_NEIGHBOURS as usize] =
         [(f64::INFINITY, usize::MAX); MAX_NEIGHBOURS as usize];
     let mut count = 0;
-    let own = &vehicles[i].body.position;
+    let own = &vehicles[i].body().position;
     for (j, v) in vehicles.iter().enumerate() {
         if j == i || k == 0 {
             continue;
         }
-        let d = (v.body.position - own).norm_squared();
+        let d = (v.body().position - own).norm_squared();
         // Insert (d, j) into the sorted first `count` entries if it beats the last.
         if count == k && (d, j) >= found[k - 1] {
             continue;
@@ -59,21 +59,21 @@ pub fn bounds(k: usize, position_bound: f64) -> (Vec<f32>, Vec<f32>) {
 /// Writes agent `i`'s `k` neighbour slots into `out` (length 7k), clipped into `lo..=hi`.
 pub fn write(
     link: &FlightLink,
-    vehicles: &[Quadrotor],
+    vehicles: &[Box<dyn AirVehicle>],
     i: usize,
     k: usize,
     lo: &[f32],
     hi: &[f32],
     out: &mut [f32],
 ) {
-    let own = &vehicles[i];
+    let own = vehicles[i].as_ref();
     for (s, slot) in nearest(vehicles, i, k).iter().take(k).enumerate() {
         let at = s * NEIGHBOUR_VALUES;
         let Some(j) = slot else {
             out[at..at + NEIGHBOUR_VALUES].fill(0.0);
             continue;
         };
-        let other = &vehicles[*j].body;
+        let other = vehicles[*j].body();
         let position = link.observed_offset(own, &other.position);
         let velocity = link.observed_relative_velocity(own, &other.velocity);
         let values = position.iter().chain(velocity.iter()).chain(&[1.0]);
@@ -90,14 +90,20 @@ mod tests {
     use crate::rng::SimRng;
     use nalgebra::Vector3;
 
-    fn at(x: f64) -> Quadrotor {
+    fn at(x: f64) -> Box<dyn AirVehicle> {
         let body = BodyState::at_rest(Vector3::new(x, 0.0, 1.0), 0.0, 0.0, 0.0, 0.0);
-        Quadrotor::new(QuadrotorParams::default(), body, SimRng::new(0)).unwrap()
+        crate::quadrotor::multirotor_at(
+            QuadrotorParams::default(),
+            crate::quadrotor::Frame::quad_x(),
+            body,
+            SimRng::new(0),
+        )
+        .unwrap()
     }
 
     #[test]
     fn nearest_first_ties_to_the_lower_index_and_absent_past_the_others() {
-        let v: Vec<Quadrotor> = [0.0, 3.0, -1.0, 1.0, 2.0].into_iter().map(at).collect();
+        let v: Vec<Box<dyn AirVehicle>> = [0.0, 3.0, -1.0, 1.0, 2.0].into_iter().map(at).collect();
         let n = nearest(&v, 0, 3);
         // 2 and 3 are both 1 m away: the lower index first.
         assert_eq!(&n[..4], &[Some(2), Some(3), Some(4), None]);

@@ -6,7 +6,7 @@ use crate::tasks::hover::Hover;
 use crate::tasks::landing::Landing;
 use crate::tasks::waypoints::Waypoints;
 use crate::tasks::{ActionError, Info, InfoVisitor, StepOutcome, Task};
-use crate::vehicle::{Kinematics, Vehicle};
+use crate::vehicle::Kinematics;
 
 /// A task instance of one of the three kinds.
 #[derive(Debug)]
@@ -55,8 +55,8 @@ impl TaskInstance {
     /// The state of the task's vehicle (the vehicle seam's kinematics).
     pub fn kinematics(&self) -> Kinematics {
         match self {
-            TaskInstance::Hover(t) => t.quadrotor().kinematics(),
-            TaskInstance::Waypoints(t) => t.quadrotor().kinematics(),
+            TaskInstance::Hover(t) => t.air_vehicle().kinematics(),
+            TaskInstance::Waypoints(t) => t.air_vehicle().kinematics(),
             TaskInstance::Landing(t) => t.lander().kinematics(),
         }
     }

@@ -7,6 +7,10 @@
 //! core's frames (world ENU, body FLU); [`crate::frames`] turns those into NED / FRD. The
 //! sensors read the kinematics, so a sensor model never depends on which model flies.
 
+pub mod air;
+
+pub use air::AirVehicle;
+
 use crate::error::CommandError;
 use crate::frames::{enu_to_ned, flu_to_frd};
 use crate::snapshot::SnapshotError;
@@ -112,5 +116,27 @@ impl VehicleStart {
 impl std::fmt::Debug for VehicleStart {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_tuple("VehicleStart").field(&self.take()).finish()
+    }
+}
+
+/// An air vehicle's start state, taken again and again as [`VehicleStart`] does: a world's
+/// vehicle goes back to it (a fleet's autopilot reconnecting).
+pub struct AirVehicleStart(Box<dyn AirVehicle>);
+
+impl AirVehicleStart {
+    /// Starts from a copy of `vehicle`'s state.
+    pub fn new<V: AirVehicle>(vehicle: V) -> Self {
+        AirVehicleStart(Box::new(vehicle))
+    }
+
+    /// A new vehicle in the start state.
+    pub fn take(&self) -> Box<dyn AirVehicle> {
+        self.0.clone_boxed()
+    }
+}
+
+impl std::fmt::Debug for AirVehicleStart {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_tuple("AirVehicleStart").field(&self.0).finish()
     }
 }
