@@ -48,7 +48,7 @@ fn info_len(t: &MultiFlight, i: usize) -> usize {
 /// The hover motor state of the nominal vehicle.
 fn hover(t: &MultiFlight) -> f64 {
     let q = t.world().vehicle(0);
-    hover_motor_state(&q.params, q.frame()).unwrap()
+    hover_motor_state(q.params(), q.frame()).unwrap()
 }
 
 #[test]
@@ -65,7 +65,7 @@ fn a_weak_motor_of_one_agent_gives_that_agent_its_share_of_thrust() {
         t.step(&[h; 8]).unwrap();
     }
     let ratio = t.world().vehicle(1).thrust() / t.world().vehicle(0).thrust();
-    let tau = t.world().vehicle(0).params.motor_time_constant;
+    let tau = t.world().vehicle(0).params().motor_time_constant;
     let weak = h * (0.5f64.sqrt() + (1.0 - 0.5f64.sqrt()) * (-0.5 / tau).exp());
     let expected = (3.0 * h * h + weak * weak) / (4.0 * h * h);
     assert!(
@@ -171,7 +171,7 @@ fn without_faults_the_task_flies_as_before_and_has_no_fault_info() {
         plain.step(&[0.5; 12]).unwrap();
     }
     for i in 0..3 {
-        assert_eq!(t.world().vehicle(i).body, plain.world().vehicle(i).body);
+        assert_eq!(t.world().vehicle(i).body(), plain.world().vehicle(i).body());
     }
 }
 

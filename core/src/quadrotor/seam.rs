@@ -118,6 +118,10 @@ impl AirVehicle for Quadrotor {
         self.external_wind = wind;
     }
 
+    fn external_wind(&self) -> Vector3<f64> {
+        self.external_wind
+    }
+
     fn set_external_force(&mut self, force: Vector3<f64>) {
         self.external_force = force;
     }

@@ -52,6 +52,8 @@ pub trait AirVehicle: Vehicle + Send + Sync + Any {
     /// Sets the wind added from outside (a world's wind field, the faults' air), world ENU,
     /// m/s, held until changed.
     fn set_external_wind(&mut self, wind: Vector3<f64>);
+    /// The wind added from outside, world ENU, m/s (what `set_external_wind` last set).
+    fn external_wind(&self) -> Vector3<f64>;
     /// Sets the force from outside (a world's contacts and downwash), world ENU, N, held
     /// until changed; not saved with the vehicle (whoever applies it saves it).
     fn set_external_force(&mut self, force: Vector3<f64>);

@@ -342,10 +342,10 @@ impl MultiFlight {
                 let quad = self.world.vehicle_mut(i);
                 // The world sets each vehicle's wind (a link's faults would set their own:
                 // air faults are refused in multi-agent tasks).
-                let wind = quad.external_wind;
+                let wind = quad.external_wind();
                 // Checked in `step`: finite and 4 values.
                 let _ = self.links[i].begin(quad, action, dt);
-                quad.external_wind = wind;
+                quad.set_external_wind(wind);
             }
         }
         let (mut now, end) = self.links[0].window(dt);

@@ -58,7 +58,7 @@ fn collide(name: &str, seed: u64, steps: usize) -> (Vec<u8>, [Vec<MavMessage>; 2
     f.member_mut(1).out.clear();
     answer(&mut f, 0, 0.0);
     answer(&mut f, 1, 0.0);
-    f.world.vehicle_mut(1).body.velocity.x = -2.0;
+    f.world.vehicle_mut(1).body_mut().velocity.x = -2.0;
     for _ in 0..steps {
         let _ = f.advance(false);
         take(&mut f);
