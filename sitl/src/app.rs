@@ -4,6 +4,7 @@
 use crate::autopilot_params::{self, Autopilot};
 use crate::cli::{Args, GcsTarget, ListFormat};
 use crate::config::{self, AutopilotVehicle, ConfigError};
+use crate::control_link::ControlLink;
 use crate::px4::server::Pacing;
 use crate::px4::session::{Session, SessionOptions};
 use crate::server::{self, GcsLink};
@@ -153,10 +154,15 @@ fn start_px4(args: Args) -> Result<(), StartError> {
     listener.set_nonblocking(true)?;
     let listen = listener.local_addr()?;
     let speed = args.speed_factor;
+    let control = control_link(&args)?;
     let ready = format!(
-        "flyloop-sitl ready px4={listen} mode=px4 model=quadrotor step_us={step_us} speed_factor={speed} seed={}",
-        args.seed
+        "flyloop-sitl ready px4={listen} mode=px4 model=quadrotor step_us={step_us} speed_factor={speed} seed={}{}",
+        args.seed,
+        control_field(control.as_ref())?,
     );
+    if let Some(control) = control {
+        session.set_control(control);
+    }
     let pacing = Pacing {
         speed_factor: speed,
     };
@@ -179,6 +185,12 @@ fn start_px4(args: Args) -> Result<(), StartError> {
 /// lockstep until a signal.
 fn start_fleet(args: Args) -> Result<(), StartError> {
     use crate::fleet::{self, file};
+    if args.control.is_some() {
+        return Err(StartError::Options(
+            "--control injects faults into one autopilot's vehicle; fleet mode has none yet"
+                .to_string(),
+        ));
+    }
     let mut spec = match &args.fleet {
         Some(path) => {
             let fleet_err = |source| StartError::FleetFile {
@@ -198,6 +210,12 @@ fn start_fleet(args: Args) -> Result<(), StartError> {
             };
             quadrotor_only(&args, if args.px4 { "--px4" } else { "--ardupilot" })?;
             let vehicle = vehicle_config(&args)?;
+            if !vehicle.faults.is_empty() {
+                return Err(StartError::Options(
+                    "`[[faults]]`: fleet mode takes no faults yet (the PX4 and ArduPilot modes do)"
+                        .to_string(),
+                ));
+            }
             file::row(
                 autopilot,
                 usize::from(args.vehicles),
@@ -398,6 +416,23 @@ fn view_stream(args: &Args) -> Result<Option<crate::view_stream::ViewStream>, St
     Ok(Some(stream))
 }
 
+/// The autopilot modes' control link (`--control`), if asked for.
+fn control_link(args: &Args) -> Result<Option<ControlLink>, StartError> {
+    let Some(addr) = args.control else {
+        return Ok(None);
+    };
+    let socket = bind("control", addr)?;
+    Ok(Some(ControlLink::new(socket)?))
+}
+
+/// ` control=HOST:PORT` for the ready line (empty without a control link).
+fn control_field(control: Option<&ControlLink>) -> Result<String, StartError> {
+    Ok(match control {
+        Some(c) => format!(" control={}", c.local_addr()?),
+        None => String::new(),
+    })
+}
+
 /// The vehicle of the autopilot modes: `--config`, else the Iris preset.
 fn vehicle_config(args: &Args) -> Result<AutopilotVehicle, StartError> {
     Ok(match &args.config {
@@ -427,10 +462,15 @@ fn start_ardupilot(args: Args) -> Result<(), StartError> {
         })?;
     let listen = socket.local_addr()?;
     let speed = args.speed_factor;
+    let control = control_link(&args)?;
     let ready = format!(
-        "flyloop-sitl ready ardupilot={listen} mode=ardupilot model=quadrotor speed_factor={speed} seed={}",
-        args.seed
+        "flyloop-sitl ready ardupilot={listen} mode=ardupilot model=quadrotor speed_factor={speed} seed={}{}",
+        args.seed,
+        control_field(control.as_ref())?,
     );
+    if let Some(control) = control {
+        session.set_control(control);
+    }
     let pacing = Pacing {
         speed_factor: speed,
     };
@@ -532,6 +572,11 @@ fn start_mavlink(
     config: TaskConfig,
     world: Option<WorldTask>,
 ) -> Result<(), StartError> {
+    if args.control.is_some() {
+        return Err(StartError::Options(
+            "--control is for the PX4 and ArduPilot modes: the MAVLink task mode takes MAV_CMD_INJECT_FAILURE on its --listen link (control= in the ready line)".to_string(),
+        ));
+    }
     let task_name = match &world {
         Some(w) => w.flight.scenario().name(),
         None => task.frame_name(),
@@ -569,7 +614,7 @@ fn start_mavlink(
         None => "off".to_string(),
     };
     let ready = format!(
-        "flyloop-sitl ready listen={listen} gcs={gcs_text} mode={} model={} task={} vehicles={} seed={}",
+        "flyloop-sitl ready listen={listen} gcs={gcs_text} mode={} model={} task={} vehicles={} seed={} control={listen}",
         args.mode().name(),
         args.model().name(),
         task_name,

@@ -112,6 +112,13 @@ pub struct Args {
     #[arg(long, default_value = "127.0.0.1:9002")]
     pub ardupilot_listen: SocketAddr,
 
+    /// PX4 and ArduPilot modes: control link, a MAVLink UDP address that takes
+    /// MAV_CMD_INJECT_FAILURE for the vehicle (system id 1) and answers COMMAND_ACK +
+    /// STATUSTEXT (port 0 picks a free port: see `control=` in the first stdout line). The
+    /// lockstep task mode takes the command on its `--listen` link.
+    #[arg(long)]
+    pub control: Option<SocketAddr>,
+
     /// PX4 and ArduPilot modes: simulation seconds per wall-clock second (0 = as fast as the
     /// autopilot answers). Start PX4 with the same PX4_SIM_SPEED_FACTOR, ArduPilot with a
     /// `--speedup` at least as high.

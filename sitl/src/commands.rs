@@ -9,7 +9,7 @@
 //! vehicle k the seed `seed + k − 1` (wrapping).
 
 use crate::vehicle::{Vehicle, next_seed};
-use mavlink::dialects::common::COMMAND_LONG_DATA;
+use mavlink::dialects::common::{COMMAND_LONG_DATA, MavResult, MavSeverity};
 
 /// Why a reset command was refused.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
@@ -90,6 +90,35 @@ pub fn failure_code(c: &COMMAND_LONG_DATA) -> Result<(u8, u8, u8), String> {
         byte("param2 (failure_type)", c.param2)?,
         byte("param3 (instance)", c.param3)?,
     ))
+}
+
+/// The answer to MAV_CMD_INJECT_FAILURE `c`, on every link that takes it: `inject` fires or
+/// clears PX4's code (unit, type, instance) and says what it did (ACCEPTED, a WARNING
+/// STATUSTEXT), or names the field the catalogue has no fault for (UNSUPPORTED); a parameter
+/// that is no integer code is DENIED. The text is the STATUSTEXT to send with the ack.
+pub fn inject_outcome(
+    c: &COMMAND_LONG_DATA,
+    inject: impl FnOnce(u8, u8, u8) -> Result<String, flyloop_core::ParamError>,
+) -> (MavResult, MavSeverity, String) {
+    match failure_code(c) {
+        Err(e) => (
+            MavResult::MAV_RESULT_DENIED,
+            MavSeverity::MAV_SEVERITY_ERROR,
+            format!("inject failure refused: {e}"),
+        ),
+        Ok((unit, failure, instance)) => match inject(unit, failure, instance) {
+            Ok(done) => (
+                MavResult::MAV_RESULT_ACCEPTED,
+                MavSeverity::MAV_SEVERITY_WARNING,
+                done,
+            ),
+            Err(e) => (
+                MavResult::MAV_RESULT_UNSUPPORTED,
+                MavSeverity::MAV_SEVERITY_ERROR,
+                format!("inject failure refused: {e}"),
+            ),
+        },
+    }
 }
 
 #[cfg(test)]

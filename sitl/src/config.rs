@@ -148,6 +148,9 @@ pub struct AutopilotVehicle {
     pub sensors: SensorParams,
     /// The rotor table (`[frame]`: `name = "hexa_x"`, or a whole table); the quad X if none.
     pub frame: Frame,
+    /// `[[faults]]` and `[[fault_randomization]]` (none: a healthy vehicle), checked against
+    /// the frame by the session.
+    pub faults: FaultPlan,
 }
 
 impl AutopilotVehicle {
@@ -163,11 +166,12 @@ impl AutopilotVehicle {
         let mut table: toml::Table = toml::from_str(text)?;
         let frame = take_frame(&mut table)?.unwrap_or_default();
         let file = walk(&table, autopilot_name)?;
-        if !file.faults.is_empty() {
-            return Err(ParamError::Parse(format!(
-                "`{FAULTS_TABLE}`: the PX4 and ArduPilot modes take no faults yet (the lockstep task mode does)"
-            )));
-        }
+        let rotors = frame.rotor_count();
+        file.faults.check(&flyloop_core::faults::Reach {
+            duration: None,
+            waypoints: None,
+            rotors,
+        })?;
         if file.ranges.is_some() {
             return Err(ParamError::Parse(format!(
                 "`{RANDOMIZE_TABLE}`: the PX4 and ArduPilot modes fly one vehicle, without randomisation"
@@ -181,6 +185,7 @@ impl AutopilotVehicle {
             quadrotor: QuadrotorParams::from_values(quad)?,
             sensors: SensorParams::from_values(sensors)?,
             frame,
+            faults: file.faults,
         })
     }
 }

@@ -17,6 +17,7 @@ pub mod air;
 pub mod battery;
 pub mod catalogue;
 pub mod draw;
+pub mod on_vehicle;
 pub mod plan;
 pub mod px4;
 pub mod sensor;
@@ -25,6 +26,7 @@ pub mod state;
 pub mod trigger;
 
 pub use catalogue::{CATALOGUE, FaultKind, SensorId};
+pub use on_vehicle::{Delivered, VehicleFaults};
 pub use plan::FaultPlan;
 pub use spec::FaultSpec;
 pub use state::{FaultEvent, FaultState};

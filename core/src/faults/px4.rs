@@ -38,6 +38,21 @@ pub enum Injection {
     Clear { motor: u8, sensor: Option<SensorId> },
 }
 
+impl Injection {
+    /// What the injection does, as the STATUSTEXT says it: `fault injected: motor_off:1`,
+    /// `fault cleared: gps`, `fault cleared: all motors`, `fault cleared: motor 2`.
+    pub fn describe(&self) -> String {
+        match self {
+            Injection::Fire(spec) => format!("fault injected: {}", spec.label()),
+            Injection::Clear {
+                sensor: Some(s), ..
+            } => format!("fault cleared: {}", s.name()),
+            Injection::Clear { motor: 0, .. } => "fault cleared: all motors".to_string(),
+            Injection::Clear { motor, .. } => format!("fault cleared: motor {motor}"),
+        }
+    }
+}
+
 /// The fault of PX4 code (`unit`, `failure`, `instance`) on a frame of `rotors`: an error
 /// naming the field for a code the catalogue has no fault for.
 pub fn from_px4(

@@ -221,6 +221,11 @@ impl FaultState {
         self.battery.is_some() || !self.active(|s| is_actuator(s.kind)).is_empty()
     }
 
+    /// Whether a fault of `sensor` is in effect.
+    pub fn acts_on_sensor(&self, sensor: SensorId) -> bool {
+        !self.active(|s| s.sensor == Some(sensor)).is_empty()
+    }
+
     /// Whether an air fault is in effect.
     pub fn acts_on_air(&self) -> bool {
         !self.active(|s| is_air(s.kind)).is_empty()

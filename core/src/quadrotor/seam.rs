@@ -197,4 +197,8 @@ impl Vehicle for Quadrotor {
     fn save(&self) -> Result<Vec<u8>, SnapshotError> {
         Quadrotor::save(self)
     }
+
+    fn set_external_wind(&mut self, wind: nalgebra::Vector3<f64>) {
+        self.external_wind = wind;
+    }
 }

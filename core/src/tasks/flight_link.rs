@@ -28,7 +28,6 @@ use super::flight_faults::FlightFaults;
 use super::randomization::{Randomization, VehicleParams};
 use crate::error::ParamError;
 use crate::faults::FaultPlan;
-use crate::faults::px4::Injection;
 use crate::frames::{attitude_ned, enu_to_ned, flu_to_frd};
 use crate::params::Parameters;
 use crate::quadrotor::{BodyState, multirotor_at};
@@ -232,14 +231,7 @@ impl FlightLink {
                     .insert(FlightFaults::new(FaultPlan::default(), rotors, duration)?)
             }
         };
-        let done = match &injection {
-            Injection::Fire(spec) => format!("fault injected: {}", spec.label()),
-            Injection::Clear {
-                sensor: Some(s), ..
-            } => format!("fault cleared: {}", s.name()),
-            Injection::Clear { motor: 0, .. } => "fault cleared: all motors".to_string(),
-            Injection::Clear { motor, .. } => format!("fault cleared: motor {motor}"),
-        };
+        let done = injection.describe();
         faults.inject(injection, self.flight.dt);
         Ok(done)
     }

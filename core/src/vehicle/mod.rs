@@ -85,6 +85,9 @@ pub trait Vehicle {
     fn is_finite(&self) -> bool;
     /// The whole state as bytes; a restored vehicle continues bit for bit.
     fn save(&self) -> Result<Vec<u8>, SnapshotError>;
+    /// Wind added to the vehicle's own (the air faults' gusts and shear), world ENU, m/s,
+    /// until set again; a vehicle that flies in no wind ignores it.
+    fn set_external_wind(&mut self, _wind: Vector3<f64>) {}
 }
 
 impl std::fmt::Debug for dyn Vehicle + Send {

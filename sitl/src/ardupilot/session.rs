@@ -5,14 +5,16 @@ use super::packet::{self, MAX_PWM, PacketError, ServoFrame};
 use super::reply::{self, State};
 use crate::autopilot_record::Sent;
 use crate::config::AutopilotVehicle;
+use crate::control_link::ControlLink;
 use crate::kinematics::attitude_ned;
+use crate::session_faults::SessionFaults;
 use crate::speed::SpeedLog;
 use crate::stats::us_per;
 use crate::track::SessionTrack;
 use flyloop_core::ParamError;
 use flyloop_core::quadrotor::standing_multirotor;
-use flyloop_core::sensors::Sensors;
-use flyloop_core::vehicle::{Vehicle, VehicleStart};
+use flyloop_core::sensors::{ImuReading, SensorReading, Sensors, baro};
+use flyloop_core::vehicle::{Kinematics, Vehicle, VehicleStart};
 use nalgebra::Vector3;
 use std::fmt;
 use std::net::SocketAddr;
@@ -118,11 +120,15 @@ pub struct Session {
     reply: Vec<u8>,
     /// Kinds of bad input already logged.
     logged: u8,
+    /// The IMU sample last sent while faults act (what an off IMU sensor repeats).
+    last_imu: Option<ImuReading>,
     /// Ground-truth CSV (`--track`), if any.
     pub track: SessionTrack,
     pub stats: Counters,
     /// Simulated time against wall time, logged while ArduPilot steps.
     pub speed: SpeedLog,
+    /// The vehicle's faults and the control link (nothing runs without them).
+    faults: SessionFaults,
 }
 
 /// What to do with a datagram.
@@ -142,6 +148,9 @@ impl Session {
         let c = &options.vehicle;
         let start = standing_multirotor(c.quadrotor.clone(), c.frame.clone(), options.seed)?;
         let sensors = Sensors::new(c.sensors.clone(), options.seed)?;
+        let rotors = c.frame.rotor_count();
+        let faults =
+            SessionFaults::imu_only(c.faults.clone(), rotors, c.quadrotor.mass, options.seed)?;
         Ok(Session {
             vehicle: start.take(),
             start: (start, sensors.clone()),
@@ -150,10 +159,17 @@ impl Session {
             last: None,
             reply: Vec::with_capacity(512),
             logged: 0,
+            last_imu: None,
             track: SessionTrack::default(),
             stats: Counters::default(),
             speed: SpeedLog::default(),
+            faults,
         })
+    }
+
+    /// Takes MAV_CMD_INJECT_FAILURE on `control` from now on (read while ArduPilot steps).
+    pub fn set_control(&mut self, control: ControlLink) {
+        self.faults.set_control(control);
     }
 
     /// Physics time of the last reply, µs.
@@ -268,6 +284,7 @@ impl Session {
     /// A new ArduPilot: counted, and a new connection number in the track.
     fn connect(&mut self) {
         self.stats.connections += 1;
+        self.faults.restart();
         self.track.connect();
     }
 
@@ -308,11 +325,14 @@ impl Session {
         let start = Instant::now();
         self.apply_motors(frame);
         let step_us = frame_step_us(frame.frame_rate);
-        self.time_us += step_us;
         let dt = step_us as f64 * 1e-6;
-        self.vehicle.advance(dt);
+        (self.faults).advance(self.vehicle.as_mut(), self.time_us, dt);
+        self.time_us += step_us;
         let k = self.vehicle.kinematics();
-        let imu = self.sensors.sample_imu(&k, dt);
+        let mut imu = self.sensors.sample_imu(&k, dt);
+        if self.faults.is_active() {
+            imu = self.faulted_imu(imu, &k, dt);
+        }
         self.stats.steps += 1;
         self.stats.physics += start.elapsed();
         self.speed.observe(self.time_us);
@@ -335,6 +355,26 @@ impl Session {
         reply::write(&mut self.reply, &state);
         let sent = Sent::Imu(&imu);
         self.track.record(self.time_us, self.vehicle.as_ref(), sent);
+    }
+
+    /// The IMU through the sensor path; an off gyro or accelerometer holds its last value
+    /// (ArduPilot needs both in every frame: a frame without one would be dropped).
+    fn faulted_imu(&mut self, imu: ImuReading, k: &Kinematics, dt: f64) -> ImuReading {
+        let mut r = SensorReading {
+            imu,
+            mag: Vector3::zeros(),
+            baro: baro::reading(k.position.z, 0.0),
+        };
+        let motors = self.vehicle.actuator_states();
+        let p = self.sensors.params();
+        let d = (self.faults).reading(&mut r, self.time_us, dt, p, &motors);
+        let last = self.last_imu.unwrap_or(imu);
+        let out = ImuReading {
+            accel: if d.accel { r.imu.accel } else { last.accel },
+            gyro: if d.gyro { r.imu.gyro } else { last.gyro },
+        };
+        self.last_imu = Some(out);
+        out
     }
 
     /// The body rates without noise, FRD (for tests).

@@ -220,10 +220,26 @@ fn faults_in_the_config_file_reach_the_task() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("`faults` must be tables"), "{e}");
-    let e = AutopilotVehicle::parse("[[faults]]\nkind = \"motor_off\"")
+}
+
+/// Issue 35: the PX4 and ArduPilot modes take faults too, checked against their frame and an
+/// open-ended flight (no waypoints).
+#[test]
+fn the_autopilot_modes_take_faults_checked_against_their_frame() {
+    let v = AutopilotVehicle::parse(
+        "[[faults]]\nkind = \"sensor_off\"\nsensor = \"gps\"\nat = 30.0\n\
+         [[fault_randomization]]\nkinds = [\"gust\"]\nat = [1.0, 2.0]",
+    )
+    .unwrap();
+    assert_eq!((v.faults.faults.len(), v.faults.draws.len()), (1, 1));
+    let e = AutopilotVehicle::parse("[[faults]]\nkind = \"motor_off\"\nmotor = 5")
         .unwrap_err()
         .to_string();
-    assert!(e.contains("take no faults yet"), "{e}");
+    assert!(e.contains("it must be in [0, 4]"), "{e}");
+    let e = AutopilotVehicle::parse("[[faults]]\nkind = \"motor_off\"\nat_waypoint = 1")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no waypoints"), "{e}");
 }
 
 /// A motor fault on a hexa addresses its six motors; a motor the frame lacks is refused

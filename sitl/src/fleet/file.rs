@@ -236,6 +236,12 @@ fn vehicle(i: usize, e: VehicleEntry, dir: &Path) -> Result<FleetVehicle, FleetE
         Some(path) => crate::config::load_autopilot_vehicle(&dir.join(path))
             .map_err(|err| item(format!("config: {err}")))?,
     };
+    if !vehicle.faults.is_empty() {
+        return Err(item(
+            "config: `[[faults]]`: fleet mode takes no faults yet (the PX4 and ArduPilot modes do)"
+                .to_string(),
+        ));
+    }
     if let Some(frame) = &e.frame {
         vehicle.frame = Frame::named(frame).map_err(|err| item(format!("frame: {err}")))?;
     }

@@ -2,6 +2,7 @@
 //! (units as PX4's simulator_mavlink reads them; see docs/protocol.md).
 
 use crate::kinematics::{round_i16, round_i32, round_u16};
+use flyloop_core::faults::Delivered;
 use flyloop_core::sensors::{GpsFix, ImuReading, SensorReading};
 use mavlink::dialects::common::{HIL_GPS_DATA, HIL_SENSOR_DATA, HilSensorUpdatedFlags, MavMessage};
 
@@ -23,9 +24,51 @@ pub fn sensor_fields() -> HilSensorUpdatedFlags {
         | F::HIL_SENSOR_UPDATED_TEMPERATURE
 }
 
+/// The field groups of a sample whose off sensors deliver nothing (their bits cleared: PX4
+/// reads no new value of them).
+pub fn delivered_fields(d: &Delivered) -> HilSensorUpdatedFlags {
+    use HilSensorUpdatedFlags as F;
+    let mut fields = sensor_fields();
+    let groups = [
+        (
+            d.accel,
+            F::HIL_SENSOR_UPDATED_XACC | F::HIL_SENSOR_UPDATED_YACC | F::HIL_SENSOR_UPDATED_ZACC,
+        ),
+        (
+            d.gyro,
+            F::HIL_SENSOR_UPDATED_XGYRO | F::HIL_SENSOR_UPDATED_YGYRO | F::HIL_SENSOR_UPDATED_ZGYRO,
+        ),
+        (
+            d.mag,
+            F::HIL_SENSOR_UPDATED_XMAG | F::HIL_SENSOR_UPDATED_YMAG | F::HIL_SENSOR_UPDATED_ZMAG,
+        ),
+        (
+            d.baro,
+            F::HIL_SENSOR_UPDATED_ABS_PRESSURE
+                | F::HIL_SENSOR_UPDATED_PRESSURE_ALT
+                | F::HIL_SENSOR_UPDATED_TEMPERATURE,
+        ),
+    ];
+    for (delivered, bits) in groups {
+        if !delivered {
+            fields.remove(bits);
+        }
+    }
+    fields
+}
+
 /// HIL_SENSOR at simulation time `time_usec` (µs): accel m/s², gyro rad/s, mag gauss, all body
 /// FRD; pressure hPa, altitude m, temperature °C.
 pub fn hil_sensor(r: &SensorReading, time_usec: u64) -> MavMessage {
+    hil_sensor_delivered(r, time_usec, sensor_fields())
+}
+
+/// HIL_SENSOR claiming only `fields` (a faulted sample: see [`delivered_fields`]).
+pub fn hil_sensor_delivered(
+    r: &SensorReading,
+    time_usec: u64,
+    fields: HilSensorUpdatedFlags,
+) -> MavMessage {
     let (m, b) = (r.mag, r.baro);
     MavMessage::HIL_SENSOR(HIL_SENSOR_DATA {
         xmag: m.x as f32,
@@ -35,7 +78,7 @@ pub fn hil_sensor(r: &SensorReading, time_usec: u64) -> MavMessage {
         diff_pressure: 0.0,
         pressure_alt: b.pressure_altitude as f32,
         temperature: b.temperature_c as f32,
-        fields_updated: sensor_fields(),
+        fields_updated: fields,
         ..hil_imu(&r.imu, time_usec)
     })
 }
@@ -120,6 +163,16 @@ mod tests {
         // Flying west, climbing: vn 0, ve −100, vd −50 cm/s, course 270°.
         assert_eq!((g.vn, g.ve, g.vd, g.cog), (0, -100, -50, 27_000));
         assert_eq!((g.fix_type, g.satellites_visible, g.time_usec), (3, 12, 7));
+    }
+
+    #[test]
+    fn an_off_sensor_loses_its_field_bits() {
+        let d = Delivered {
+            baro: false,
+            ..Delivered::ALL
+        };
+        assert_eq!(delivered_fields(&Delivered::ALL), sensor_fields());
+        assert_eq!(delivered_fields(&d).bits(), 0x7 | 0x38 | 0x1C0);
     }
 
     #[test]

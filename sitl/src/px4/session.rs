@@ -4,7 +4,9 @@
 use super::messages;
 use crate::autopilot_record::Sent;
 use crate::config::AutopilotVehicle;
+use crate::control_link::ControlLink;
 use crate::kinematics::Home;
+use crate::session_faults::SessionFaults;
 use crate::speed::SpeedLog;
 use crate::stats::Stats;
 use crate::telemetry;
@@ -54,6 +56,8 @@ pub struct Session {
     pub stats: Stats,
     /// Simulated time against wall time, logged while PX4 steps.
     pub speed: SpeedLog,
+    /// The vehicle's faults and the control link (nothing runs without them).
+    faults: SessionFaults,
 }
 
 /// The start vehicle after one step with the motors off: the state PX4's first controls meet.
@@ -70,6 +74,8 @@ impl Session {
         let start = standing_multirotor(c.quadrotor.clone(), c.frame.clone(), options.seed)?;
         let vehicle = first_state(&start, options.step_us.max(1));
         let sensors = Sensors::new(c.sensors.clone(), options.seed)?;
+        let rotors = c.frame.rotor_count();
+        let faults = SessionFaults::new(c.faults.clone(), rotors, c.quadrotor.mass, options.seed)?;
         let home = Home {
             latitude_deg: c.sensors.home_latitude,
             longitude_deg: c.sensors.home_longitude,
@@ -91,7 +97,13 @@ impl Session {
             track: SessionTrack::default(),
             stats: Stats::default(),
             speed: SpeedLog::default(),
+            faults,
         })
+    }
+
+    /// Takes MAV_CMD_INJECT_FAILURE on `control` from now on (read while PX4 steps).
+    pub fn set_control(&mut self, control: ControlLink) {
+        self.faults.set_control(control);
     }
 
     /// A new PX4 connection: the vehicle and sensors back to their start state, time back to
@@ -107,6 +119,7 @@ impl Session {
         self.gps_epoch_us = gps_epoch_us;
         self.decoder.clear();
         self.track.connect();
+        self.faults.restart();
         self.emit(out);
     }
 
@@ -210,7 +223,8 @@ impl Session {
     /// One physics step, then the sensors of the new time.
     fn advance(&mut self, out: &mut Vec<u8>) {
         let start = Instant::now();
-        self.vehicle.advance(self.step_us as f64 * 1e-6);
+        let dt = self.step_us as f64 * 1e-6;
+        (self.faults).advance(self.vehicle.as_mut(), self.time_us, dt);
         self.time_us += self.step_us;
         self.stats.steps += 1;
         self.emit(out);
@@ -222,11 +236,20 @@ impl Session {
     fn emit(&mut self, out: &mut Vec<u8>) {
         let dt = self.step_us as f64 * 1e-6;
         let k = self.vehicle.kinematics();
-        let reading = self.sensors.sample(&k, dt);
+        let mut reading = self.sensors.sample(&k, dt);
         let sent_from = out.len();
-        let sensor = messages::hil_sensor(&reading, self.time_us);
+        let sensor = if self.faults.is_active() {
+            let (p, motors) = (self.sensors.params(), self.vehicle.actuator_states());
+            let d = (self.faults).reading(&mut reading, self.time_us, dt, p, &motors);
+            let fields = messages::delivered_fields(&d);
+            messages::hil_sensor_delivered(&reading, self.time_us, fields)
+        } else {
+            messages::hil_sensor(&reading, self.time_us)
+        };
         self.encoder.push(out, SIMULATOR_SYSTEM, &sensor);
-        if let Some(fix) = self.sensors.gps(&k, self.time_us as f64 * 1e-6) {
+        let fix = self.sensors.gps(&k, self.time_us as f64 * 1e-6);
+        let (p, time_us) = (self.sensors.params(), self.time_us);
+        if let Some(fix) = fix.and_then(|f| self.faults.gps(f, time_us, p)) {
             let stamp = self.gps_epoch_us + (fix.measured_at * 1e6).round() as u64;
             self.encoder
                 .push(out, SIMULATOR_SYSTEM, &messages::hil_gps(&fix, stamp));
@@ -246,5 +269,7 @@ impl Session {
     }
 }
 
+#[cfg(test)]
+mod faults_tests;
 #[cfg(test)]
 pub(crate) mod tests;

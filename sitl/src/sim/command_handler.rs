@@ -121,29 +121,10 @@ impl Sim {
         targets: Range<usize>,
         out: &mut Vec<u8>,
     ) {
-        let code = crate::commands::failure_code(c);
         for i in targets {
-            let (result, severity, text) = match code {
-                Err(ref e) => (
-                    MavResult::MAV_RESULT_DENIED,
-                    MavSeverity::MAV_SEVERITY_ERROR,
-                    format!("inject failure refused: {e}"),
-                ),
-                Ok((unit, failure, instance)) => {
-                    match self.vehicles[i].task.inject_px4(unit, failure, instance) {
-                        Ok(done) => (
-                            MavResult::MAV_RESULT_ACCEPTED,
-                            MavSeverity::MAV_SEVERITY_WARNING,
-                            done,
-                        ),
-                        Err(e) => (
-                            MavResult::MAV_RESULT_UNSUPPORTED,
-                            MavSeverity::MAV_SEVERITY_ERROR,
-                            format!("inject failure refused: {e}"),
-                        ),
-                    }
-                }
-            };
+            let task = &mut self.vehicles[i].task;
+            let (result, severity, text) =
+                crate::commands::inject_outcome(c, |u, f, n| task.inject_px4(u, f, n));
             if result != MavResult::MAV_RESULT_ACCEPTED {
                 self.stats.refused_requests += 1;
             }

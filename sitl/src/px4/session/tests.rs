@@ -9,7 +9,7 @@ use mavlink::dialects::common::{
 };
 use nalgebra::Vector3;
 
-fn session(seed: u64) -> Session {
+pub(crate) fn session(seed: u64) -> Session {
     Session::new(&SessionOptions {
         vehicle: AutopilotVehicle::iris(),
         step_us: 4000,
@@ -33,7 +33,7 @@ pub(crate) fn controls(value: f32) -> Vec<u8> {
     out
 }
 
-fn messages(bytes: &[u8]) -> Vec<MavMessage> {
+pub(crate) fn messages(bytes: &[u8]) -> Vec<MavMessage> {
     frames(bytes).map(|f| f.unwrap().message).collect()
 }
 
