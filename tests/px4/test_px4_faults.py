@@ -1,0 +1,81 @@
+"""Issue 35: the real PX4 v1.16.0 flies through faults flyloop injects on its control link
+(`--control`): it loses GPS while it holds a hover. What PX4 reports (its console, its modes)
+and what it does (its failsafe; flyloop's truth) are printed and checked; docs/faults.md
+quotes them. PX4's offboard link (where the test listens) carries no STATUSTEXT: its words
+are read from its console."""
+
+from __future__ import annotations
+
+import time
+
+from px4_support import SPEED, launch, settle
+from pymavlink import mavutil
+
+# FAILURE_UNIT_SENSOR_GPS, FAILURE_TYPE_OFF (MAVLink common.xml).
+GPS, OFF = 4, 1
+
+
+def control_link(flyloop):
+    """A pymavlink link to flyloop's control endpoint (from its ready line)."""
+    return mavutil.mavlink_connection(
+        f"udpout:{flyloop.ready['control']}", source_system=250, dialect="common"
+    )
+
+
+def inject(link, unit: int, failure: int, instance: int = 0):
+    """MAV_CMD_INJECT_FAILURE to vehicle 1; returns flyloop's ack and STATUSTEXT."""
+    link.mav.command_long_send(
+        1, 1, mavutil.mavlink.MAV_CMD_INJECT_FAILURE, 0, unit, failure, instance, 0, 0, 0, 0
+    )
+    ack = link.recv_match(type="COMMAND_ACK", blocking=True, timeout=10)
+    text = link.recv_match(type="STATUSTEXT", blocking=True, timeout=10)
+    return ack, text
+
+
+def px4_texts(px4, seconds: float) -> list[tuple[float, str, int]]:
+    """PX4's STATUSTEXTs and mode changes over `seconds` of wall time: (wall s, text,
+    custom_mode of the latest heartbeat)."""
+    out = []
+    mode = None
+    end = time.monotonic() + seconds
+    start = time.monotonic()
+    while time.monotonic() < end:
+        m = px4.link.recv_match(type=["STATUSTEXT", "HEARTBEAT"], blocking=True, timeout=0.2)
+        if m is None or m.get_srcSystem() != px4.target:
+            continue
+        if m.get_type() == "HEARTBEAT":
+            if m.custom_mode != mode:
+                mode = m.custom_mode
+                out.append((time.monotonic() - start, f"mode {mode:#010x}", mode))
+            continue
+        out.append((time.monotonic() - start, m.text, mode))
+    return out
+
+
+# PX4's custom_mode of AUTO.LAND (main mode 4 AUTO in bits 16-23, sub mode 6 LAND in 24-31).
+AUTO_LAND = 0x06040000
+
+
+def test_px4_loses_gps_in_a_hover_and_lands(pair):
+    flyloop = pair.flyloop("--control", "127.0.0.1:0")
+    px4 = pair.px4()
+    _, target = launch(px4)
+    settle(px4, target, 0.5, 60)
+    console_before = len(px4.output())
+    link = control_link(flyloop)
+    ack, text = inject(link, GPS, OFF)
+    assert ack is not None and ack.result == mavutil.mavlink.MAV_RESULT_ACCEPTED, ack
+    assert text is not None and text.text == "fault injected: sensor_off:gps", text
+    events = px4_texts(px4, 25)
+    for t, what, _ in events:
+        print(f"{t * SPEED:6.1f} s after the fault (simulation)  {what}")
+    console = px4.output()[console_before:]
+    said = [line for line in console.splitlines() if "WARN" in line or "INFO" in line]
+    print("PX4's console after the fault:", *said, sep="\n  ")
+    flyloop.stop()
+    rows = flyloop.rows()
+    print(f"truth at the end: down {rows[-1]['down']:.2f} m, grounded {rows[-1]['grounded']}")
+    # PX4 switches to AUTO.LAND and puts the vehicle down.
+    assert any(mode == AUTO_LAND for _, _, mode in events), events
+    assert rows[-1]["grounded"] == 1.0, rows[-1]
+    assert "Failsafe: blind land" in console and "Disarmed by landing" in console, said
