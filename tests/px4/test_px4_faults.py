@@ -7,8 +7,9 @@ are read from its console."""
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
-from px4_support import SPEED, launch, settle
+from px4_support import SPEED, autopilot_params, collect, launch, settle
 from pymavlink import mavutil
 
 # FAILURE_UNIT_SENSOR_GPS, FAILURE_TYPE_OFF (MAVLink common.xml).
@@ -79,3 +80,45 @@ def test_px4_loses_gps_in_a_hover_and_lands(pair):
     assert any(mode == AUTO_LAND for _, _, mode in events), events
     assert rows[-1]["grounded"] == 1.0, rows[-1]
     assert "Failsafe: blind land" in console and "Disarmed by landing" in console, said
+
+
+HEXA = Path(__file__).resolve().parents[2] / "sitl" / "presets" / "px4_hexa_x.toml"
+# FAILURE_UNIT_SYSTEM_MOTOR (PX4's instance numbering: 1 = first motor).
+MOTOR = 101
+
+
+def test_px4_hexa_loses_motor_1_in_a_hover_and_lands(pair, sitl_binary):
+    params = autopilot_params(sitl_binary, HEXA, "px4")
+    flyloop = pair.flyloop("--config", str(HEXA), "--control", "127.0.0.1:0")
+    px4 = pair.px4(**params)
+    _, target = launch(px4)
+    settle(px4, target, 0.5, 60)
+    console_before = len(px4.output())
+    ack, text = inject(control_link(flyloop), MOTOR, OFF, 1)
+    assert ack is not None and ack.result == mavutil.mavlink.MAV_RESULT_ACCEPTED, ack
+    assert text is not None and text.text == "fault injected: motor_off:1", text
+    hold = collect(px4, 10.0)
+    h, v = hold.worst(target)
+    print(f"hexa without motor 1, 10 s hold: position error {h:.3f} m, altitude error {v:.3f} m")
+    px4.land()
+    px4.wait_for(
+        "the automatic disarm after landing",
+        lambda m: m.get_srcSystem() == px4.target and not px4.armed(m),
+        60,
+        "HEARTBEAT",
+    )
+    console = px4.output()[console_before:]
+    said = [line for line in console.splitlines() if "WARN" in line or "INFO" in line]
+    print("PX4's console after the fault:", *said, sep="\n  ")
+    flyloop.stop()
+    rows = flyloop.rows()
+    flying = [r for r in rows if r["down"] < rows[0]["down"] - 3.0]
+    print(f"motor 1 state in flight after the fault: {flying[-1]['m0']:.4f}")
+    off = [r for r in flying if r["m0"] < 0.01]
+    heights = [rows[0]["down"] - r["down"] for r in off]
+    print(
+        f"truth with motor 1 off: height {min(heights):.2f} to {max(heights):.2f} m, "
+        f"{len(off)} rows"
+    )
+    assert flying[-1]["m0"] < 0.01, flying[-1]
+    assert rows[-1]["grounded"] == 1.0, rows[-1]
