@@ -114,10 +114,6 @@ impl AirVehicle for Quadrotor {
         Quadrotor::rng_mut(self)
     }
 
-    fn set_external_wind(&mut self, wind: Vector3<f64>) {
-        self.external_wind = wind;
-    }
-
     fn external_wind(&self) -> Vector3<f64> {
         self.external_wind
     }

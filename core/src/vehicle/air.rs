@@ -49,10 +49,8 @@ pub trait AirVehicle: Vehicle + Send + Sync + Any {
     fn restart(&mut self, body: BodyState, rng: SimRng);
     /// Its random stream (tasks that sample from the same stream).
     fn rng_mut(&mut self) -> &mut SimRng;
-    /// Sets the wind added from outside (a world's wind field, the faults' air), world ENU,
-    /// m/s, held until changed.
-    fn set_external_wind(&mut self, wind: Vector3<f64>);
-    /// The wind added from outside, world ENU, m/s (what `set_external_wind` last set).
+    /// The wind added from outside, world ENU, m/s (what [`Vehicle::set_external_wind`]
+    /// last set: a world's wind field, the faults' air).
     fn external_wind(&self) -> Vector3<f64>;
     /// Sets the force from outside (a world's contacts and downwash), world ENU, N, held
     /// until changed; not saved with the vehicle (whoever applies it saves it).
