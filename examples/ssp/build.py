@@ -1,8 +1,9 @@
 """Builds SSP archives (SSP 1.0, System Structure and Parameterization) from flyloop's FMUs:
 one `<system>.ssp` per entry of systems.SYSTEMS, holding SystemStructure.ssd and the FMUs in
 resources/. Connections are made by name (an input connects to the one output of that name in
-the system; inputs nothing feeds keep their start values), parameters are inline
-ParameterBindings of each component, typed from its modelDescription.
+the system; an input nothing feeds is refused unless a parameter binds it or its component
+lists it in open_inputs), parameters are inline ParameterBindings of each component, typed
+from its modelDescription (Real, Integer or Boolean).
 
 Usage: .venv/bin/python examples/ssp/build.py [--fmus dist/fmu] [--out dist/ssp] [SYSTEM ...]
 """
@@ -84,11 +85,15 @@ def parameter_xml(component: Component, table: dict[str, tuple[str, str]]) -> st
                 f"`{name}` of {component.fmu} is an {causality}, not a parameter or input"
             )
         text = {
-            "Real": repr(float(value)),
-            "Integer": str(int(value)),
-            "Boolean": "true" if value else "false",
+            "Real": lambda v: repr(float(v)),
+            "Integer": lambda v: str(int(v)),
+            "Boolean": lambda v: "true" if v else "false",
         }
-        value = f'<ssv:{kind} value="{text[kind]}"/>'
+        if kind not in text:
+            raise WiringError(
+                f"`{name}` of {component.fmu} is a {kind}; a binding is Real, Integer or Boolean"
+            )
+        value = f'<ssv:{kind} value="{text[kind](value)}"/>'
         rows.append(f'                <ssv:Parameter name="{name}">{value}</ssv:Parameter>')
     body = "\n".join(rows)
     return f"""      <ssd:ParameterBindings>

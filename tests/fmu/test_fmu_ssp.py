@@ -136,6 +136,16 @@ def test_a_system_that_cannot_be_wired_is_refused_naming_the_variable(fmus, tmp_
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_binding_of_a_type_ssp_cannot_carry_is_refused_naming_it():
+    policy = systems.Component("p", "Policy.fmu", {"mode": 1, "gain": 2})
+    table = {"mode": ("parameter", "String"), "gain": ("parameter", "Integer")}
+    with pytest.raises(build.WiringError, match="`mode` of Policy.fmu is a String"):
+        build.parameter_xml(policy, table)
+    table["mode"] = ("parameter", "Boolean")
+    xml = build.parameter_xml(policy, table)
+    assert '<ssv:Boolean value="true"/>' in xml and '<ssv:Integer value="2"/>' in xml
+
+
 def test_the_archive_holds_the_ssd_and_each_fmu_once(runs, fmus, tmp_path):
     path = build.build(systems.SYSTEMS["attitude_hover"], fmus["Quadrotor"].parent, tmp_path)
     names = sorted(zipfile.ZipFile(path).namelist())
