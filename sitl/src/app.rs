@@ -8,7 +8,7 @@ use crate::control_link::ControlLink;
 use crate::px4::server::Pacing;
 use crate::px4::session::{Session, SessionOptions};
 use crate::server::{self, GcsLink};
-use crate::sim::{Mode, Sim, SimOptions, WorldTask};
+use crate::sim::{Sim, SimOptions, WorldTask};
 use crate::track::Track;
 use crate::{ardupilot, px4};
 use crate::{param_table, starter_config, task_frame};
@@ -543,14 +543,7 @@ fn printout(
 /// A multi-agent task as one world of `--vehicles` quadrotors on the lockstep MAVLink link
 /// (docs/protocol.md section 14).
 fn start_world(args: Args, scenario: Scenario) -> Result<(), StartError> {
-    let not_here = [
-        (args.mode() != Mode::Lockstep, "--realtime"),
-        (args.record.is_some(), "--record"),
-        (args.list_params.is_some(), "--list-params"),
-        (args.describe_frame, "--describe-frame"),
-        (args.model() != ModelKind::Quadrotor, "--model lander2d"),
-    ];
-    if let Some((_, option)) = not_here.iter().find(|(set, _)| *set) {
+    if let Some(option) = args.not_for_a_world() {
         return Err(StartError::Options(format!(
             "{option} is not available for the multi-agent task `{}` (a lockstep world; docs/protocol.md section 14)",
             scenario.name()

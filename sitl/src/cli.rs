@@ -342,6 +342,22 @@ impl Args {
         }
     }
 
+    /// The first option set that a multi-agent world does not take (it runs in lockstep and
+    /// writes nothing beside the flight), if any: refused at start-up rather than ignored.
+    pub fn not_for_a_world(&self) -> Option<&'static str> {
+        [
+            (self.mode() != Mode::Lockstep, "--realtime"),
+            (self.record.is_some(), "--record"),
+            (self.track.is_some(), "--track"),
+            (self.view.is_some(), "--view"),
+            (self.list_params.is_some(), "--list-params"),
+            (self.describe_frame, "--describe-frame"),
+            (self.model() != ModelKind::Quadrotor, "--model lander2d"),
+        ]
+        .into_iter()
+        .find_map(|(set, option)| set.then_some(option))
+    }
+
     pub fn mode(&self) -> Mode {
         if self.realtime {
             Mode::Realtime
@@ -399,6 +415,24 @@ mod tests {
         let a = parse(&["--task", "multi_hover"]).unwrap();
         assert_eq!(a.world_task(), Some(Scenario::MultiHover));
         assert_eq!(parse(&["--task", "hover"]).unwrap().world_task(), None);
+    }
+
+    #[test]
+    fn a_world_refuses_the_options_it_would_ignore() {
+        let world = ["--task", "swap", "--vehicles", "2"];
+        assert_eq!(parse(&world).unwrap().not_for_a_world(), None);
+        for (extra, named) in [
+            (&["--realtime"][..], "--realtime"),
+            (&["--record", "w.tlog"], "--record"),
+            (&["--track", "w.csv"], "--track"),
+            (&["--view", "127.0.0.1:14570"], "--view"),
+            (&["--list-params"], "--list-params"),
+            (&["--describe-frame"], "--describe-frame"),
+            (&["--model", "lander2d"], "--model lander2d"),
+        ] {
+            let a = parse(&[&world[..], extra].concat()).unwrap();
+            assert_eq!(a.not_for_a_world(), Some(named), "{extra:?}");
+        }
     }
 
     #[test]
