@@ -214,3 +214,45 @@ fn a_reset_drops_the_commands_a_step_held() {
     assert_eq!(sim.stats.steps, 0, "the held commands went with the reset");
     assert_eq!(sim.stats.held_steps, 2);
 }
+
+#[test]
+fn a_command_naming_another_step_than_the_one_gathered_is_refused() {
+    let mut sim = world_sim();
+    let client: SocketAddr = "127.0.0.1:41004".parse().unwrap();
+    let mut enc = Encoder::default();
+    let now = Instant::now();
+    let mut out = Vec::new();
+    let first = controls(&mut enc, 1, [0.5; 4], 10_000, true);
+    sim.handle(Link::Controller, client, &first, now, &mut out);
+    out.clear();
+    let other = controls(&mut enc, 2, [0.5; 4], 20_000, true);
+    sim.handle(Link::Controller, client, &other, now, &mut out);
+    let said = crate::refused_controls::said(&out);
+    assert!(
+        said.iter()
+            .any(|(s, t)| *s == 2
+                && t.contains("time_usec 20000 is not the step being gathered, 10000")),
+        "{said:?}"
+    );
+    assert_eq!(sim.stats.stale_controls, 1);
+    // The step still waits for vehicles 2 and 3, and steps under its own name.
+    let rest: Vec<u8> = (2..=AGENTS)
+        .flat_map(|s| controls(&mut enc, s, [0.5; 4], 10_000, true))
+        .collect();
+    out.clear();
+    sim.handle(Link::Controller, client, &rest, now, &mut out);
+    assert_eq!(sim.stats.steps, 1);
+    assert_eq!(
+        frame_values(&out).iter().filter(|v| !v.is_empty()).count(),
+        3
+    );
+    // The refused command was not kept for the next step: vehicle 2 alone steps nothing.
+    out.clear();
+    sim.handle(Link::Controller, client, &other, now, &mut out);
+    assert_eq!(sim.stats.steps, 1);
+    assert!(
+        sim.world
+            .as_ref()
+            .is_some_and(|w| w.missing() == vec![1, 3])
+    );
+}

@@ -22,6 +22,9 @@ pub(crate) enum Refusal {
     LateDuplicate { step: u64, clock_us: u64 },
     /// It names the vehicle's last step, which a reset has since ended.
     BeforeReset { step: u64 },
+    /// A multi-agent world: it names another step than the one whose commands are being
+    /// gathered (`gathering`, named by an earlier command of the step).
+    OtherStep { step: u64, gathering: u64 },
     /// It came in on the ground-station link, which flies nothing.
     GcsLink,
     /// An intact MAVLink 1 frame from `system_id` (this SITL reads MAVLink 2 only).
@@ -35,9 +38,9 @@ impl Refusal {
             Refusal::UnknownVehicle { .. } => stats.unknown_vehicle += 1,
             Refusal::NotLockstep { .. } => stats.unflagged_controls += 1,
             Refusal::BadValue(_) => stats.refused_controls += 1,
-            Refusal::LateDuplicate { .. } | Refusal::BeforeReset { .. } => {
-                stats.stale_controls += 1
-            }
+            Refusal::LateDuplicate { .. }
+            | Refusal::BeforeReset { .. }
+            | Refusal::OtherStep { .. } => stats.stale_controls += 1,
             Refusal::GcsLink => stats.gcs_controls += 1,
             // Counted with every MAVLink 1 frame (`mavlink1`) when it was skipped.
             Refusal::MavlinkV1 { .. } => {}
@@ -73,6 +76,12 @@ impl Refusal {
             }
             Refusal::BeforeReset { step } => {
                 format!("time_usec {step} names the last step before a reset (a late duplicate)")
+            }
+            Refusal::OtherStep { step, gathering } => {
+                format!(
+                    "time_usec {step} is not the step being gathered, {gathering} (every \
+                     vehicle's command of a step names it alike)"
+                )
             }
             Refusal::GcsLink => {
                 "controls on the ground-station link are not flown (send them to --listen)".into()

@@ -92,6 +92,18 @@ impl Sim {
                 return self.refuse(Link::Controller, from, i, refusal, now, out);
             }
         }
+        // Every command of a step names it alike: one naming another step while this one is
+        // gathered would be flown in the wrong step (or step this one under a wrong name).
+        if let Some(gathering) = w
+            .gathering()
+            .filter(|&g| c.time_usec != 0 && c.time_usec != g)
+        {
+            let refusal = Refusal::OtherStep {
+                step: c.time_usec,
+                gathering,
+            };
+            return self.refuse(Link::Controller, from, i, refusal, now, out);
+        }
         let used = &c.controls[..ACTION_SIZE];
         if let Some(channel) = used.iter().position(|x| !x.is_finite()) {
             let e = ControlError::NotFinite {

@@ -130,6 +130,11 @@ impl WorldTask {
         }
     }
 
+    /// The name of the step being gathered, once a command of it named one (not 0).
+    pub(crate) fn gathering(&self) -> Option<u64> {
+        (self.have_count > 0 && self.pending_name != 0).then_some(self.pending_name)
+    }
+
     /// Whether some, not all, commands of a step are in.
     pub fn incomplete(&self) -> bool {
         self.have_count > 0 && self.have_count < self.have.len()
@@ -235,10 +240,14 @@ mod tests {
             Gathered::Waiting,
             "a repeat adds nothing"
         );
+        assert_eq!(w.gathering(), Some(10_000));
         assert_eq!(w.gather(1, &hover, 10_000), Gathered::Complete);
         assert_eq!(w.step().unwrap(), 10_000);
         assert_eq!((w.clock_us, w.episode_step), (10_000, 1));
         assert!(!w.incomplete());
+        assert_eq!(w.gathering(), None);
+        assert_eq!(w.gather(0, &hover, 0), Gathered::Waiting);
+        assert_eq!(w.gathering(), None, "an unnamed command names no step");
     }
 
     #[test]
