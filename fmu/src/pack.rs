@@ -44,26 +44,62 @@ pub fn write_fmu(
     library: &Path,
     out_dir: &Path,
 ) -> Result<PathBuf, PackError> {
-    let xml = generate(table, version);
-    let binary = fs::read(library).map_err(at(library))?;
     fs::create_dir_all(out_dir).map_err(at(out_dir))?;
     let path = out_dir.join(format!("{}.fmu", stem(table, version)));
-    let file = File::create(&path).map_err(at(&path))?;
+    write_archive(table, version, library, &path, &[])?;
+    Ok(path)
+}
+
+/// Writes the FMU `path`: the modelDescription, `library` as the model's binary and
+/// `resources` (file name, bytes) under `resources/`. The archive is written next to `path`
+/// and renamed onto it once complete, so a failure leaves no partial FMU at `path`.
+pub fn write_archive(
+    table: &ModelTable,
+    version: Api,
+    library: &Path,
+    path: &Path,
+    resources: &[(&str, &[u8])],
+) -> Result<(), PackError> {
+    let xml = generate(table, version);
+    let binary = fs::read(library).map_err(at(library))?;
+    let partial = path.with_extension("fmu.partial");
+    let written = write_zip(table, version, &xml, &binary, resources, &partial);
+    if written.is_err() {
+        let _ = fs::remove_file(&partial);
+    }
+    written?;
+    fs::rename(&partial, path).map_err(at(path))
+}
+
+fn write_zip(
+    table: &ModelTable,
+    version: Api,
+    xml: &str,
+    binary: &[u8],
+    resources: &[(&str, &[u8])],
+    path: &Path,
+) -> Result<(), PackError> {
+    let file = File::create(path).map_err(at(path))?;
     let mut zip = ZipWriter::new(file);
     let options = SimpleFileOptions::default().compression_method(CompressionMethod::Deflated);
     zip.start_file("modelDescription.xml", options.unix_permissions(0o644))
-        .map_err(at(&path))?;
-    zip.write_all(xml.as_bytes()).map_err(at(&path))?;
+        .map_err(at(path))?;
+    zip.write_all(xml.as_bytes()).map_err(at(path))?;
     let platform = match version {
         Api::Fmi2 => "linux64",
         Api::Fmi3 => "x86_64-linux",
     };
     let so = format!("binaries/{platform}/{}.so", table.info.identifier);
     zip.start_file(so, options.unix_permissions(0o755))
-        .map_err(at(&path))?;
-    zip.write_all(&binary).map_err(at(&path))?;
-    zip.finish().map_err(at(&path))?;
-    Ok(path)
+        .map_err(at(path))?;
+    zip.write_all(binary).map_err(at(path))?;
+    for (name, bytes) in resources {
+        zip.start_file(format!("resources/{name}"), options.unix_permissions(0o644))
+            .map_err(at(path))?;
+        zip.write_all(bytes).map_err(at(path))?;
+    }
+    zip.finish().map_err(at(path))?;
+    Ok(())
 }
 
 /// Where the checked-in modelDescription of `table` lives under `dir`.

@@ -47,3 +47,16 @@ def core_trajectory(fmus):
         return json.loads(result.stdout)
 
     return run
+
+
+@pytest.fixture(scope="session")
+def policy_fmus(fmus) -> dict[str, Path]:
+    """dist/fmu/HexaHoverPolicy.fmu and -fmi3.fmu (scripts/pack-policy-fmus.sh: the policy
+    library links tract, so it is built only for the tests that need it)."""
+    out = ROOT / "dist" / "fmu"
+    script = ROOT / "scripts" / "pack-policy-fmus.sh"
+    subprocess.run(["bash", str(script), str(out)], cwd=ROOT, check=True)
+    paths = {name: out / f"{name}.fmu" for name in ("HexaHoverPolicy", "HexaHoverPolicy-fmi3")}
+    for path in paths.values():
+        assert path.is_file(), path
+    return paths

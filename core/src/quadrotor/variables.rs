@@ -96,6 +96,29 @@ const WIND_OUTPUTS: &[OutputRow<Quadrotor>] = &[
     }),
 ];
 
+/// Outputs after the wind: the body's angular acceleration, which the gym's hover observation
+/// holds (a policy FMU builds that observation from the plant's outputs).
+const ANGULAR_ACCELERATION_OUTPUTS: &[OutputRow<Quadrotor>] = &[
+    OutputRow::real(
+        "dwx",
+        "rad/s2",
+        "Angular acceleration about body x (forward)",
+        |q| q.accelerations().1.x,
+    ),
+    OutputRow::real(
+        "dwy",
+        "rad/s2",
+        "Angular acceleration about body y (left)",
+        |q| q.accelerations().1.y,
+    ),
+    OutputRow::real(
+        "dwz",
+        "rad/s2",
+        "Angular acceleration about body z (up)",
+        |q| q.accelerations().1.z,
+    ),
+];
+
 /// Inputs after the motor commands.
 const WIND_INPUTS: &[InputRow<Quadrotor>] = &[
     wind::<0>(
@@ -293,6 +316,7 @@ impl VariableTable for Quadrotor {
         (BODY_OUTPUTS.iter().cloned())
             .chain(motor_states(frame))
             .chain(wind)
+            .chain(ANGULAR_ACCELERATION_OUTPUTS.iter().cloned())
             .collect()
     }
 

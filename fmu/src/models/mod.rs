@@ -19,7 +19,8 @@ use crate::model::{FmuModel, Table};
 use crate::table::ModelTable;
 use flyloop_core::lander2d::Lander2d;
 use flyloop_core::quadrotor::{Frame, Quadrotor};
-use std::sync::LazyLock;
+use std::path::Path;
+use std::sync::{LazyLock, OnceLock};
 
 /// A shipped frame by name (the crate's tests build every declared FMU).
 fn shipped(name: &str) -> Frame {
@@ -68,6 +69,40 @@ pub fn tables() -> [&'static ModelTable; 5] {
         &RATE_CONTROLLER.table,
         &ATTITUDE_CONTROLLER.table,
     ]
+}
+
+/// FMUs of another library built on this FMI layer, whose models are read from the FMU's
+/// resources (Policy.fmu: `flyloop-fmu-policy`). That library's cdylib carries these exports
+/// too and registers its catalog when it is loaded; the plant library registers none.
+pub trait Catalog: Sync {
+    /// A fresh simulation of the FMU in `resources` (the unpacked FMU's `resources/` folder)
+    /// whose token is `token`; `None` when it is not one of this catalog's.
+    fn simulation_for(
+        &self,
+        api: Api,
+        token: &str,
+        resources: Option<&Path>,
+    ) -> Option<Result<Box<dyn Simulation>, FmuError>>;
+}
+
+static CATALOG: OnceLock<&'static dyn Catalog> = OnceLock::new();
+
+/// Registers the library's extra catalog (once; a second one is refused with `false`).
+pub fn register_catalog(catalog: &'static dyn Catalog) -> bool {
+    CATALOG.set(catalog).is_ok()
+}
+
+/// The simulation for `token`: one of [`tables`], else one of the registered catalog's.
+pub fn simulation_in(
+    api: Api,
+    token: &str,
+    resources: Option<&Path>,
+) -> Option<Result<Box<dyn Simulation>, FmuError>> {
+    simulation_for(api, token).or_else(|| {
+        CATALOG
+            .get()
+            .and_then(|c| c.simulation_for(api, token, resources))
+    })
 }
 
 /// A fresh simulation of the FMU whose GUID (FMI 2.0) or instantiation token (FMI 3.0) is

@@ -3,7 +3,7 @@
 
 use crate::api::Api;
 use crate::exports::guard::c_str;
-use crate::exports::shared::instantiate::{Request, instantiate};
+use crate::exports::shared::instantiate::{Request, instantiate, resource_path};
 use crate::exports::shared::lifecycle::setup_experiment;
 use crate::fmi2_types::*;
 use crate::instance::{Interface, Stage, masks};
@@ -31,7 +31,7 @@ exports! {
         instanceName: fmi2String,
         fmuType: fmi2Type,
         fmuGUID: fmi2String,
-        _fmuResourceLocation: fmi2String,
+        fmuResourceLocation: fmi2String,
         functions: *const fmi2CallbackFunctions,
         _visible: fmi2Boolean,
         loggingOn: fmi2Boolean,
@@ -55,6 +55,8 @@ exports! {
             name: c_str(instanceName),
             interface,
             token: c_str(fmuGUID),
+            resources: c_str(fmuResourceLocation)
+                .and_then(|uri| resource_path(&uri.to_string_lossy())),
             sink,
             logging_on: loggingOn != fmi2False,
         })

@@ -24,6 +24,7 @@ unsafe fn instantiate3(
     function: &'static str,
     interface: Result<Interface, String>,
     (name, token, logging_on): (fmi3String, fmi3String, fmi3Boolean),
+    resource_path: fmi3String,
     (environment, callback): (fmi3InstanceEnvironment, Option<fmi3LogMessageCallback>),
 ) -> fmi3Instance {
     instantiate(Request {
@@ -34,6 +35,9 @@ unsafe fn instantiate3(
         interface,
         // SAFETY: as above.
         token: unsafe { c_str(token) },
+        // SAFETY: as above. FMI 3.0's resourcePath is a plain path.
+        resources: unsafe { c_str(resource_path) }
+            .map(|p| std::path::PathBuf::from(p.to_string_lossy().into_owned())),
         sink: Some(Sink::Fmi3 {
             callback,
             environment,
@@ -49,7 +53,7 @@ exports! {
     fn fmi3InstantiateModelExchange(
         instanceName: fmi3String,
         instantiationToken: fmi3String,
-        _resourcePath: fmi3String,
+        resourcePath: fmi3String,
         _visible: fmi3Boolean,
         loggingOn: fmi3Boolean,
         instanceEnvironment: fmi3InstanceEnvironment,
@@ -57,7 +61,7 @@ exports! {
     ) -> fmi3Instance {
         let args = (instanceName, instantiationToken, loggingOn);
         let logger = (instanceEnvironment, logMessage);
-        instantiate3("fmi3InstantiateModelExchange", Ok(Interface::ModelExchange), args, logger)
+        instantiate3("fmi3InstantiateModelExchange", Ok(Interface::ModelExchange), args, resourcePath, logger)
     }
 
     /// A Co-Simulation instance. Refused (NULL, with the reason logged) with
@@ -67,7 +71,7 @@ exports! {
     fn fmi3InstantiateCoSimulation(
         instanceName: fmi3String,
         instantiationToken: fmi3String,
-        _resourcePath: fmi3String,
+        resourcePath: fmi3String,
         _visible: fmi3Boolean,
         loggingOn: fmi3Boolean,
         eventModeUsed: fmi3Boolean,
@@ -87,14 +91,14 @@ exports! {
         } else {
             Ok(Interface::CoSimulation)
         };
-        instantiate3("fmi3InstantiateCoSimulation", interface, args, logger)
+        instantiate3("fmi3InstantiateCoSimulation", interface, args, resourcePath, logger)
     }
 
     /// Scheduled Execution is not offered: always NULL, with the reason logged.
     fn fmi3InstantiateScheduledExecution(
         instanceName: fmi3String,
         instantiationToken: fmi3String,
-        _resourcePath: fmi3String,
+        resourcePath: fmi3String,
         _visible: fmi3Boolean,
         loggingOn: fmi3Boolean,
         instanceEnvironment: fmi3InstanceEnvironment,
@@ -107,7 +111,7 @@ exports! {
         let logger = (instanceEnvironment, logMessage);
         let why = "Scheduled Execution is not offered (the modelDescription has no \
                    ScheduledExecution element)";
-        instantiate3("fmi3InstantiateScheduledExecution", Err(why.to_string()), args, logger)
+        instantiate3("fmi3InstantiateScheduledExecution", Err(why.to_string()), args, resourcePath, logger)
     }
 }
 

@@ -8,6 +8,7 @@ use crate::models;
 use std::collections::HashMap;
 use std::ffi::{CStr, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::PathBuf;
 
 /// An instantiation request, its C arguments already read.
 pub(crate) struct Request<'a> {
@@ -18,6 +19,8 @@ pub(crate) struct Request<'a> {
     pub interface: Result<Interface, String>,
     /// FMI 2.0's GUID or FMI 3.0's instantiation token.
     pub token: Option<&'a CStr>,
+    /// The unpacked FMU's resources folder, when the importer named one it can be read from.
+    pub resources: Option<PathBuf>,
     /// `None` (FMI 2.0 without a logger callback): no one to tell why instantiation fails.
     pub sink: Option<Sink>,
     pub logging_on: bool,
@@ -56,7 +59,8 @@ pub(crate) fn instantiate(request: Request<'_>) -> *mut c_void {
             instance_name: request.name.map(CStr::to_owned).unwrap_or_default(),
         };
         let found = checked(&request).and_then(|(interface, token)| {
-            let sim = models::simulation_for(api, &token).ok_or_else(|| unknown(api, &token))?;
+            let sim = models::simulation_in(api, &token, request.resources.as_deref())
+                .ok_or_else(|| unknown(api, &token))?;
             let sim = sim.map_err(|e| format!("the model does not start: {e}"))?;
             let table = sim.table();
             if interface == Interface::ModelExchange && table.model_exchange.is_none() {
@@ -93,4 +97,53 @@ pub(crate) fn instantiate(request: Request<'_>) -> *mut c_void {
         Some(Box::into_raw(Box::new(instance)).cast())
     }));
     outcome.ok().flatten().unwrap_or(std::ptr::null_mut())
+}
+
+/// FMI 2.0's fmuResourceLocation (a `file:` URI) as a path: `file:///a/b`, `file:/a/b` and
+/// `file://localhost/a/b`, with %XX escapes decoded; `None` for another scheme.
+pub(crate) fn resource_path(uri: &str) -> Option<PathBuf> {
+    let rest = uri.strip_prefix("file:")?;
+    let rest = match rest.strip_prefix("//") {
+        Some(authority) => &authority[authority.find('/')?..],
+        None => rest,
+    };
+    let bytes = rest.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let escaped = (bytes[i] == b'%')
+            .then(|| std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok())
+            .flatten()
+            .and_then(|hex| u8::from_str_radix(hex, 16).ok());
+        match escaped {
+            Some(b) => {
+                out.push(b);
+                i += 3;
+            }
+            None => {
+                out.push(bytes[i]);
+                i += 1;
+            }
+        }
+    }
+    Some(PathBuf::from(String::from_utf8(out).ok()?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::resource_path;
+    use std::path::Path;
+
+    #[test]
+    fn resource_uris_become_paths() {
+        let want = Path::new("/tmp/fmu dir/resources");
+        for uri in [
+            "file:///tmp/fmu%20dir/resources",
+            "file:/tmp/fmu%20dir/resources",
+            "file://localhost/tmp/fmu%20dir/resources",
+        ] {
+            assert_eq!(resource_path(uri).as_deref(), Some(want), "{uri}");
+        }
+        assert_eq!(resource_path("http://example.org/r"), None);
+    }
 }

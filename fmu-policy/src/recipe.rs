@@ -1,0 +1,167 @@
+//! A policy's recipe (`recipe.json`, written by examples/train/export_onnx.py): how Policy.fmu
+//! builds the network's input from the plant's outputs and turns the network's output into
+//! the plant's inputs, exactly as the gym env the policy was trained on does it. Every check
+//! names the file and the field it failed on.
+
+use crate::error::PolicyError;
+use serde::Deserialize;
+use std::path::Path;
+
+/// The recipe's format tag.
+pub const FORMAT: &str = "flyloop-policy-recipe/1";
+
+/// The recipe's file name in a policy folder and in the FMU's resources.
+pub const RECIPE_FILE: &str = "recipe.json";
+
+/// Fewest and most rotors of a multirotor plant (the core's frames).
+const ROTORS: (usize, usize) = (4, flyloop_core::quadrotor::frame::MAX_ROTORS);
+
+/// The observation groups of the "hover-motors" recipe (the gym's QuadHover motor
+/// interface), with their sizes for `rotors` motors.
+pub fn hover_motors_layout(rotors: usize) -> Vec<(&'static str, usize)> {
+    vec![
+        ("target_offset", 3),
+        ("velocity", 3),
+        ("acceleration", 3),
+        ("quaternion", 4),
+        ("body_rates", 3),
+        ("angular_acceleration", 3),
+        ("body_z_axis", 3),
+        ("wind", 3),
+        ("motor_states", rotors),
+        ("motor_commands", rotors),
+    ]
+}
+
+/// `recipe.json` as read.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Recipe {
+    /// [`FORMAT`].
+    pub format: String,
+    /// Which observation: "hover-motors" (the only one so far).
+    pub observation: String,
+    /// The gym's observation groups (name, size), as the env describes them; must be the
+    /// recipe's ([`hover_motors_layout`]).
+    pub layout: Vec<(String, usize)>,
+    /// Motors of the plant: outputs `motor_command_0..`, inputs `motor_state_0..`.
+    pub rotors: usize,
+    /// The gym's control step: the FMU acts every this many seconds, s.
+    pub sample_period: f64,
+    /// The env's observation bounds (float32): each value is clipped into them.
+    pub observation_low: Vec<f64>,
+    pub observation_high: Vec<f64>,
+    /// The observation normalisation (float64): (o - mean) / sqrt(var + epsilon), clipped
+    /// into +-clip, then float32.
+    pub observation_mean: Vec<f64>,
+    pub observation_var: Vec<f64>,
+    pub normalisation_epsilon: f64,
+    pub normalisation_clip: f64,
+    /// The network's output is clipped into +-this (float32).
+    pub action_clip: f64,
+    /// gymnasium's RescaleAction (float32): command = (a - intercept) / gradient.
+    pub action_gradient: Vec<f64>,
+    pub action_intercept: Vec<f64>,
+    /// The ONNX file next to the recipe.
+    pub network: String,
+    /// Where the policy came from (free text).
+    #[serde(default)]
+    pub source: String,
+}
+
+impl Recipe {
+    /// Reads and checks `folder/recipe.json`.
+    pub fn read(folder: &Path) -> Result<Recipe, PolicyError> {
+        let path = folder.join(RECIPE_FILE);
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| PolicyError::file(&path, format!("cannot be read: {e}")))?;
+        let recipe: Recipe = serde_json::from_str(&text)
+            .map_err(|e| PolicyError::file(&path, format!("is not a policy recipe: {e}")))?;
+        recipe.check(&path)?;
+        Ok(recipe)
+    }
+
+    /// The observation's size.
+    pub fn observation_size(&self) -> usize {
+        self.layout.iter().map(|(_, n)| n).sum()
+    }
+
+    fn check(&self, path: &Path) -> Result<(), PolicyError> {
+        let bad = |field: &str, why: String| Err(PolicyError::field(path, field, why));
+        if self.format != FORMAT {
+            return bad("format", format!("{:?} is not {FORMAT:?}", self.format));
+        }
+        if self.observation != "hover-motors" {
+            let why = format!(
+                "{:?}: the recipes known are [\"hover-motors\"]",
+                self.observation
+            );
+            return bad("observation", why);
+        }
+        if !(ROTORS.0..=ROTORS.1).contains(&self.rotors) {
+            let why = format!("{} is not in [{}, {}]", self.rotors, ROTORS.0, ROTORS.1);
+            return bad("rotors", why);
+        }
+        let want = hover_motors_layout(self.rotors);
+        let got: Vec<(&str, usize)> = self.layout.iter().map(|(n, k)| (n.as_str(), *k)).collect();
+        if got != want {
+            return bad("layout", format!("{got:?} is not hover-motors' {want:?}"));
+        }
+        if !(self.sample_period.is_finite() && self.sample_period > 0.0) {
+            return bad(
+                "sample_period",
+                format!("{} is not > 0 s", self.sample_period),
+            );
+        }
+        let n = self.observation_size();
+        let vectors: [(&str, &[f64], usize); 6] = [
+            ("observation_low", &self.observation_low, n),
+            ("observation_high", &self.observation_high, n),
+            ("observation_mean", &self.observation_mean, n),
+            ("observation_var", &self.observation_var, n),
+            ("action_gradient", &self.action_gradient, self.rotors),
+            ("action_intercept", &self.action_intercept, self.rotors),
+        ];
+        for (field, values, len) in vectors {
+            if values.len() != len {
+                return bad(
+                    field,
+                    format!("has {} values, the recipe needs {len}", values.len()),
+                );
+            }
+            if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+                return bad(field, format!("value {i} is not finite"));
+            }
+        }
+        if let Some(i) = self.observation_var.iter().position(|v| *v < 0.0) {
+            return bad("observation_var", format!("value {i} is negative"));
+        }
+        if let Some(i) = self.action_gradient.iter().position(|v| *v == 0.0) {
+            return bad("action_gradient", format!("value {i} is 0"));
+        }
+        let lo_hi = self.observation_low.iter().zip(&self.observation_high);
+        if let Some(i) = lo_hi.clone().position(|(lo, hi)| lo > hi) {
+            return bad(
+                "observation_low",
+                format!("value {i} is above observation_high's"),
+            );
+        }
+        for (field, v) in [
+            ("normalisation_epsilon", self.normalisation_epsilon),
+            ("normalisation_clip", self.normalisation_clip),
+            ("action_clip", self.action_clip),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(field, format!("{v} is not a finite number >= 0"));
+            }
+        }
+        let plain = Path::new(&self.network)
+            .file_name()
+            .map(|f| f == self.network.as_str());
+        if plain != Some(true) {
+            let why = format!("{:?} is not a file name in the policy folder", self.network);
+            return bad("network", why);
+        }
+        Ok(())
+    }
+}
