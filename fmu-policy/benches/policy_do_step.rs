@@ -69,7 +69,8 @@ fn bench(c: &mut Criterion) {
             _ => 0.0,
         })
         .collect();
-    let output_vrs = [vr("motor_command")];
+    // FMI 3.0: the array motor_command has the value reference of motor_command_0.
+    let output_vrs = [vr("motor_command_0")];
     let instance = instance();
     let mut t = 0.0;
     let mut commands = [0.0; 6];
