@@ -1,5 +1,7 @@
 //! Packing policies/hexa_hover, and refusing bad policy folders with the file and field at
 //! fault, writing nothing.
+// Test code: a failed setup is a failed test.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use flyloop_fmu_policy::pack::{fmi3_path, pack};
 use serde_json::Value;
