@@ -334,7 +334,7 @@ def test_long_commands_are_run_by_their_tests(block: Block):
     tests = sorted((REPO / block.argument).rglob("*.py"))
     assert tests, block.argument
     corpus = "\n".join(t.read_text() for t in tests)
-    named = (".py", ".toml", ".parm")
+    named = (".py", ".toml", ".parm", ".sh")
     words = [shlex.split(c) for c in commands(block)]
     scripts = {w for c in words for w in c if w.endswith(named)}
     # `python -m MODULE`: a test that runs the module names it as "MODULE".
