@@ -14,6 +14,7 @@ use crate::network::Network;
 use crate::observation::{MOTOR_STATES, PLANT_OUTPUTS, commands, normalised, observation};
 use crate::recipe::Recipe;
 use flyloop_core::params::{ParamSpec, Parameters, ValueKind};
+use flyloop_core::quadrotor::variables::{MOTOR_COMMAND_NAMES, MOTOR_STATE_NAMES};
 use flyloop_core::snapshot;
 use flyloop_core::variables::{InputRow, OutputRow, VariableTable};
 use flyloop_core::{InputError, ParamError, SnapshotError};
@@ -292,36 +293,6 @@ static INPUT_SET: [Setter; MAX_INPUTS] = by_index!(set_input, Setter;
     0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31 32 33);
 static COMMAND_GET: [Getter; MAX_ROTORS] =
     by_index!(get_command, Getter; 0 1 2 3 4 5 6 7 8 9 10 11);
-
-const MOTOR_STATE_NAMES: [&str; MAX_ROTORS] = [
-    "motor_state_0",
-    "motor_state_1",
-    "motor_state_2",
-    "motor_state_3",
-    "motor_state_4",
-    "motor_state_5",
-    "motor_state_6",
-    "motor_state_7",
-    "motor_state_8",
-    "motor_state_9",
-    "motor_state_10",
-    "motor_state_11",
-];
-
-const MOTOR_COMMAND_NAMES: [&str; MAX_ROTORS] = [
-    "motor_command_0",
-    "motor_command_1",
-    "motor_command_2",
-    "motor_command_3",
-    "motor_command_4",
-    "motor_command_5",
-    "motor_command_6",
-    "motor_command_7",
-    "motor_command_8",
-    "motor_command_9",
-    "motor_command_10",
-    "motor_command_11",
-];
 
 /// Largest plant output the inputs take (the observation clips far inside).
 const INPUT_RANGE: f64 = 1e9;
