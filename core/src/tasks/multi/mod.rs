@@ -47,6 +47,7 @@ use crate::vehicle::AirVehicle;
 use crate::world::{World, WorldError, shape};
 use nalgebra::Vector3;
 use neighbours::NEIGHBOUR_VALUES;
+use std::sync::OnceLock;
 
 /// Values per agent action (thrust or motors, as the single-agent flight tasks).
 pub const ACTION_SIZE: usize = 4;
@@ -108,6 +109,9 @@ pub struct MultiFlight {
     obs_high: Vec<f32>,
     /// Per agent, its own fault slot for each of the task's (empty without faults).
     fault_slots: Vec<Vec<Option<usize>>>,
+    /// Every agent's nearest neighbours now ([`neighbours::all_nearest`]), found once for all
+    /// agents on the first observation after a change; emptied by every `&mut self` method.
+    nearest: OnceLock<Vec<u32>>,
 }
 
 impl MultiFlight {
@@ -170,6 +174,7 @@ impl MultiFlight {
             obs_low,
             obs_high,
             config,
+            nearest: OnceLock::new(),
         };
         task.reset(0)?;
         Ok(task)
@@ -194,6 +199,7 @@ impl MultiFlight {
 
     /// The world, to place or push vehicles by hand between steps (tests, front ends).
     pub fn world_mut(&mut self) -> &mut World {
+        self.nearest.take();
         &mut self.world
     }
 
@@ -237,6 +243,7 @@ impl MultiFlight {
 
     /// Starts a new episode (module docs); the same seed gives the same episode, bit for bit.
     pub fn reset(&mut self, seed: u64) -> Result<(), MultiError> {
+        self.nearest.take();
         let n = self.links.len();
         let mut master = SimRng::new(seed);
         let world_seed = master.fork_seed();
@@ -333,6 +340,7 @@ impl MultiFlight {
     /// Flies every vehicle through one control period: the live agents' rate loops tick on
     /// their grids (the world stepped from tick to tick), the done agents' motors are off.
     fn advance(&mut self, actions: &[f64]) {
+        self.nearest.take();
         let dt = self.config.flight.dt;
         for (i, action) in actions.chunks(ACTION_SIZE).enumerate() {
             self.status[i].active = !self.status[i].done;
@@ -468,11 +476,14 @@ impl MultiFlight {
         );
         let k = self.config.multi.neighbours as usize;
         let vehicles = self.world.vehicles();
+        let nearest = self
+            .nearest
+            .get_or_init(|| neighbours::all_nearest(vehicles, k));
         neighbours::write(
             link,
             vehicles,
             i,
-            k,
+            &nearest[i * k..(i + 1) * k],
             &lo[base..],
             &hi[base..],
             &mut out[base..],
