@@ -1,10 +1,11 @@
 """Cost of the examples/ssp systems per simulated second in each engine (fmpy's SSP support,
-ecos), wall clock, best of a few rounds (engines alternate each round, so a load change hits
-both). Each system runs for its stop time T and for 2T: the difference over T is the cost of
-simulating (per simulated second), the rest of the T run the fixed cost of unpacking, loading
-and instantiating the FMUs.
+ecos, libcosim), wall clock, best of a few rounds (engines alternate each round, so a load
+change hits all). Each system runs for its stop time T and for 2T: the difference over T is
+the cost of simulating (per simulated second), the rest of the T run the fixed cost of
+unpacking, loading and instantiating the FMUs.
 
-    bash scripts/pack-fmus.sh && .venv/bin/python benchmarks/ssp_engines.py [--rounds N]
+    bash scripts/pack-fmus.sh && bash scripts/pack-policy-fmus.sh
+    .venv/bin/python benchmarks/ssp_engines.py [--rounds N] [SYSTEM ...]
 """
 
 import argparse
@@ -24,10 +25,17 @@ def main(argv=None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--fmus", type=Path, default=ROOT / "dist" / "fmu")
     parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument(
+        "systems", nargs="*", default=list(SYSTEMS), help=f"any of {', '.join(SYSTEMS)}"
+    )
     args = parser.parse_args(argv)
+    unknown = [s for s in args.systems if s not in SYSTEMS]
+    if unknown:
+        parser.error(f"unknown system {unknown[0]!r}: known are {', '.join(SYSTEMS)}")
+    chosen = {name: SYSTEMS[name] for name in args.systems}
     best = {}  # (system, engine, T or 2T) -> best wall seconds
     with tempfile.TemporaryDirectory() as tmp:
-        for name, system in SYSTEMS.items():
+        for name, system in chosen.items():
             ssp = build.build(system, args.fmus, Path(tmp))
             for _ in range(args.rounds):
                 for engine in engines.ENGINES:
@@ -40,7 +48,7 @@ def main(argv=None) -> dict:
                         best[key] = min(best.get(key, wall), wall)
     print(f"load average {os.getloadavg()[0]:.1f} (1 min) on {os.cpu_count()} cores")
     result = {}
-    for name, system in SYSTEMS.items():
+    for name, system in chosen.items():
         for engine in engines.ENGINES:
             once, twice = best[name, engine, 1], best[name, engine, 2]
             per_second = (twice - once) / system.stop_time

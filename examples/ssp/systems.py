@@ -9,9 +9,31 @@ or RateController.fmu's inputs connect themselves.
 """
 
 from dataclasses import dataclass, field
+from pathlib import Path
+
+import tomllib
 
 HOVER = (9.81 / 40) ** 0.5  # motor state / normalised thrust that carries the 1 kg default quad X
-START_Z = 1.0  # m: both systems start at rest at this height
+START_Z = 1.0  # m: the controller systems start at rest at this height
+
+# The policy systems fly a gym episode: the start and target QuadHover-v0 draws for the seed
+# (level start, no wind; tests/fmu/test_fmu_ssp.py checks the gym draws these), so the FMU
+# system and the gym episode can be compared step by step.
+HEXA_HOVER = (9.81 / 60) ** 0.5  # the 1 kg default hexa X: six rotors of k = 10 N
+HEXA_SEED = 2_000_003  # policies/hexa_hover's episode (tests/fmu/test_fmu_policy.py's too)
+HEXA_TARGET = (-0.7264971733093262, 1.1584380865097046, 1.9632468223571777)  # m, world ENU
+OFFBOARD_SEED = 1  # policies/px4_offboard_hover's episode on the nominal Iris
+OFFBOARD_TARGET = (-0.3244643807411194, 0.7180993556976318, 0.4697224199771881)
+POLICY_START_Z = 1.5  # m: QuadHover's start height
+# The Iris the offboard policy was trained on (flyloop-sitl --px4's vehicle), its wind off.
+IRIS = {
+    k: v
+    for k, v in tomllib.loads(
+        (Path(__file__).resolve().parents[2] / "sitl" / "presets" / "px4_iris.toml").read_text()
+    ).items()
+    if k != "wind_enabled"
+}
+IRIS_HOVER = (IRIS["mass"] * 9.81 / (4 * IRIS["thrust_coefficient"])) ** 0.5
 
 
 @dataclass(frozen=True)
@@ -34,19 +56,34 @@ class System:
     watch: tuple[str, ...] = ("plant.x", "plant.y", "plant.z", "plant.yaw")  # recorded outputs
 
 
+def target(xyz) -> dict[str, float]:
+    return dict(zip(("target_x", "target_y", "target_z"), xyz, strict=True))
+
+
+def open_plant_inputs(rotors: int) -> tuple[str, ...]:
+    """No external wind, healthy motors: the inputs a plant keeps at their start values."""
+    wind = ("wind_input_x", "wind_input_y", "wind_input_z")
+    return (*wind, *(f"motor_effectiveness_{i}" for i in range(rotors)))
+
+
+def policy_pair(plant, rotors, vehicle, hover, policy, goal) -> tuple[Component, Component]:
+    """A plant FMU (`vehicle` parameters, at rest at POLICY_START_Z with its motors at
+    `hover`, no wind) and a Policy.fmu flying it to `goal`, as the gym's episode starts."""
+    start = {"seed": 1, "initial_z": POLICY_START_Z, "initial_motor": hover, "wind_enabled": 0}
+    return (
+        Component("plant", plant, {**vehicle, **start}, open_inputs=open_plant_inputs(rotors)),
+        Component("policy", policy, {**target(goal), "initial_motor": hover}),
+    )
+
+
 PLANT = Component(
     "plant",
     "Quadrotor.fmu",
     {"seed": 1, "initial_z": START_Z, "initial_motor": HOVER, "wind_enabled": 0},
-    # No external wind; healthy motors (the effectiveness inputs keep their start value 1).
-    open_inputs=(
-        "wind_input_x",
-        "wind_input_y",
-        "wind_input_z",
-        *(f"motor_effectiveness_{i}" for i in range(4)),
-    ),
+    open_inputs=open_plant_inputs(4),
 )
 RATES = Component("rates", "RateController.fmu")
+
 
 SYSTEMS = {
     # (a) Quadrotor + RateController + AttitudeController: level hover at 1 m, then a yaw step
@@ -83,6 +120,33 @@ SYSTEMS = {
             ),
         ),
         stop_time=3.0,
+        step_size=0.004,
+    ),
+    # (c) Hexacopter + Policy.fmu (policies/hexa_hover, motor commands): the gym episode of
+    # seed HEXA_SEED, from 1.5 m to its target; the policy acts every 20 ms. 5 ms is the
+    # plant's physics grid, so each communication step is whole RK4 steps, as in the gym.
+    "policy_hover": System(
+        "policy_hover",
+        "Hexacopter.fmu flown to a target by a trained policy (HexaHoverPolicy.fmu: "
+        "policies/hexa_hover, ONNX in tract) writing the six motor commands",
+        (*policy_pair("Hexacopter.fmu", 6, {}, HEXA_HOVER, "HexaHoverPolicy.fmu", HEXA_TARGET),),
+        stop_time=5.0,
+        step_size=0.005,
+    ),
+    # (d) Quadrotor (the Iris) + RateController + Policy.fmu (policies/px4_offboard_hover):
+    # the policy PX4 flies in offboard mode, writing RateController's setpoint by name from
+    # the plant's state (the estimate of an FMU system); the gym episode of OFFBOARD_SEED.
+    "offboard_policy": System(
+        "offboard_policy",
+        "Quadrotor.fmu (the Iris) flown through PX4's rate loop (RateController.fmu) by the "
+        "PX4 offboard rates policy (OffboardPolicy.fmu: policies/px4_offboard_hover) to a target",
+        (
+            *policy_pair(
+                "Quadrotor.fmu", 4, IRIS, IRIS_HOVER, "OffboardPolicy.fmu", OFFBOARD_TARGET
+            ),
+            RATES,
+        ),
+        stop_time=5.0,
         step_size=0.004,
     ),
 }

@@ -16,6 +16,13 @@ QuadHover motor interface as evaluate.py flies it:
 3. the network (float32): the actor's mean, with the action basis folded in;
 4. the action clipped into +-1 (float32) and mapped to the env's motor commands by
    gymnasium's RescaleAction: (a - intercept) / gradient in float32.
+
+A train_offboard.py rates policy (policy.json with interface "px4-rates-v1", e.g.
+policies/px4_offboard_hover) exports with the recipe "rates-estimate": the gym's rates
+interface observation (target - position and velocity in the heading frame, the body's down
+axis, body rates FRD, the previous setpoint: 16 values) built from the plant's true state
+(the estimate an FMU system has), the same normalisation, the actor's mean, and fast_ppo.py's
+map to the setpoint, low + (a + 1) * 0.5 * (high - low) in float32 ("bounds").
 """
 
 from __future__ import annotations
@@ -30,8 +37,80 @@ import numpy as np
 RECIPE_FORMAT = "flyloop-policy-recipe/1"
 
 
+def write_onnx(actor, size: int, folder: Path) -> None:
+    """folder/model.onnx: `actor` (torch) from one observation row of `size` to the action."""
+    import torch
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        torch.onnx.export(
+            actor.eval(),
+            (torch.zeros(1, size),),
+            str(folder / "model.onnx"),
+            dynamo=False,
+            input_names=["observation"],
+            output_names=["action"],
+        )
+
+
+def write_recipe(folder: Path, recipe: dict) -> dict:
+    recipe = {"format": RECIPE_FORMAT, **recipe, "network": "model.onnx"}
+    (folder / "recipe.json").write_text(json.dumps(recipe, indent=1) + "\n")
+    return recipe
+
+
+def export_rates(folder: Path, meta: dict) -> dict:
+    """A train_offboard.py policy (policy.pt, policy.json): the "rates-estimate" recipe."""
+    import fast_ppo
+    import torch
+    from training_envs import make_env
+
+    saved = torch.load(folder / "policy.pt", weights_only=False)
+    state = saved["model"]
+    size, actions = state["mu.0.weight"].shape[1], state["log_std"].shape[0]
+    model = fast_ppo.ActorCritic(size, actions, meta["training"]["config"]["hidden"])
+    model.load_state_dict(state)
+    # The env the policy flies, nominal (its bounds do not depend on the randomisation).
+    env = make_env("offboard", overrides=dict(randomize=None, observation_noise=None))
+    try:
+        layout = env.unwrapped.core["observation"]
+        low, high = env.observation_space.low, env.observation_space.high
+        action_low, action_high = env.action_space.low, env.action_space.high
+        dt = float(env.unwrapped.dt)
+    finally:
+        env.close()
+    if low.shape[0] != size:
+        raise ValueError(f"{folder}/policy.pt: takes {size} values, the env observes {len(low)}")
+    write_onnx(model.mu, size, folder)
+    return write_recipe(
+        folder,
+        {
+            "observation": "rates-estimate",
+            "layout": [[name, n] for name, n in layout],
+            "sample_period": dt,
+            "observation_low": low.astype(float).tolist(),
+            "observation_high": high.astype(float).tolist(),
+            "observation_mean": np.asarray(saved["obs_mean"], np.float64).tolist(),
+            "observation_var": np.asarray(saved["obs_var"], np.float64).tolist(),
+            "normalisation_epsilon": 1e-8,
+            "normalisation_clip": 10.0,
+            "action_clip": 1.0,
+            "action_map": "bounds",
+            "action_low": action_low.astype(float).tolist(),
+            "action_high": action_high.astype(float).tolist(),
+            "source": f"{folder.name}: {meta['interface']} {meta['training']['env_kwargs']}",
+        },
+    )
+
+
 def export(folder: Path) -> dict:
     """Writes folder/model.onnx and folder/recipe.json; returns the recipe."""
+    meta_path = folder / "policy.json"
+    if meta_path.is_file():
+        meta = json.loads(meta_path.read_text())
+        if meta.get("interface") != "px4-rates-v1":
+            raise ValueError(f"{meta_path}: interface {meta.get('interface')!r} does not export")
+        return export_rates(folder, meta)
     import torch
     from evaluate import SavedRun
     from gymnasium.wrappers.utils import rescale_box
@@ -73,41 +152,33 @@ def export(folder: Path) -> dict:
             mean = self.mu(observation)
             return mean if model.basis is None else mean @ self.basis_t
 
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DeprecationWarning)
-        torch.onnx.export(
-            Actor().eval(),
-            (torch.zeros(1, size),),
-            str(folder / "model.onnx"),
-            dynamo=False,
-            input_names=["observation"],
-            output_names=["action"],
-        )
-    recipe = {
-        "format": RECIPE_FORMAT,
-        "observation": "hover-motors",
-        "layout": [[name, n] for name, n in layout],
-        "rotors": len(unit),
-        "sample_period": dt,
-        "observation_low": low.astype(float).tolist(),
-        "observation_high": high.astype(float).tolist(),
-        "observation_mean": np.asarray(run.norm.mean, np.float64).tolist(),
-        "observation_var": np.asarray(run.norm.var, np.float64).tolist(),
-        "normalisation_epsilon": 1e-8,
-        "normalisation_clip": 10.0,
-        "action_clip": 1.0,
-        "action_gradient": gradient.astype(float).tolist(),
-        "action_intercept": intercept.astype(float).tolist(),
-        "network": "model.onnx",
-        "source": f"{folder.name}: {summary.get('env_id')} {summary.get('env_kwargs')}",
-    }
-    (folder / "recipe.json").write_text(json.dumps(recipe, indent=1) + "\n")
-    return recipe
+    write_onnx(Actor(), size, folder)
+    return write_recipe(
+        folder,
+        {
+            "observation": "hover-motors",
+            "layout": [[name, n] for name, n in layout],
+            "rotors": len(unit),
+            "sample_period": dt,
+            "observation_low": low.astype(float).tolist(),
+            "observation_high": high.astype(float).tolist(),
+            "observation_mean": np.asarray(run.norm.mean, np.float64).tolist(),
+            "observation_var": np.asarray(run.norm.var, np.float64).tolist(),
+            "normalisation_epsilon": 1e-8,
+            "normalisation_clip": 10.0,
+            "action_clip": 1.0,
+            "action_gradient": gradient.astype(float).tolist(),
+            "action_intercept": intercept.astype(float).tolist(),
+            "source": f"{folder.name}: {summary.get('env_id')} {summary.get('env_kwargs')}",
+        },
+    )
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("policy", type=Path, help="a fast_ppo.py QuadHover output folder")
+    parser.add_argument(
+        "policy", type=Path, help="a fast_ppo.py QuadHover or train_offboard.py output folder"
+    )
     args = parser.parse_args(argv)
     recipe = export(args.policy)
     print(f"{args.policy}/model.onnx, recipe.json: {len(recipe['observation_low'])} inputs")

@@ -5,7 +5,7 @@
 use crate::error::PolicyError;
 use crate::model::{Loaded, Policy, Shape};
 use crate::network::Network;
-use crate::recipe::Recipe;
+use crate::recipe::{Interface, Recipe};
 use flyloop_core::variables::Rows;
 use flyloop_fmu::api::Api;
 use flyloop_fmu::engine::{Engine, Simulation};
@@ -45,7 +45,7 @@ pub fn load(folder: &Path) -> Result<Loaded, PolicyError> {
     let network = Network::load(
         &folder.join(&recipe.network),
         recipe.observation_size(),
-        recipe.rotors,
+        recipe.action_size(),
     )?;
     Ok(Loaded {
         key: key_of(folder),
@@ -80,19 +80,19 @@ pub fn table_of(loaded: Loaded) -> Table<Policy> {
     let feedthrough: Vec<(&'static str, &'static [&'static str])> =
         rows.outputs.iter().map(|r| (r.name, inputs)).collect();
     let recipe = &shape.0.recipe;
-    let info = ModelInfo {
-        identifier: IDENTIFIER,
-        description: Cow::Owned(format!(
-            "flyloop Policy: a trained policy ({} observation, {} motors; ONNX evaluated by \
-             tract) acting every {} s on the plant's outputs (inputs of the same names) \
-             toward the target target_x/y/z; the plant's motor commands out. From: {}",
-            recipe.observation, recipe.rotors, recipe.sample_period, recipe.source
-        )),
-        default_experiment: (0.0, 10.0, recipe.sample_period),
-        // A tick at a communication point reads the inputs set there.
-        direct_feedthrough: Box::leak(feedthrough.into_boxed_slice()),
-        state_free_outputs: &[],
-        arrays: vec![Array {
+    let (what, out) = match recipe.interface() {
+        Interface::HoverMotors => (
+            format!("{} motors", recipe.rotors),
+            "the plant's motor commands",
+        ),
+        Interface::RatesEstimate => (
+            "thrust and body rates".to_string(),
+            "RateController's setpoint (thrust roll_rate pitch_rate yaw_rate)",
+        ),
+    };
+    // FMI 3.0 gathers the motor commands into one array; a setpoint stays four scalars.
+    let arrays = match recipe.interface() {
+        Interface::HoverMotors => vec![Array {
             name: "motor_command",
             description: Cow::Owned(format!(
                 "Commands of the {} motors, 0 .. 1 each (the plant's motor_command)",
@@ -101,6 +101,21 @@ pub fn table_of(loaded: Loaded) -> Table<Policy> {
             first: "motor_command_0",
             len: recipe.rotors,
         }],
+        Interface::RatesEstimate => Vec::new(),
+    };
+    let info = ModelInfo {
+        identifier: IDENTIFIER,
+        description: Cow::Owned(format!(
+            "flyloop Policy: a trained policy ({} observation, {what}; ONNX evaluated by \
+             tract) acting every {} s on the plant's outputs (inputs of the same names) \
+             toward the target target_x/y/z; {out} out. From: {}",
+            recipe.observation, recipe.sample_period, recipe.source
+        )),
+        default_experiment: (0.0, 10.0, recipe.sample_period),
+        // A tick at a communication point reads the inputs set there.
+        direct_feedthrough: Box::leak(feedthrough.into_boxed_slice()),
+        state_free_outputs: &[],
+        arrays,
         event_indicators: &[],
         descriptions: Vec::new(),
     };

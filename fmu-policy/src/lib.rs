@@ -8,10 +8,12 @@
 
 pub mod catalog;
 pub mod error;
+pub mod estimate;
 pub mod model;
 pub mod network;
 pub mod observation;
 pub mod pack;
+pub mod ports;
 pub mod recipe;
 
 pub use error::PolicyError;

@@ -2,25 +2,25 @@
 //! its own grid `k · sample_period` from the start time, whatever the communication step.
 //!
 //! As RateController.fmu does, a tick at a communication point reads the inputs set there: the
-//! motor commands are direct feedthrough of the plant's outputs at a tick (the master sets the
-//! plant's outputs into the policy, reads the commands, sets them on the plant and steps
-//! both), which is what the gym does each control step. Between ticks the commands of the
-//! last tick hold. The observation's "motor_commands" are the policy's own previous commands
-//! (the gym's `quad.command()`): `initial_motor` before the first tick, as the plant's
-//! `initial_motor` is its command at the start.
+//! outputs (motor commands or RateController's setpoint) are direct feedthrough of the
+//! plant's outputs at a tick (the master sets the plant's outputs into the policy, reads the
+//! outputs, sets them on the plant or RateController and steps all), which is what the gym
+//! does each control step. Between ticks the outputs of the last tick hold. The observation's
+//! previous action is the policy's own previous outputs (the gym's `quad.command()`, or the
+//! rates interface's last action as applied): before the first tick `initial_motor` on every
+//! motor, or the setpoint (thrust `initial_motor`, zero rates) the gym starts with.
 
 use crate::catalog;
 use crate::network::Network;
-use crate::observation::{MOTOR_STATES, PLANT_OUTPUTS, commands, normalised, observation};
+use crate::observation::{MOTOR_STATES, commands, normalised, observation};
+use crate::ports;
 use crate::recipe::Recipe;
 use flyloop_core::params::{ParamSpec, Parameters, ValueKind};
-use flyloop_core::quadrotor::variables::{MOTOR_COMMAND_NAMES, MOTOR_STATE_NAMES};
 use flyloop_core::snapshot;
 use flyloop_core::variables::{InputRow, OutputRow, VariableTable};
 use flyloop_core::{InputError, ParamError, SnapshotError};
 use flyloop_fmu::model::FmuModel;
 use serde::{Deserialize, Serialize};
-use std::borrow::Cow;
 use std::cell::RefCell;
 use std::fmt;
 use std::sync::Arc;
@@ -28,7 +28,7 @@ use std::sync::Arc;
 /// Times closer than this are the same instant on the policy's grid, s.
 const TIME_TOLERANCE: f64 = 1e-9;
 const SNAPSHOT_TAG: &[u8; 8] = b"FLYPOL01";
-/// Most motors a plant has (the core's frames).
+/// Most motors a plant has (the core's frames): the most outputs a policy has.
 const MAX_ROTORS: usize = flyloop_core::quadrotor::frame::MAX_ROTORS;
 const MAX_INPUTS: usize = MOTOR_STATES + MAX_ROTORS;
 
@@ -53,7 +53,8 @@ impl PartialEq for Shape {
 
 impl fmt::Debug for Shape {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "Policy({}, {} motors)", self.0.key, self.0.recipe.rotors)
+        let recipe = &self.0.recipe;
+        write!(f, "Policy({}, {})", self.0.key, recipe.observation)
     }
 }
 
@@ -124,7 +125,8 @@ impl Parameters for Target {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct PolicyStart {
     /// The previous motor command the first observation holds, 0 .. 1 (set it to the plant's
-    /// `initial_motor`). Default 0.
+    /// `initial_motor`; a rates policy's first previous thrust, as the gym's hover thrust).
+    /// Default 0.
     pub initial_motor: f64,
 }
 
@@ -162,7 +164,7 @@ struct State {
     target: Target,
     /// The plant's outputs as set, in input order.
     inputs: Vec<f64>,
-    /// The commands of the last tick (before the first: initial_motor).
+    /// The outputs of the last tick (before the first: [`ports::initial_outputs`]).
     held: Vec<f64>,
     ticks: u64,
     /// Seconds since the start time of the last communication point.
@@ -173,13 +175,14 @@ struct State {
 
 impl Policy {
     pub fn new(shape: Shape, target: Target, start: &PolicyStart) -> Self {
-        let n = shape.0.recipe.rotors;
+        let recipe = &shape.0.recipe;
+        let inputs = ports::inputs(recipe).len();
         Policy {
             state: State {
                 key: shape.0.key.clone(),
                 target,
-                inputs: vec![0.0; MOTOR_STATES + n],
-                held: vec![start.initial_motor; n],
+                inputs: vec![0.0; inputs],
+                held: ports::initial_outputs(recipe, start.initial_motor),
                 ticks: 0,
                 now: 0.0,
                 failure: None,
@@ -303,24 +306,16 @@ impl VariableTable for Policy {
     type Shape = Shape;
 
     fn inputs(shape: &Shape) -> Vec<InputRow<Self>> {
-        let n = shape.0.recipe.rotors;
-        let plant = PLANT_OUTPUTS
-            .iter()
-            .map(|(name, unit, text)| (*name, *unit, Cow::Borrowed(*text)));
-        let motors = (0..n).map(|i| {
-            let text = format!("State of motor {i}, 0 .. 1: the plant's motor_state_{i}");
-            (MOTOR_STATE_NAMES[i], "1", Cow::Owned(text))
-        });
-        plant
-            .chain(motors)
+        ports::inputs(&shape.0.recipe)
+            .into_iter()
             .enumerate()
-            .map(|(i, (name, unit, description))| InputRow {
-                name,
-                unit,
-                description,
+            .map(|(i, port)| InputRow {
+                name: port.name,
+                unit: port.unit,
+                description: port.description,
                 min: -INPUT_RANGE,
                 max: INPUT_RANGE,
-                start: if name == "qw" { 1.0 } else { 0.0 },
+                start: if port.name == "qw" { 1.0 } else { 0.0 },
                 get: INPUT_GET[i],
                 set: INPUT_SET[i],
             })
@@ -328,12 +323,12 @@ impl VariableTable for Policy {
     }
 
     fn outputs(shape: &Shape) -> Vec<OutputRow<Self>> {
-        (0..shape.0.recipe.rotors)
-            .map(|i| OutputRow {
-                description: Cow::Owned(format!(
-                    "Command of motor {i}, 0 .. 1: the plant's motor_command_{i}"
-                )),
-                ..OutputRow::real(MOTOR_COMMAND_NAMES[i], "1", "", COMMAND_GET[i])
+        ports::outputs(&shape.0.recipe)
+            .into_iter()
+            .enumerate()
+            .map(|(i, port)| OutputRow {
+                description: port.description,
+                ..OutputRow::real(port.name, port.unit, "", COMMAND_GET[i])
             })
             .collect()
     }
@@ -388,10 +383,11 @@ impl FmuModel for Policy {
         let loaded = catalog::loaded(&state.key).ok_or_else(|| {
             SnapshotError::Invalid(format!("the policy in {} is not loaded", state.key))
         })?;
-        let n = loaded.recipe.rotors;
-        if state.inputs.len() != MOTOR_STATES + n || state.held.len() != n {
+        let recipe = &loaded.recipe;
+        let (inputs, outputs) = (ports::inputs(recipe).len(), recipe.action_size());
+        if state.inputs.len() != inputs || state.held.len() != outputs {
             return Err(SnapshotError::Invalid(format!(
-                "not a state of a {n}-motor policy"
+                "not a state of a policy of {inputs} inputs and {outputs} outputs"
             )));
         }
         Ok(Policy {

@@ -67,7 +67,7 @@ impl Network {
             Some(n) if n == outputs => {}
             other => {
                 let why = format!(
-                    "gives {} values; the recipe has {outputs} motors",
+                    "gives {} values; the recipe has {outputs} actions",
                     other.map_or("a shape other than [1, n] of".to_string(), |n| n
                         .to_string())
                 );

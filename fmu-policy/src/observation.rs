@@ -5,7 +5,9 @@
 //! normalisation (fast_ppo.py's RunningNorm, float64) and the action mapping (gymnasium's
 //! RescaleAction, float32).
 
-use crate::recipe::Recipe;
+use crate::estimate;
+use crate::recipe::{ACTION_MAPS, Interface, Recipe};
+use flyloop_core::tasks::clip_f32;
 
 /// The plant outputs the policy reads, in input order, before the motor states.
 pub const PLANT_OUTPUTS: [(&str, &str, &str); 22] = [
@@ -64,24 +66,23 @@ pub const PLANT_OUTPUTS: [(&str, &str, &str); 22] = [
 /// Where the motor states start among the inputs.
 pub const MOTOR_STATES: usize = PLANT_OUTPUTS.len();
 
-/// The core's clip of an observation value: rounded to float32, NaN as 0, into `lo..=hi`.
-fn clip_f32(value: f64, lo: f32, hi: f32) -> f32 {
-    let v = value as f32;
-    if v.is_nan() {
-        0.0f32.clamp(lo, hi)
-    } else {
-        v.clamp(lo, hi)
-    }
-}
-
-/// The gym's observation (float32, clipped into the recipe's bounds) for the plant outputs
-/// `inputs` (in input order), the target (world ENU) and the previous motor commands.
+/// The recipe's observation (float32, clipped into its bounds) for the plant outputs `inputs`
+/// (in input order), the target (world ENU) and the FMU's previous outputs.
 pub fn observation(
     recipe: &Recipe,
     inputs: &[f64],
     target: [f64; 3],
     previous: &[f64],
 ) -> Vec<f32> {
+    match recipe.interface() {
+        Interface::HoverMotors => hover_motors(recipe, inputs, target, previous),
+        Interface::RatesEstimate => estimate::observation(recipe, inputs, target, previous),
+    }
+}
+
+/// The gym's motor-interface observation for the plant outputs `inputs` (in input order),
+/// the target (world ENU) and the previous motor commands.
+fn hover_motors(recipe: &Recipe, inputs: &[f64], target: [f64; 3], previous: &[f64]) -> Vec<f32> {
     let n = recipe.rotors;
     let at = |i: usize| inputs.get(i).copied().unwrap_or(0.0);
     let (w, x, y, z) = (at(9), at(10), at(11), at(12));
@@ -129,21 +130,33 @@ pub fn normalised(recipe: &Recipe, observation: &[f32]) -> Vec<f32> {
         .collect()
 }
 
-/// The motor commands for the network's output: clipped into +-action_clip (float32), then
-/// gymnasium's RescaleAction (a - intercept) / gradient in float32, as the env receives it.
+/// The FMU's outputs for the network's output: clipped into +-action_clip (float32), then
+/// the recipe's action map in float32, as the env receives it — gymnasium's RescaleAction
+/// `(a - intercept) / gradient`, or fast_ppo.py's `low + (a + 1) * 0.5 * (high - low)`
+/// followed by the env's clip into `[low, high]` (float64: the action as applied).
 pub fn commands(recipe: &Recipe, action: &[f32]) -> Vec<f64> {
     let clip = recipe.action_clip as f32;
-    let map = recipe.action_intercept.iter().zip(&recipe.action_gradient);
-    action
-        .iter()
-        .zip(map)
-        .map(|(a, (intercept, gradient))| {
-            let a = if a.is_nan() {
-                0.0
-            } else {
-                a.clamp(-clip, clip)
-            };
-            f64::from((a - *intercept as f32) / *gradient as f32)
-        })
-        .collect()
+    let clipped = action.iter().map(|a| {
+        if a.is_nan() {
+            0.0
+        } else {
+            a.clamp(-clip, clip)
+        }
+    });
+    if recipe.action_map == ACTION_MAPS[0] {
+        let map = recipe.action_intercept.iter().zip(&recipe.action_gradient);
+        clipped
+            .zip(map)
+            .map(|(a, (intercept, gradient))| f64::from((a - *intercept as f32) / *gradient as f32))
+            .collect()
+    } else {
+        let bounds = recipe.action_low.iter().zip(&recipe.action_high);
+        clipped
+            .zip(bounds)
+            .map(|(a, (low, high))| {
+                let (lo, hi) = (*low as f32, *high as f32);
+                f64::from(lo + (a + 1.0) * 0.5 * (hi - lo)).clamp(*low, *high)
+            })
+            .collect()
+    }
 }

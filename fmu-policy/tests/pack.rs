@@ -9,16 +9,28 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 fn shipped() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../policies/hexa_hover")
+    policy("hexa_hover")
 }
 
-/// A fresh folder holding the shipped policy's recipe.json and model.onnx.
+/// A shipped policy folder (policies/NAME).
+fn policy(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../policies")
+        .join(name)
+}
+
+/// A fresh folder holding the shipped hover policy's recipe.json and model.onnx.
 fn copy_of_shipped(name: &str) -> PathBuf {
+    copy_of(&shipped(), name)
+}
+
+/// A fresh folder holding `from`'s recipe.json and model.onnx.
+fn copy_of(from: &Path, name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("flyloop-policy-{name}-{}", std::process::id()));
     let _ = fs::remove_dir_all(&dir);
     fs::create_dir_all(&dir).unwrap();
     for file in ["recipe.json", "model.onnx"] {
-        fs::copy(shipped().join(file), dir.join(file)).unwrap();
+        fs::copy(from.join(file), dir.join(file)).unwrap();
     }
     dir
 }
@@ -175,4 +187,77 @@ fn the_shipped_hover_policy_packs_into_both_fmi_versions_with_its_resources() {
             assert!(xml.contains(name), "{name}");
         }
     }
+}
+
+#[test]
+fn the_offboard_rates_policy_packs_with_the_setpoint_as_its_outputs() {
+    let dir = copy_of(&policy("px4_offboard_hover"), "offboard-pack");
+    let out = dir.join("OffboardPolicy.fmu");
+    let paths = pack(&policy("px4_offboard_hover"), &library(), &out).unwrap();
+    for path in &paths {
+        let bytes = fs::read(path).unwrap();
+        let mut zip = zip::ZipArchive::new(std::io::Cursor::new(bytes)).unwrap();
+        let mut xml = String::new();
+        std::io::Read::read_to_string(&mut zip.by_name("modelDescription.xml").unwrap(), &mut xml)
+            .unwrap();
+        // The plant's position, velocity, attitude and rates in; RateController's setpoint out.
+        for name in [
+            "\"qw\"",
+            "\"wz\"",
+            "\"thrust\"",
+            "\"yaw_rate\"",
+            "\"target_x\"",
+        ] {
+            assert!(xml.contains(name), "{name} in {}", path.display());
+        }
+        for absent in ["\"motor_command", "\"motor_state", "\"dwx\"", "\"wind_x\""] {
+            assert!(!xml.contains(absent), "{absent} in {}", path.display());
+        }
+    }
+}
+
+#[test]
+fn a_rates_recipe_that_does_not_fit_is_refused_naming_the_field() {
+    let offboard = policy("px4_offboard_hover");
+    let cases: [(&str, Value, &str); 4] = [
+        (
+            "rotors",
+            Value::from(4),
+            "rotors: 4: a rates-estimate policy commands RateController.fmu",
+        ),
+        (
+            "action_map",
+            Value::from("linear"),
+            "action_map: \"linear\" is not one of",
+        ),
+        (
+            "action_gradient",
+            Value::from(vec![1.0; 4]),
+            "action_gradient: has 4 values, the recipe needs 0",
+        ),
+        (
+            "action_low",
+            Value::from(vec![0.0, -4.0, -4.0]),
+            "action_low: has 3 values, the recipe needs 4",
+        ),
+    ];
+    for (field, value, expected) in cases {
+        let dir = copy_of(&offboard, &format!("rates-{field}"));
+        edit_recipe(&dir, |r| r[field] = value);
+        let error = refused(&dir);
+        assert!(
+            error.contains("recipe.json: ") && error.contains(expected),
+            "{error}"
+        );
+    }
+    // The offboard recipe (16 observation values) with the hexa's network (37 in, 6 out).
+    let dir = copy_of(&offboard, "rates-network");
+    fs::copy(shipped().join("model.onnx"), dir.join("model.onnx")).unwrap();
+    let error = refused(&dir);
+    assert!(
+        error.contains(
+            "model.onnx: input \"observation\": takes 37 values; the recipe's observation has 16"
+        ),
+        "{error}"
+    );
 }

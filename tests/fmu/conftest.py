@@ -51,12 +51,15 @@ def core_trajectory(fmus):
 
 @pytest.fixture(scope="session")
 def policy_fmus(fmus) -> dict[str, Path]:
-    """dist/fmu/HexaHoverPolicy.fmu and -fmi3.fmu (scripts/pack-policy-fmus.sh: the policy
-    library links tract, so it is built only for the tests that need it)."""
+    """dist/fmu/HexaHoverPolicy.fmu, OffboardPolicy.fmu and their -fmi3.fmu
+    (scripts/pack-policy-fmus.sh: the policy library links tract, so it is built only for the
+    tests that need it)."""
     out = ROOT / "dist" / "fmu"
     script = ROOT / "scripts" / "pack-policy-fmus.sh"
     subprocess.run(["bash", str(script), str(out)], cwd=ROOT, check=True)
-    paths = {name: out / f"{name}.fmu" for name in ("HexaHoverPolicy", "HexaHoverPolicy-fmi3")}
+    names = ("HexaHoverPolicy", "OffboardPolicy")
+    names += tuple(f"{name}-fmi3" for name in names)
+    paths = {name: out / f"{name}.fmu" for name in names}
     for path in paths.values():
         assert path.is_file(), path
     return paths

@@ -16,19 +16,12 @@ through the dynamics: measured 2.2e-6 m apart at most over 5 s, asserted within 
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
-import flyloop  # noqa: F401  (registers the ids)
 import numpy as np
 import pytest
-from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave
+from policy_episodes import Slave, hexa_episode
 
-ROOT = Path(__file__).resolve().parents[2]
-POLICY = ROOT / "policies" / "hexa_hover"
 SEED = 2_000_003
-OVERRIDES = dict(start_attitude_range=0.0, use_wind=False)
 COMMAND_TOLERANCE = 1e-5
 POSITION_TOLERANCE_M = 1e-3
 
@@ -36,83 +29,6 @@ POSITION_TOLERANCE_M = 1e-3
 def hexa_hover_state() -> float:
     """The core's hover state of the default hexa X: sqrt(m·g / (6·k))."""
     return math.sqrt(1.0 * 9.81 / (6.0 * 10.0))
-
-
-@pytest.fixture(scope="module")
-def saved_run():
-    sys.path.insert(0, str(ROOT / "examples" / "train"))
-    import torch
-    from evaluate import SavedRun
-
-    torch.set_num_threads(1)
-    return SavedRun(POLICY)
-
-
-def gym_episode(run, seed: int = SEED) -> dict[str, np.ndarray]:
-    """The policy's episode in the gym (torch): commands, positions, the target."""
-    from training_envs import make_env
-
-    env = make_env(run.preset.name, action="motors", overrides=OVERRIDES)
-    commands, positions = [], []
-    try:
-        obs, info = env.reset(seed=seed)
-        target = np.array(info["target_position"], np.float64)
-        positions.append(info["position"])
-        done = False
-        while not done:
-            action = run.act(obs)
-            # What the env receives: RescaleAction's float32 map of the clipped action.
-            commands.append(env.action(action.astype(np.float32)))
-            obs, _, terminated, truncated, info = env.step(action.astype(np.float32))
-            positions.append(info["position"])
-            done = terminated or truncated
-        assert truncated and not terminated, "the policy holds the episode to its end"
-        dt = env.unwrapped.dt
-    finally:
-        env.close()
-    return dict(
-        commands=np.array(commands, np.float64),
-        positions=np.array(positions, np.float64),
-        target=target,
-        dt=dt,
-    )
-
-
-class Slave:
-    """An fmpy Co-Simulation instance with its variables by name."""
-
-    def __init__(self, fmu: Path, name: str, start: dict[str, float]):
-        self.md = read_model_description(str(fmu))
-        self.slave = FMU2Slave(
-            guid=self.md.guid,
-            unzipDirectory=extract(str(fmu)),
-            modelIdentifier=self.md.coSimulation.modelIdentifier,
-            instanceName=name,
-        )
-        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
-        self.type = {v.name: v.type for v in self.md.modelVariables}
-        self.slave.instantiate()
-        self.slave.setupExperiment(startTime=0.0)
-        self.set(start)
-        self.slave.enterInitializationMode()
-        self.slave.exitInitializationMode()
-
-    def names(self, causality: str) -> list[str]:
-        return [v.name for v in self.md.modelVariables if v.causality == causality]
-
-    def get(self, names: list[str]) -> list[float]:
-        return self.slave.getReal([self.vr[n] for n in names])
-
-    def set(self, values: dict[str, float]) -> None:
-        flags = {n: v for n, v in values.items() if self.type[n] == "Boolean"}
-        reals = {n: v for n, v in values.items() if n not in flags}
-        self.slave.setReal([self.vr[n] for n in reals], list(reals.values()))
-        if flags:
-            self.slave.setBoolean([self.vr[n] for n in flags], [bool(v) for v in flags.values()])
-
-    def close(self) -> None:
-        self.slave.terminate()
-        self.slave.freeInstance()
 
 
 def plant_and_policy(fmus, policy_fmus, episode) -> tuple[Slave, Slave]:
@@ -128,11 +44,15 @@ def plant_and_policy(fmus, policy_fmus, episode) -> tuple[Slave, Slave]:
     return plant, policy
 
 
-def test_the_policy_fmu_acts_as_torch_on_every_state_of_a_gym_episode(fmus, policy_fmus, saved_run):
+@pytest.fixture(scope="module")
+def episode():
+    return hexa_episode(SEED)
+
+
+def test_the_policy_fmu_acts_as_torch_on_every_state_of_a_gym_episode(fmus, policy_fmus, episode):
     """Hexacopter.fmu replays the gym episode's commands (the same states bit for bit, as
     test_fmu_gym_episode.py shows); at each control step Policy.fmu reads the plant's outputs
     by name and its commands equal the torch policy's in the gym within 1e-5."""
-    episode = gym_episode(saved_run)
     plant, policy = plant_and_policy(fmus, policy_fmus, episode)
     inputs, outputs = policy.names("input"), policy.names("output")
     assert set(inputs) <= set(plant.names("output")), "every policy input is a plant output"
@@ -159,12 +79,11 @@ def test_the_policy_fmu_acts_as_torch_on_every_state_of_a_gym_episode(fmus, poli
 
 
 def test_the_policy_fmu_and_the_plant_hold_the_target_as_the_gym_episode(
-    fmus, policy_fmus, saved_run
+    fmus, policy_fmus, episode
 ):
     """Policy.fmu and Hexacopter.fmu in a closed loop (this test is the master; each policy
     input from the plant output of the same name, each plant input from the policy output
     of the same name) fly the gym's episode within 1 mm and end within 0.5 m of the target."""
-    episode = gym_episode(saved_run)
     plant, policy = plant_and_policy(fmus, policy_fmus, episode)
     inputs, outputs = policy.names("input"), policy.names("output")
     dt, t = episode["dt"], 0.0
