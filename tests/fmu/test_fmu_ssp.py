@@ -194,6 +194,21 @@ def test_a_system_that_cannot_be_wired_is_refused_naming_the_variable(fmus, tmp_
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_policy_wired_to_the_wrong_plant_is_refused_naming_the_input(fmus, policy_fmus, tmp_path):
+    """The hexa policy reads motor_state_0..5; Quadrotor.fmu has four motors, so nothing
+    feeds motor_state_4: refused naming it, before anything is written."""
+    plant, policy = systems.policy_pair(
+        "Quadrotor.fmu", 4, {}, systems.HOVER, "HexaHoverPolicy.fmu", systems.HEXA_TARGET
+    )
+    wrong = systems.System("wrong", "", (plant, policy), 1.0, 0.005)
+    with pytest.raises(
+        build.WiringError,
+        match="input `motor_state_4` of HexaHoverPolicy.fmu \\(policy\\) is fed by no output",
+    ):
+        build.build(wrong, fmus["Quadrotor"].parent, tmp_path)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_binding_of_a_type_ssp_cannot_carry_is_refused_naming_it():
     policy = systems.Component("p", "Policy.fmu", {"mode": 1, "gain": 2})
     table = {"mode": ("parameter", "String"), "gain": ("parameter", "Integer")}
