@@ -31,7 +31,7 @@ pub struct SessionFaults {
 /// Why ArduPilot mode refuses a fault of a sensor other than the IMU.
 const IMU_ONLY: &str = "ArduPilot mode sends ArduPilot only the IMU (gyro, accel): it \
     simulates its mag, baro and GPS itself from the JSON position (fail them with its own \
-    SIM_ parameters, e.g. SIM_GPS1_ENABLE = 0)";
+    SIM_ parameters over MAVLink, e.g. SIM_GPS_DISABLE = 1 in ArduCopter 4.6)";
 
 /// Whether a fault of `kind` on `sensor` reaches a sensor other than the IMU.
 fn beyond_imu(kind: FaultKind, sensor: Option<SensorId>) -> bool {
@@ -174,9 +174,10 @@ impl SessionFaults {
                     unit::SENSOR_MAG | unit::SENSOR_BARO | unit::SENSOR_GPS
                 )
             {
-                return Err(ParamError::Parse(format!(
-                    "failure_unit {unit}: {IMU_ONLY}"
-                )));
+                return Err(ParamError::Relation {
+                    name: "failure_unit",
+                    requirement: format!("{unit} is not the IMU's: {IMU_ONLY}"),
+                });
             }
             let f = match faults {
                 Some(f) => f,

@@ -9,28 +9,9 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+from control_link import GPS, MOTOR, OFF, control_link, inject
 from px4_support import SPEED, autopilot_params, collect, launch, settle
 from pymavlink import mavutil
-
-# FAILURE_UNIT_SENSOR_GPS, FAILURE_TYPE_OFF (MAVLink common.xml).
-GPS, OFF = 4, 1
-
-
-def control_link(flyloop):
-    """A pymavlink link to flyloop's control endpoint (from its ready line)."""
-    return mavutil.mavlink_connection(
-        f"udpout:{flyloop.ready['control']}", source_system=250, dialect="common"
-    )
-
-
-def inject(link, unit: int, failure: int, instance: int = 0):
-    """MAV_CMD_INJECT_FAILURE to vehicle 1; returns flyloop's ack and STATUSTEXT."""
-    link.mav.command_long_send(
-        1, 1, mavutil.mavlink.MAV_CMD_INJECT_FAILURE, 0, unit, failure, instance, 0, 0, 0, 0
-    )
-    ack = link.recv_match(type="COMMAND_ACK", blocking=True, timeout=10)
-    text = link.recv_match(type="STATUSTEXT", blocking=True, timeout=10)
-    return ack, text
 
 
 def px4_texts(px4, seconds: float) -> list[tuple[float, str, int]]:
@@ -66,7 +47,7 @@ def test_px4_loses_gps_in_a_hover_and_lands(pair):
     link = control_link(flyloop)
     ack, text = inject(link, GPS, OFF)
     assert ack is not None and ack.result == mavutil.mavlink.MAV_RESULT_ACCEPTED, ack
-    assert text is not None and text.text == "fault injected: sensor_off:gps", text
+    assert text == "fault injected: sensor_off:gps", text
     events = px4_texts(px4, 25)
     for t, what, _ in events:
         print(f"{t * SPEED:6.1f} s after the fault (simulation)  {what}")
@@ -83,8 +64,6 @@ def test_px4_loses_gps_in_a_hover_and_lands(pair):
 
 
 HEXA = Path(__file__).resolve().parents[2] / "sitl" / "presets" / "px4_hexa_x.toml"
-# FAILURE_UNIT_SYSTEM_MOTOR (PX4's instance numbering: 1 = first motor).
-MOTOR = 101
 
 
 def test_px4_hexa_loses_motor_1_in_a_hover_and_lands(pair, sitl_binary):
@@ -96,7 +75,7 @@ def test_px4_hexa_loses_motor_1_in_a_hover_and_lands(pair, sitl_binary):
     console_before = len(px4.output())
     ack, text = inject(control_link(flyloop), MOTOR, OFF, 1)
     assert ack is not None and ack.result == mavutil.mavlink.MAV_RESULT_ACCEPTED, ack
-    assert text is not None and text.text == "fault injected: motor_off:1", text
+    assert text == "fault injected: motor_off:1", text
     hold = collect(px4, 10.0)
     h, v = hold.worst(target)
     print(f"hexa without motor 1, 10 s hold: position error {h:.3f} m, altitude error {v:.3f} m")
