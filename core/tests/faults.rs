@@ -254,18 +254,33 @@ fn an_empty_plan_flies_the_healthy_bits_and_adds_no_info() {
 
 #[test]
 fn a_height_trigger_fires_when_the_vehicle_climbs_past_it() {
-    let mut task = hover("[[faults]]\nkind = 'motor_off'\nmotor = 1\nabove_height = 1.6");
+    let (t, z) = first_firing("above_height = 1.6", 300).unwrap();
+    assert!(t > 0.0 && z > 1.6 && z < 1.7, "{t} {z}");
+}
+
+/// When a motor_off fault with `trigger` first fired in `steps` Hover steps at command 0.6:
+/// its time (s) and the height then (m).
+fn first_firing(trigger: &str, steps: usize) -> Option<(f64, f64)> {
+    let mut task = hover(&format!(
+        "[[faults]]\nkind = 'motor_off'\nmotor = 1\n{trigger}"
+    ));
     task.reset(0);
-    let mut fired_at = None;
-    for _ in 0..300 {
+    for _ in 0..steps {
         task.step(&[0.6; 4]).unwrap();
         let t = vector(&task, "fault_time")[0];
-        if t >= 0.0 && fired_at.is_none() {
-            fired_at = Some((t, task.air_vehicle().body().position.z));
+        if t >= 0.0 {
+            return Some((t, task.air_vehicle().body().position.z));
         }
     }
-    let (t, z) = fired_at.unwrap();
-    assert!(t > 0.0 && z > 1.6 && z < 1.7, "{t} {z}");
+    None
+}
+
+#[test]
+fn a_takeoff_trigger_fires_its_delay_after_the_first_takeoff() {
+    // Hover starts in the air: it took off at 0, so the fault fires at 0.5 s of flight.
+    let (t, _) = first_firing("after_takeoff = 0.5", 100)
+        .expect("after_takeoff = 0.5 never fired in 1 s of flight");
+    assert!((t - 0.5).abs() < 0.011, "{t}");
 }
 
 #[test]

@@ -8,7 +8,7 @@ from pymavlink import mavutil
 
 # FAILURE_UNIT (MAVLink common.xml): SENSOR_BARO, SENSOR_GPS, SYSTEM_MOTOR (PX4's instance
 # numbering: 1 = first motor, 0 = all).
-BARO, GPS, MOTOR = 2, 4, 101
+BARO, GPS, MOTOR = 3, 4, 101
 # FAILURE_TYPE: OK (clears the unit), OFF, STUCK.
 OK, OFF, STUCK = 0, 1, 2
 

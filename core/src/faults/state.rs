@@ -127,7 +127,9 @@ impl FaultState {
     /// out; records each as an event.
     pub fn update(&mut self, c: &Conditions) {
         let mut c = *c;
-        if c.takeoff.is_none() {
+        // The first time the vehicle left the ground counts (the caller says "airborne now"
+        // with the current time every step): keep it once known.
+        if self.takeoff.is_some() {
             c.takeoff = self.takeoff;
         }
         self.takeoff = c.takeoff;
