@@ -40,7 +40,8 @@ def watch(ap, seconds: float, until=None, servos=None) -> list[tuple[float, str]
     `until(events, now)` holds (now: ArduPilot's clock, s): (ArduPilot's clock in s, what).
     `servos`, a list, gets ArduPilot's servo outputs 1-6 (µs) every 0.5 s: (time µs, PWMs)."""
     out: list[tuple[float, str]] = []
-    mode, armed, landed, now = None, None, None, 0.0
+    mode, armed, landed = None, None, None
+    now = ap.estimate().time_ms / 1000
     end = time.monotonic() + seconds
     while time.monotonic() < end and not (until and until(out, now)):
         m = ap.link.recv_match(blocking=True, timeout=0.2)
@@ -97,8 +98,8 @@ def test_ardupilot_loses_gps_in_a_guided_hover_and_lands(pair):
     assert ack is not None and ack.result == mavutil.mavlink.MAV_RESULT_UNSUPPORTED, ack
     print(f"flyloop: {text}")
     assert text is not None and "SIM_GPS" in text, text
-    start = ap.estimate().time_ms / 1000
     set_param(ap, "SIM_GPS_DISABLE", 1)
+    start = ap.estimate().time_ms / 1000
     events = watch(ap, 60, until=disarmed)
     print("ArduPilot after SIM_GPS_DISABLE = 1 (s of its clock):")
     show(events, start)
