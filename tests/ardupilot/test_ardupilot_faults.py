@@ -21,8 +21,14 @@ from pymavlink import mavutil
 MODES = {0: "STABILIZE", 2: "ALT_HOLD", 3: "AUTO", 4: "GUIDED", 5: "LOITER", 9: "LAND"}
 
 
-# MAV_LANDED_STATE.
-LANDED = {0: "UNDEFINED", 1: "ON_GROUND", 2: "IN_AIR", 3: "TAKEOFF", 4: "LANDING"}
+def distance(row) -> float:
+    """Horizontal distance of a track row from home, m."""
+    return math.hypot(row["north"], row["east"])
+
+
+def tilt(row) -> float:
+    """Tilt of a track row from level, deg."""
+    return math.degrees(math.hypot(row["roll"], row["pitch"]))
 
 
 def take_off(ap) -> None:
@@ -40,7 +46,7 @@ def watch(ap, seconds: float, until=None, servos=None) -> list[tuple[float, str]
     `until(events, now)` holds (now: ArduPilot's clock, s): (ArduPilot's clock in s, what).
     `servos`, a list, gets ArduPilot's servo outputs 1-6 (µs) every 0.5 s: (time µs, PWMs)."""
     out: list[tuple[float, str]] = []
-    mode, armed, landed = None, None, None
+    mode, armed = None, None
     now = ap.estimate().time_ms / 1000
     end = time.monotonic() + seconds
     while time.monotonic() < end and not (until and until(out, now)):
@@ -55,9 +61,6 @@ def watch(ap, seconds: float, until=None, servos=None) -> list[tuple[float, str]
         elif m.get_type() == "SERVO_OUTPUT_RAW" and servos is not None:
             if not servos or m.time_usec - servos[-1][0] >= 500_000:
                 servos.append((m.time_usec, [getattr(m, f"servo{i}_raw") for i in range(1, 7)]))
-        elif m.get_type() == "EXTENDED_SYS_STATE" and m.landed_state != landed:
-            landed = m.landed_state
-            out.append((now, f"landed_state {LANDED.get(landed, landed)}"))
         elif m.get_type() == "HEARTBEAT" and m.type != mavutil.mavlink.MAV_TYPE_GCS:
             if m.custom_mode != mode:
                 mode = m.custom_mode
@@ -107,10 +110,7 @@ def test_ardupilot_loses_gps_in_a_guided_hover_and_lands(pair):
     flyloop.stop()
     rows = flyloop.rows()
     last = rows[-1]
-    print(
-        f"truth at the end: {math.hypot(last['north'], last['east']):.2f} m from home, "
-        f"grounded {last['grounded']}"
-    )
+    print(f"truth at the end: {distance(last):.2f} m from home, grounded {last['grounded']}")
     said = [w for _, w in events]
     assert "mode LAND" in said and "disarmed" in said, said
     assert any("EKF Failsafe" in w for w in said), said
@@ -121,16 +121,6 @@ HEXA = REPO / "sitl" / "presets" / "ardupilot_hexa_x.toml"
 # Seconds of ArduPilot's clock the hexa holds on five motors before it is told to land, and
 # the longest its landing from 5 m may take before the test disarms it.
 HOLD_S, LAND_S = 10.0, 15.0
-
-
-def distance(row) -> float:
-    """Horizontal distance of a track row from home, m."""
-    return math.hypot(row["north"], row["east"])
-
-
-def tilt(row) -> float:
-    """Tilt of a track row from level, deg."""
-    return math.degrees(math.hypot(row["roll"], row["pitch"]))
 
 
 def disarm(ap) -> list[tuple[float, str]]:
