@@ -10,8 +10,10 @@
 //! and octo X, whose motor order is the table's (checked against AP_MotorsMatrix's motor
 //! angles in this module's tests), and a frame it has no class for is refused.
 
+use crate::telemetry::multirotor_mav_type;
 use flyloop_core::quadrotor::{Frame, QuadrotorParams};
 use flyloop_core::rate_loop::px4_rotors::{NONE_IRIS, px4_rotors};
+use mavlink::dialects::common::MavType;
 use std::fmt::Write;
 
 /// Which autopilot's parameters to print.
@@ -21,13 +23,13 @@ pub enum Autopilot {
     Ardupilot,
 }
 
-/// PX4's MAV_TYPE for a multirotor of `rotors` rotors (quad 2, hexa 13, octo 14, else the
-/// generic "decarotor"-less fallback: quad).
+/// PX4's MAV_TYPE for a multirotor of `rotors` rotors: the ground-station HEARTBEAT's
+/// ([`multirotor_mav_type`]) where PX4's airframes name it (quad 2, hexa 13, octo 14);
+/// other counts stay the quadrotor PX4 mode has always set.
 fn px4_mav_type(rotors: usize) -> u8 {
-    match rotors {
-        6 => 13,
-        8 => 14,
-        _ => 2,
+    match multirotor_mav_type(rotors) {
+        t @ (MavType::MAV_TYPE_HEXAROTOR | MavType::MAV_TYPE_OCTOROTOR) => t as u8,
+        _ => MavType::MAV_TYPE_QUADROTOR as u8,
     }
 }
 

@@ -8,7 +8,7 @@
 //! - [`kinematics`]: the one place where ENU/FLU becomes NED/FRD,
 //! - [`task_frame`]: the task frame layout (DEBUG_FLOAT_ARRAY),
 //! - [`param_table`], [`param_protocol`]: parameters over MAVLink (the task registry itself is
-//!   the core's `flyloop_core::tasks::registry`),
+//!   the core's `flyloop_core::tasks::registry`; a multi-agent world's rows: [`world_params`]),
 //! - [`config`]: the parameter file of every mode (the task's, or the autopilot modes' vehicle),
 //! - [`px4`]: PX4 mode, flyloop as PX4's simulator over TCP,
 //! - [`ardupilot`]: ArduPilot mode, flyloop as ArduPilot's JSON physics backend over UDP,
@@ -46,3 +46,4 @@ pub mod track;
 pub mod vehicle;
 pub mod view_stream;
 pub mod wire;
+pub mod world_params;

@@ -4,7 +4,7 @@
 
 use crate::kinematics::{Home, Kinematics, STANDARD_GRAVITY, round_i16, round_u16};
 use crate::vehicle::Vehicle;
-use flyloop_core::tasks::registry::TaskKind;
+use flyloop_core::tasks::registry::ModelKind;
 use mavlink::dialects::common::*;
 use mavlink::types::CharArray;
 
@@ -72,14 +72,35 @@ pub fn hil_state_quaternion_of(k: &Kinematics, home: &Home, time_usec: u64) -> M
     })
 }
 
-pub fn mav_type(kind: TaskKind) -> MavType {
-    match kind.model() {
-        flyloop_core::tasks::registry::ModelKind::Quadrotor => MavType::MAV_TYPE_QUADROTOR,
-        flyloop_core::tasks::registry::ModelKind::Lander2d => MavType::MAV_TYPE_GENERIC,
+/// MAV_TYPE of a multirotor with `rotors` rotors: the spec's names for 3, 4, 6, 8, 10 and
+/// 12 rotors, GENERIC_MULTIROTOR for any other count. A ground station picks its icon and
+/// its airframe pages from this.
+pub fn multirotor_mav_type(rotors: usize) -> MavType {
+    match rotors {
+        3 => MavType::MAV_TYPE_TRICOPTER,
+        4 => MavType::MAV_TYPE_QUADROTOR,
+        6 => MavType::MAV_TYPE_HEXAROTOR,
+        8 => MavType::MAV_TYPE_OCTOROTOR,
+        10 => MavType::MAV_TYPE_DECAROTOR,
+        12 => MavType::MAV_TYPE_DODECAROTOR,
+        _ => MavType::MAV_TYPE_GENERIC_MULTIROTOR,
+    }
+}
+
+/// What vehicle `v` is: a multirotor by its frame's rotor count, the lander generic.
+pub fn mav_type(v: &Vehicle) -> MavType {
+    match v.kind.model() {
+        ModelKind::Quadrotor => multirotor_mav_type(v.config.frame.rotor_count()),
+        ModelKind::Lander2d => MavType::MAV_TYPE_GENERIC,
     }
 }
 
 pub fn heartbeat(v: &Vehicle, status: Status) -> MavMessage {
+    heartbeat_of(mav_type(v), status)
+}
+
+/// HEARTBEAT of a vehicle of type `mavtype` in `status` (armed only while active).
+pub fn heartbeat_of(mavtype: MavType, status: Status) -> MavMessage {
     // The crate's Default for bitflags is not empty: build from empty().
     let mut base_mode = MavModeFlag::empty();
     let system_status = match status {
@@ -92,7 +113,7 @@ pub fn heartbeat(v: &Vehicle, status: Status) -> MavMessage {
     };
     MavMessage::HEARTBEAT(HEARTBEAT_DATA {
         custom_mode: 0,
-        mavtype: mav_type(v.kind),
+        mavtype,
         autopilot: MavAutopilot::MAV_AUTOPILOT_GENERIC,
         base_mode,
         system_status,
@@ -101,11 +122,15 @@ pub fn heartbeat(v: &Vehicle, status: Status) -> MavMessage {
 }
 
 pub fn attitude(v: &Vehicle) -> MavMessage {
-    let k = v.task.kinematics();
+    attitude_of(&v.task.kinematics(), v.time_boot_ms())
+}
+
+/// ATTITUDE of state `k` at `time_boot_ms` (ms of simulation time).
+pub fn attitude_of(k: &Kinematics, time_boot_ms: u32) -> MavMessage {
     let (roll, pitch, yaw) = crate::kinematics::euler_ned(&k.attitude);
     let rates = k.body_rates_frd();
     MavMessage::ATTITUDE(ATTITUDE_DATA {
-        time_boot_ms: v.time_boot_ms(),
+        time_boot_ms,
         roll: roll as f32,
         pitch: pitch as f32,
         yaw: yaw as f32,
@@ -116,18 +141,22 @@ pub fn attitude(v: &Vehicle) -> MavMessage {
 }
 
 /// Heading in centidegrees [0, 36000).
-fn heading_cdeg(v: &Vehicle) -> u16 {
-    let (_, _, yaw) = crate::kinematics::euler_ned(&v.task.kinematics().attitude);
+fn heading_cdeg(k: &Kinematics) -> u16 {
+    let (_, _, yaw) = crate::kinematics::euler_ned(&k.attitude);
     let deg = yaw.to_degrees().rem_euclid(360.0);
     round_u16(deg * 100.0) % 36000
 }
 
 pub fn global_position_int(v: &Vehicle, home: &Home) -> MavMessage {
-    let k = v.task.kinematics();
+    global_position_int_of(&v.task.kinematics(), home, v.time_boot_ms())
+}
+
+/// GLOBAL_POSITION_INT of state `k` over `home` at `time_boot_ms`.
+pub fn global_position_int_of(k: &Kinematics, home: &Home, time_boot_ms: u32) -> MavMessage {
     let g = home.global(&k.position);
     let vel = k.velocity_ned();
     MavMessage::GLOBAL_POSITION_INT(GLOBAL_POSITION_INT_DATA {
-        time_boot_ms: v.time_boot_ms(),
+        time_boot_ms,
         lat: g.lat,
         lon: g.lon,
         alt: g.alt_mm,
@@ -135,16 +164,20 @@ pub fn global_position_int(v: &Vehicle, home: &Home) -> MavMessage {
         vx: round_i16(vel.x * 100.0),
         vy: round_i16(vel.y * 100.0),
         vz: round_i16(vel.z * 100.0),
-        hdg: heading_cdeg(v),
+        hdg: heading_cdeg(k),
     })
 }
 
 pub fn local_position_ned(v: &Vehicle) -> MavMessage {
-    let k = v.task.kinematics();
+    local_position_ned_of(&v.task.kinematics(), v.time_boot_ms())
+}
+
+/// LOCAL_POSITION_NED of state `k` at `time_boot_ms`.
+pub fn local_position_ned_of(k: &Kinematics, time_boot_ms: u32) -> MavMessage {
     let p = k.position_ned();
     let vel = k.velocity_ned();
     MavMessage::LOCAL_POSITION_NED(LOCAL_POSITION_NED_DATA {
-        time_boot_ms: v.time_boot_ms(),
+        time_boot_ms,
         x: p.x as f32,
         y: p.y as f32,
         z: p.z as f32,
@@ -164,15 +197,19 @@ fn command_fractions(v: &Vehicle) -> impl Iterator<Item = f64> + '_ {
 }
 
 pub fn vfr_hud(v: &Vehicle, home: &Home) -> MavMessage {
-    let k = v.task.kinematics();
     let n = v.command.len().max(1) as f64;
     let throttle = command_fractions(v).sum::<f64>() / n;
+    vfr_hud_of(&v.task.kinematics(), home, throttle)
+}
+
+/// VFR_HUD of state `k` over `home`; `throttle`: the mean motor command, a fraction of full.
+pub fn vfr_hud_of(k: &Kinematics, home: &Home, throttle: f64) -> MavMessage {
     MavMessage::VFR_HUD(VFR_HUD_DATA {
         airspeed: k.airspeed() as f32,
         groundspeed: k.velocity.xy().norm() as f32,
         alt: (home.altitude_m + k.position.z) as f32,
         climb: k.velocity.z as f32,
-        heading: (heading_cdeg(v) / 100) as i16,
+        heading: (heading_cdeg(k) / 100) as i16,
         throttle: round_u16(throttle * 100.0),
     })
 }
@@ -259,7 +296,13 @@ pub fn home_position_of(home: &Home, time_usec: u64) -> MavMessage {
 /// SYS_STATUS with the battery: the lander's charge in percent; the quadrotor has no battery
 /// model, so its battery is reported unknown (remaining −1, voltage UINT16_MAX).
 pub fn sys_status(v: &Vehicle) -> MavMessage {
-    let (remaining, voltage) = match v.task.battery_fraction() {
+    sys_status_of(v.task.battery_fraction())
+}
+
+/// SYS_STATUS of a vehicle whose battery holds `battery` (a fraction of full; None: no
+/// battery model).
+pub fn sys_status_of(battery: Option<f64>) -> MavMessage {
+    let (remaining, voltage) = match battery {
         Some(f) => {
             let percent = (f * 100.0).round().clamp(0.0, 100.0) as i8;
             // A nominal 4S pack: 16.8 V full, 13.2 V empty, linear in between.
@@ -302,11 +345,16 @@ fn software_version() -> u32 {
 }
 
 pub fn autopilot_version(v: &Vehicle) -> MavMessage {
+    autopilot_version_of(v.system_id)
+}
+
+/// AUTOPILOT_VERSION of system `system_id` (its uid).
+pub fn autopilot_version_of(system_id: u8) -> MavMessage {
     let capabilities = MavProtocolCapability::MAV_PROTOCOL_CAPABILITY_MAVLINK2
         | MavProtocolCapability::MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_C_CAST;
     MavMessage::AUTOPILOT_VERSION(AUTOPILOT_VERSION_DATA {
         capabilities,
-        uid: u64::from(v.system_id),
+        uid: u64::from(system_id),
         flight_sw_version: software_version(),
         middleware_sw_version: 0,
         os_sw_version: 0,
@@ -352,7 +400,8 @@ pub fn statustext(severity: MavSeverity, text: &str, id: u16) -> Vec<MavMessage>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use flyloop_core::tasks::registry::TaskConfig;
+    use flyloop_core::quadrotor::Frame;
+    use flyloop_core::tasks::registry::{TaskConfig, TaskKind};
 
     fn hover() -> Vehicle {
         let mut config = TaskConfig::default();
@@ -410,6 +459,29 @@ mod tests {
             unreachable!()
         };
         assert_eq!(h.base_mode, MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED);
+    }
+
+    #[test]
+    fn heartbeat_names_the_frame_by_its_rotor_count() {
+        for (name, expected) in [
+            ("quad_x", MavType::MAV_TYPE_QUADROTOR),
+            ("hexa_x", MavType::MAV_TYPE_HEXAROTOR),
+            ("octo_x", MavType::MAV_TYPE_OCTOROTOR),
+        ] {
+            let config = TaskConfig {
+                frame: Frame::named(name).unwrap(),
+                ..TaskConfig::default()
+            };
+            let v = Vehicle::new(1, TaskKind::Hover, config, 3).unwrap();
+            let MavMessage::HEARTBEAT(h) = heartbeat(&v, Status::Standby) else {
+                unreachable!()
+            };
+            assert_eq!(h.mavtype, expected, "{name}");
+        }
+        assert_eq!(multirotor_mav_type(12), MavType::MAV_TYPE_DODECAROTOR);
+        assert_eq!(multirotor_mav_type(5), MavType::MAV_TYPE_GENERIC_MULTIROTOR);
+        let lander = Vehicle::new(1, TaskKind::Landing, TaskConfig::default(), 0).unwrap();
+        assert_eq!(mav_type(&lander), MavType::MAV_TYPE_GENERIC);
     }
 
     #[test]

@@ -232,3 +232,36 @@ def statustexts(msgs: list) -> list[str]:
             out.append(key)
         chunks[key].append(m.text)
     return ["".join(chunks[t]) if isinstance(t, tuple) else t for t in out]
+
+
+class GroundStation:
+    """A pymavlink ground station listening like QGroundControl does (udpin)."""
+
+    def __init__(self):
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.sock.bind(("127.0.0.1", 0))
+        self.port = self.sock.getsockname()[1]
+        self.mav = mavlink2.MAVLink(None, srcSystem=255, srcComponent=190)
+        self.parser = mavlink2.MAVLink(None)
+        self.sitl_address = None
+
+    def listen(self, seconds: float) -> list:
+        out = []
+        end = time.monotonic() + seconds
+        while (left := end - time.monotonic()) > 0:
+            self.sock.settimeout(left)
+            try:
+                data, self.sitl_address = self.sock.recvfrom(65536)
+            except TimeoutError:
+                break
+            out.extend(self.parser.parse_buffer(data) or [])
+        return out
+
+    def command(self, command: int, params, target: int = 1) -> None:
+        p = list(params) + [0.0] * (7 - len(params))
+        msg = self.mav.command_long_encode(target, 1, command, 0, *p)
+        self.sock.sendto(msg.pack(self.mav), self.sitl_address)
+
+    def send(self, msg) -> None:
+        """Sends a pymavlink message (e.g. PARAM_SET) to the SITL, once it has been heard."""
+        self.sock.sendto(msg.pack(self.mav), self.sitl_address)

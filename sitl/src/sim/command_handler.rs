@@ -30,7 +30,7 @@ impl Sim {
     }
 
     /// Acknowledges `command` from every vehicle in `targets` with `result`.
-    fn ack_all(
+    pub(super) fn ack_all(
         &mut self,
         link: Link,
         out: &mut Vec<u8>,
@@ -60,7 +60,8 @@ impl Sim {
         match c.command {
             RESET_COMMAND => self.on_reset(link, header, c, targets, peer, out),
             MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL => {
-                let result = self.set_message_interval(link, c.param1, c.param2, peer);
+                let result =
+                    self.set_message_interval(link, c.param1, c.param2, peer, targets.clone());
                 if result != MavResult::MAV_RESULT_ACCEPTED {
                     self.stats.refused_requests += 1;
                 }
@@ -135,7 +136,7 @@ impl Sim {
 
     /// REQUEST_MESSAGE (or the older REQUEST_AUTOPILOT_CAPABILITIES): each vehicle in
     /// `targets` acknowledges, then sends the message if it has it.
-    fn on_message_request(
+    pub(super) fn on_message_request(
         &mut self,
         link: Link,
         header: MavHeader,
@@ -209,13 +210,15 @@ impl Sim {
     }
 
     /// SET_MESSAGE_INTERVAL: on the controller link it chooses what the sending peer gets
-    /// (HIL_STATE_QUATERNION, DEBUG_FLOAT_ARRAY); on the ground-station link it sets a stream.
+    /// (HIL_STATE_QUATERNION, DEBUG_FLOAT_ARRAY); on the ground-station link it sets a stream
+    /// (of every vehicle, or in a world of the `targets` vehicles').
     pub(super) fn set_message_interval(
         &mut self,
         link: Link,
         message: f32,
         interval: f32,
         peer: Option<usize>,
+        targets: Range<usize>,
     ) -> MavResult {
         let (Some(message), true) = (crate::commands::message_id(message), interval.is_finite())
         else {
@@ -238,13 +241,27 @@ impl Sim {
                 }
                 MavResult::MAV_RESULT_ACCEPTED
             }
-            _ => self.gcs_streams.set_interval(message, interval),
+            _ => {
+                let sets = if self.gcs_streams.len() == 1 {
+                    0..1
+                } else {
+                    targets
+                };
+                let mut result = MavResult::MAV_RESULT_ACCEPTED;
+                for s in sets {
+                    result = self.gcs_streams[s].set_interval(message, interval);
+                }
+                result
+            }
         }
     }
 
     /// The message `message_id` of vehicle `i` (one or more MAVLink messages), if this SITL
     /// sends it.
     pub(super) fn message(&mut self, i: usize, message_id: u32) -> Option<Vec<MavMessage>> {
+        if self.world.is_some() {
+            return self.world_message(i, message_id);
+        }
         let status = self.status(i);
         let home = self.options.home;
         let v = &mut self.vehicles[i];

@@ -21,6 +21,7 @@ mod command_handler;
 mod controls;
 mod realtime;
 mod refusal;
+mod world_gcs;
 mod world_handler;
 mod world_task;
 
@@ -137,7 +138,9 @@ pub struct Sim {
     next_text_id: u16,
     /// The per-peer rate limit of the texts that answer refused controls.
     refusal_texts: TextBudget,
-    gcs_streams: GcsStreams,
+    /// The ground-station streams: one set every vehicle follows, or one per vehicle of a
+    /// world (SET_MESSAGE_INTERVAL addressed to its system id).
+    gcs_streams: Vec<GcsStreams>,
     /// Messages for the ground station raised by events (failsafe, resets), sent by the server.
     pub gcs_outbox: Vec<u8>,
     /// Messages for every live controller peer raised by events in real time.
@@ -180,7 +183,7 @@ impl Sim {
             peers: Vec::new(),
             next_text_id: 1,
             refusal_texts: TextBudget::default(),
-            gcs_streams: GcsStreams::new(now),
+            gcs_streams: vec![GcsStreams::new(now)],
             gcs_outbox: Vec::new(),
             controller_outbox: Vec::new(),
             stream: Vec::new(),
@@ -201,6 +204,8 @@ impl Sim {
             ..options
         };
         let mut sim = Sim::new(options, now)?;
+        // Each vehicle of the world streams to the ground station as its own system.
+        sim.gcs_streams = vec![GcsStreams::new(now); world.num_agents()];
         sim.world = Some(world);
         Ok(sim)
     }
@@ -213,16 +218,24 @@ impl Sim {
         }
     }
 
-    fn vehicle_index(&self, system_id: u8) -> Option<usize> {
-        let i = usize::from(system_id).checked_sub(1)?;
-        (i < self.vehicles.len()).then_some(i)
+    /// How many systems this SITL speaks for: its vehicles, or the world's.
+    pub(crate) fn system_count(&self) -> usize {
+        match &self.world {
+            Some(w) => w.num_agents(),
+            None => self.vehicles.len(),
+        }
     }
 
-    /// The vehicles a message with `target_system` addresses (0 = all); None if no vehicle has
-    /// that id.
+    fn vehicle_index(&self, system_id: u8) -> Option<usize> {
+        let i = usize::from(system_id).checked_sub(1)?;
+        (i < self.system_count()).then_some(i)
+    }
+
+    /// The vehicles (a world's agents) a message with `target_system` addresses (0 = all);
+    /// None if no vehicle has that id.
     pub(crate) fn targets(&mut self, target_system: u8) -> Option<std::ops::Range<usize>> {
         if target_system == 0 {
-            return Some(0..self.vehicles.len());
+            return Some(0..self.system_count());
         }
         match self.vehicle_index(target_system) {
             Some(i) => Some(i..i + 1),
@@ -393,19 +406,32 @@ impl Sim {
 
     // ---- ground station ----
 
+    /// The vehicles stream set `s` speaks for: all with one set, else vehicle `s`.
+    fn stream_systems(&self, s: usize) -> std::ops::Range<usize> {
+        if self.gcs_streams.len() == 1 {
+            0..self.system_count()
+        } else {
+            s..s + 1
+        }
+    }
+
     /// Appends the ground-station telemetry due at `now`; returns when the next is due.
     pub fn gcs_tick(&mut self, now: Instant, out: &mut Vec<u8>) -> Instant {
-        let due = self.gcs_streams.due(now);
-        for message_id in due {
-            for i in 0..self.vehicles.len() {
-                if let Some(messages) = self.message(i, message_id) {
-                    for m in messages {
-                        self.push(Link::Gcs, out, i, &m);
+        for s in 0..self.gcs_streams.len() {
+            let due = self.gcs_streams[s].due(now);
+            for message_id in due {
+                for i in self.stream_systems(s) {
+                    if let Some(messages) = self.message(i, message_id) {
+                        for m in messages {
+                            self.push(Link::Gcs, out, i, &m);
+                        }
                     }
                 }
             }
         }
-        self.gcs_streams.next_due()
+        (self.gcs_streams.iter().map(GcsStreams::next_due))
+            .min()
+            .unwrap_or_else(|| now + Duration::from_secs(1))
     }
 }
 

@@ -41,9 +41,15 @@ impl Sim {
                 self.refuse(link, from, 0, Refusal::GcsLink, now, out);
             }
             (MavMessage::COMMAND_LONG(c), _) => self.on_world_command(link, header, c, peer, out),
+            (MavMessage::PARAM_REQUEST_LIST(m), _) => {
+                self.on_param_request_list(link, m.target_system, out)
+            }
+            (MavMessage::PARAM_REQUEST_READ(m), _) => {
+                self.on_param_request_read(link, header, m, out)
+            }
+            (MavMessage::PARAM_SET(m), _) => self.on_param_set(link, header, m, out),
             (MavMessage::HEARTBEAT(_), _) => {}
             _ => {
-                // Parameters of a world come from its --config file (protocol §14).
                 self.stats.ignored_messages += 1;
                 tracing::debug!(%from, ?link, "message ignored by the world");
             }
@@ -133,6 +139,7 @@ impl Sim {
             }
         };
         self.stats.steps += 1;
+        self.announce_world_events();
         let from = out.len();
         self.push_world_reply(peer, out);
         if let Some(w) = self.world.as_mut() {
@@ -181,19 +188,26 @@ impl Sim {
         peer: Option<usize>,
         out: &mut Vec<u8>,
     ) {
-        let n = self.world.as_ref().map_or(0, |w| w.num_agents());
-        if usize::from(c.target_system) > n {
-            self.stats.unknown_vehicle += 1;
+        let Some(targets) = self.targets(c.target_system) else {
             return;
-        }
+        };
         match c.command {
             RESET_COMMAND => self.on_world_reset(link, header, c, peer, out),
             MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL => {
-                let result = self.set_message_interval(link, c.param1, c.param2, peer);
+                let result =
+                    self.set_message_interval(link, c.param1, c.param2, peer, targets.clone());
                 if result != MavResult::MAV_RESULT_ACCEPTED {
                     self.stats.refused_requests += 1;
                 }
-                self.world_ack(link, out, header, c.command, result);
+                if link == Link::Gcs {
+                    // Each vehicle's streams are its own: each addressed vehicle answers.
+                    self.ack_all(link, out, targets, header, c.command, result);
+                } else {
+                    self.world_ack(link, out, header, c.command, result);
+                }
+            }
+            MavCmd::MAV_CMD_REQUEST_MESSAGE => {
+                self.on_message_request(link, header, c, targets, out);
             }
             _ => {
                 self.stats.ignored_messages += 1;

@@ -48,6 +48,11 @@ pub struct WorldTask {
     pub last_step: Option<u64>,
     pub last_reply: Option<Vec<u8>>,
     values: Vec<f32>,
+    /// The configuration of the next reset (PARAM_SET writes here; the running world was
+    /// built from `flight.config()`).
+    pub config: MultiConfig,
+    /// Per agent, how many of its episode's fault events the ground station has been told.
+    pub faults_reported: Vec<usize>,
 }
 
 impl WorldTask {
@@ -58,7 +63,6 @@ impl WorldTask {
         let n = flight.num_agents();
         let dt_us = ((flight.dt() * 1e6).round() as u64).max(1);
         Ok(WorldTask {
-            flight,
             seed,
             clock_us: 0,
             dt_us,
@@ -70,6 +74,9 @@ impl WorldTask {
             last_step: None,
             last_reply: None,
             values: Vec::new(),
+            config: flight.config().clone(),
+            faults_reported: vec![0; n],
+            flight,
         })
     }
 
@@ -90,9 +97,14 @@ impl WorldTask {
         explicit.unwrap_or_else(|| next_seed(self.seed))
     }
 
-    /// A new episode with `seed`; the commands gathered for a step are dropped.
+    /// A new episode with `seed`, first rebuilding the world if a parameter changed; the
+    /// commands gathered for a step are dropped.
     pub fn reset(&mut self, seed: u64) -> Result<(), MultiError> {
+        if self.config != *self.flight.config() {
+            self.flight = MultiFlight::new(self.flight.scenario(), self.config.clone())?;
+        }
         self.flight.reset(seed)?;
+        self.faults_reported.fill(0);
         self.seed = seed;
         self.episode_step = 0;
         self.drop_pending();

@@ -35,6 +35,7 @@ pub use params::MultiParams;
 pub use scenario::Scenario;
 
 use crate::error::ParamError;
+use crate::faults::FaultEvent;
 use crate::quadrotor::{BodyState, QuadrotorParams, multirotor_at};
 use crate::rng::SimRng;
 use crate::tasks::flight::{
@@ -44,7 +45,7 @@ use crate::tasks::flight_link::FlightLink;
 use crate::tasks::hover::hover_reward;
 use crate::tasks::{ActionError, InfoRef, InfoVisitor, StepOutcome, check_action};
 use crate::vehicle::AirVehicle;
-use crate::world::{World, WorldError, shape};
+use crate::world::{Collision, World, WorldError, shape};
 use nalgebra::Vector3;
 use neighbours::NEIGHBOUR_VALUES;
 use std::sync::OnceLock;
@@ -112,6 +113,8 @@ pub struct MultiFlight {
     /// Every agent's nearest neighbours now ([`neighbours::all_nearest`]), found once for all
     /// agents on the first observation after a change; emptied by every `&mut self` method.
     nearest: OnceLock<Vec<u32>>,
+    /// The collisions that started in the last step (for the front ends' reports).
+    collisions: Vec<Collision>,
 }
 
 impl MultiFlight {
@@ -175,6 +178,7 @@ impl MultiFlight {
             obs_high,
             config,
             nearest: OnceLock::new(),
+            collisions: Vec::new(),
         };
         task.reset(0)?;
         Ok(task)
@@ -276,6 +280,7 @@ impl MultiFlight {
         self.world = World::new(self.config.world.clone(), world_seed, vehicles)?;
         self.steps = 0;
         self.failed = false;
+        self.collisions.clear();
         for (i, s) in self.status.iter_mut().enumerate() {
             let start = self.world.vehicle(i).body().position;
             *s = AgentStatus {
@@ -414,7 +419,8 @@ impl MultiFlight {
             s.collision_speed = 0.0;
             s.outcome = None;
         }
-        for c in self.world.take_collisions() {
+        self.collisions = self.world.take_collisions();
+        for c in &self.collisions {
             for k in [c.a, c.b] {
                 let s = &mut self.status[k];
                 s.collided = true;
@@ -496,6 +502,17 @@ impl MultiFlight {
         for (i, chunk) in out.chunks_mut(size).take(self.links.len()).enumerate() {
             self.write_observation(i, chunk);
         }
+    }
+
+    /// The collisions that started in the last step (agents by index), in the world's order.
+    pub fn last_collisions(&self) -> &[Collision] {
+        &self.collisions
+    }
+
+    /// Agent `i`'s fault events (firings, clearings) of this episode so far, in order; none
+    /// for a healthy agent.
+    pub fn fault_events(&self, i: usize) -> &[FaultEvent] {
+        self.links[i].faults().map_or(&[], |f| f.state().events())
     }
 
     /// Whether every agent is within `arrival_radius` of its target now.
