@@ -206,6 +206,12 @@ fn a_collision_ends_it_for_both_in_multi_hover_and_for_all_in_swap() {
     }
     assert!(!t.is_done(2) && !t.outcome(2).terminated);
     assert_eq!(info(&t, 2, "collided"), "false");
+    // The front ends' report of the step: which pair, how fast.
+    let c = t.last_collisions();
+    assert_eq!(c.len(), 1);
+    assert_eq!((c[0].a, c[0].b), (0, 1));
+    let speed = info(&t, 0, "collision_speed").parse::<f64>().unwrap();
+    assert!((c[0].speed - speed).abs() < 1e-9, "{} {speed}", c[0].speed);
 
     let mut t = collide(Scenario::Swap, 4.0);
     assert!((0..4).all(|i| t.is_done(i) && t.outcome(i).terminated));
@@ -214,6 +220,7 @@ fn a_collision_ends_it_for_both_in_multi_hover_and_for_all_in_swap() {
     // The done agents are out: the next step has them inactive, zero reward.
     t.step(&[0.5; 16]).unwrap();
     assert!((0..4).all(|i| !t.is_active(i) && t.outcome(i).reward == 0.0));
+    assert!(t.last_collisions().is_empty(), "only the step a contact starts in");
 }
 
 #[test]

@@ -60,6 +60,14 @@ fn a_weak_motor_of_one_agent_gives_that_agent_its_share_of_thrust() {
     );
     t.reset(7).unwrap();
     let h = hover(&t);
+    // The events the front ends report: agent 1's fault fired at 0, agent 0 has none.
+    t.step(&[h; 8]).unwrap();
+    let events = t.fault_events(1);
+    assert_eq!(events.len(), 1);
+    assert!(events[0].fired && events[0].time == 0.0, "{events:?}");
+    assert_eq!(events[0].label, "motor_effectiveness:1");
+    assert!(t.fault_events(0).is_empty());
+    t.reset(7).unwrap();
     // Same command for both: the weak rotor settles to √0.5 of the state (τ = 0.08 s).
     for _ in 0..50 {
         t.step(&[h; 8]).unwrap();

@@ -159,7 +159,7 @@ def _batch(
     if backend == "sitl":
         from .multi_sitl import SitlMultiBatch
 
-        link = {k: kwargs.pop(k) for k in ("sitl_path", "timeout") if k in kwargs}
+        link = {k: kwargs.pop(k) for k in ("sitl_path", "timeout", "gcs") if k in kwargs}
         return SitlMultiBatch(ENV_TASKS[env_id], native_config(**kwargs), **link)
     return _native.MultiBatch(ENV_TASKS[env_id], native_config(**kwargs), num_worlds, num_threads)
 
@@ -313,7 +313,8 @@ def parallel_env(env_id: str, num_agents: int = 4, backend: str = "native", **kw
     """The multi-agent env `env_id` ("flyloop/MultiHover-v0", "flyloop/Swap-v0" or "-v1") as a
     PettingZoo ParallelEnv (module docs for the spaces, reward, ends and arguments), its world
     in this process (backend "native") or in a flyloop-sitl it starts (backend "sitl", the
-    same bits: flyloop.multi_sitl; `sitl_path=`, `timeout=`)."""
+    same bits: flyloop.multi_sitl; `sitl_path=`, `timeout=`, and `gcs="127.0.0.1:14550"` to
+    show a ground station every agent as MAVLink system i + 1: docs/sitl.md)."""
     if backend not in ("native", "sitl"):
         raise ValueError(f"backend must be 'native' or 'sitl', got {backend!r}")
     return _parallel_env_class()(env_id, num_agents=num_agents, backend=backend, **kwargs)

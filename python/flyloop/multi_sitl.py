@@ -47,13 +47,15 @@ def _rewards_from_pieces(pieces: np.ndarray) -> np.ndarray:
     return bits.view(np.float64)
 
 
-def _start(task: str, config: Mapping[str, Any], agents: int, sitl_path, timeout) -> SitlProcess:
+def _start(
+    task: str, config: Mapping[str, Any], agents: int, sitl_path, timeout, gcs: str
+) -> SitlProcess:
     fd, path = tempfile.mkstemp(prefix="flyloop-world-", suffix=".toml")
     try:
         with os.fdopen(fd, "w") as f:
             f.write(to_toml(config))
         args = [
-            "--task", task, "--gcs", "off", "--mode", "lockstep", "--vehicles", str(agents),
+            "--task", task, "--gcs", gcs, "--mode", "lockstep", "--vehicles", str(agents),
             "--no-state-reply", "--log-level", "warn", "--config", path,
         ]  # fmt: skip
         return SitlProcess(find_sitl_binary(sitl_path), args, start_timeout=timeout)
@@ -63,7 +65,9 @@ def _start(task: str, config: Mapping[str, Any], agents: int, sitl_path, timeout
 
 class SitlMultiBatch:
     """One world of the multi-agent task `task` ("multi_hover", "swap") with `config` (the
-    extension's parameter dict) in a SITL of its own; the methods are `MultiBatch`'s."""
+    extension's parameter dict) in a SITL of its own; the methods are `MultiBatch`'s. `gcs`:
+    the SITL's ground-station target (`--gcs`; "off" by default), where each agent streams
+    its telemetry as MAVLink system i + 1."""
 
     num_worlds = 1
     num_threads = 1
@@ -77,6 +81,7 @@ class SitlMultiBatch:
         *,
         sitl_path: Any = None,
         timeout: float = 5.0,
+        gcs: str = "off",
     ) -> None:
         agents = config.get("num_agents", 4)
         if not 1 <= agents <= MAX_AGENTS:
@@ -105,7 +110,7 @@ class SitlMultiBatch:
         self._encoder = Encoder()
         self._dt_us = max(1, round(float(self._describe["dt"]) * 1e6))
         self._info = np.zeros((self.num_agents, self.info_size), np.float32)
-        self._process = _start(task, config, self.num_agents, sitl_path, timeout)
+        self._process = _start(task, config, self.num_agents, sitl_path, timeout, gcs)
         self._link = SitlLink(self._process.address, timeout=timeout, process=self._process)
 
     @property

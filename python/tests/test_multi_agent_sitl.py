@@ -8,6 +8,7 @@ from __future__ import annotations
 import os
 import socket
 import struct
+import time
 
 import numpy as np
 import pytest
@@ -181,6 +182,46 @@ def test_bad_input_names_the_item(backend):
         flyloop.parallel_env("flyloop/Swap-v1", num_agents=too_many, backend=backend)
     with pytest.raises(ValueError, match="swap_radius"):
         flyloop.parallel_env("flyloop/Swap-v1", num_agents=3, backend=backend, swap_radius=-1.0)
+
+
+def test_a_ground_station_sees_the_agents_of_a_sitl_env():
+    """`gcs=` shows a ground station every agent as its own system, moving as the env steps;
+    the env's bits are those of the native backend with the link on."""
+    gcs = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    gcs.bind(("127.0.0.1", 0))
+    gcs.settimeout(0.2)
+    kwargs = dict(num_agents=3, max_steps=60)
+    native = flyloop.parallel_env("flyloop/Swap-v1", **kwargs)
+    sitl = flyloop.parallel_env(
+        "flyloop/Swap-v1", backend="sitl", gcs=f"127.0.0.1:{gcs.getsockname()[1]}", **kwargs
+    )
+
+    def climb(env, rng):
+        return {a: np.full(4, 0.6, np.float32) for a in env.agents}
+
+    try:
+        a, _ = _trace(native, (3,), 40, climb)
+        b, _ = _trace(sitl, (3,), 40, climb)
+        msgs, parser = [], mavlink2.MAVLink(None)
+        end = time.monotonic() + 1.5
+        while time.monotonic() < end:
+            try:
+                msgs += parser.parse_buffer(gcs.recv(65536)) or []
+            except TimeoutError:
+                pass
+        positions, _ = sitl.positions()
+    finally:
+        sitl.close()
+        gcs.close()
+    assert a == b
+    beats = {m.get_srcSystem() for m in msgs if m.get_type() == "HEARTBEAT"}
+    assert beats == {1, 2, 3}
+    local = {m.get_srcSystem(): m for m in msgs if m.get_type() == "LOCAL_POSITION_NED"}
+    assert sorted(local) == [1, 2, 3]
+    for s, m in local.items():  # the last step's place, NED from home (the env's is ENU)
+        assert m.time_boot_ms == 400
+        assert abs(m.x - positions[s - 1][1]) < 1e-4 and abs(m.y - positions[s - 1][0]) < 1e-4
+        assert abs(m.z + positions[s - 1][2]) < 1e-4
 
 
 def _world(sitl_binary, agents=2):

@@ -234,6 +234,12 @@ def statustexts(msgs: list) -> list[str]:
     return ["".join(chunks[t]) if isinstance(t, tuple) else t for t in out]
 
 
+def free_udp_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
 class GroundStation:
     """A pymavlink ground station listening like QGroundControl does (udpin)."""
 

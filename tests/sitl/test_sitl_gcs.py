@@ -5,11 +5,10 @@ while a controller flies it."""
 from __future__ import annotations
 
 import math
-import socket
 import time
 
 from mavproxy_peer import MavProxy
-from sitl_client import GroundStation, decode_frame, mavlink2, of_type
+from sitl_client import GroundStation, decode_frame, free_udp_port, mavlink2, of_type
 
 
 def test_the_ground_station_gets_heartbeats_and_telemetry(start_sitl, client_for):
@@ -65,12 +64,6 @@ def test_requests_and_intervals_on_the_ground_station_link(start_sitl):
     # The lander's battery is reported in percent.
     status = of_type(gcs.listen(1.1), "SYS_STATUS")[0]
     assert status.battery_remaining == 100 and status.voltage_battery == 16_800
-
-
-def free_udp_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def test_mavproxy_detects_the_vehicle_and_shows_its_attitude(start_sitl, client_for, tmp_path):

@@ -8,10 +8,12 @@ in python/tests/test_multi_agent_sitl.py run with the ground-station link off)."
 from __future__ import annotations
 
 import pytest
+from mavproxy_peer import MavProxy
 from sitl_client import (
     LOCKSTEP,
     Client,
     GroundStation,
+    free_udp_port,
     local_ned,
     mavlink2,
     of_type,
@@ -109,6 +111,23 @@ def test_a_ground_station_sees_every_vehicle_of_the_world_move(world):
         beat = by_system(msgs, "HEARTBEAT")[s][-1]
         assert beat.base_mode == mavlink2.MAV_MODE_FLAG_SAFETY_ARMED
         assert beat.system_status == mavlink2.MAV_STATE_ACTIVE
+
+
+def test_mavproxy_detects_every_vehicle_of_the_world(start_sitl, client_for, tmp_path):
+    port = free_udp_port()
+    mavproxy = MavProxy(tmp_path, f"--master=udpin:127.0.0.1:{port}", "--nowait")
+    try:
+        mavproxy.wait_for("Connect udpin", timeout=30)
+        sitl = start_sitl("--task", "swap", "--vehicles", "3", gcs=f"127.0.0.1:{port}")
+        for s in (1, 2, 3):
+            mavproxy.wait_for(f"Detected vehicle {s}:1 on link 0", timeout=30)
+        assert "ARMED" not in mavproxy.console()  # nothing flies yet
+        client = client_for(sitl)
+        client.reset(1, target=0)
+        world_step(client, 3, [0.5] * 4)
+        mavproxy.wait_for("ARMED", timeout=10)  # a controller flies the world
+    finally:
+        mavproxy.kill()
 
 
 def test_message_intervals_are_per_system(world):
