@@ -220,7 +220,10 @@ fn a_collision_ends_it_for_both_in_multi_hover_and_for_all_in_swap() {
     // The done agents are out: the next step has them inactive, zero reward.
     t.step(&[0.5; 16]).unwrap();
     assert!((0..4).all(|i| !t.is_active(i) && t.outcome(i).reward == 0.0));
-    assert!(t.last_collisions().is_empty(), "only the step a contact starts in");
+    assert!(
+        t.last_collisions().is_empty(),
+        "only the step a contact starts in"
+    );
 }
 
 #[test]

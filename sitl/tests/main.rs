@@ -7,4 +7,5 @@ mod inject_failure;
 mod lockstep_over_udp;
 mod lockstep_resend;
 mod refused_controls;
+mod world_gcs;
 mod world_lockstep;

@@ -20,7 +20,7 @@ use std::time::Instant;
 
 const AGENTS: u8 = 3;
 
-fn world_sim() -> Sim {
+pub(crate) fn world_sim() -> Sim {
     let config = world_config(AGENTS, &[("wind_enabled".into(), 1.0)], Vec::new()).unwrap();
     let world = WorldTask::new(Scenario::MultiHover, config, 11).unwrap();
     Sim::new_world(SimOptions::new(TaskKind::Hover), world, Instant::now()).unwrap()
@@ -45,7 +45,7 @@ fn controls(enc: &mut Encoder, system_id: u8, values: [f32; 4], step: u64, flags
     out
 }
 
-fn reset(enc: &mut Encoder, target_system: u8, seed: u64) -> Vec<u8> {
+pub(crate) fn reset(enc: &mut Encoder, target_system: u8, seed: u64) -> Vec<u8> {
     let [param1, param2, param3, param4] = seed_params(seed);
     let m = MavMessage::COMMAND_LONG(COMMAND_LONG_DATA {
         command: MavCmd::MAV_CMD_USER_1,
@@ -73,7 +73,7 @@ fn frame_values(bytes: &[u8]) -> Vec<Vec<f32>> {
     out
 }
 
-fn step_datagram(enc: &mut Encoder, k: u64) -> Vec<u8> {
+pub(crate) fn step_datagram(enc: &mut Encoder, k: u64) -> Vec<u8> {
     let x = 0.02 * (k % 7) as f32;
     (1..=AGENTS)
         .flat_map(|s| controls(enc, s, [0.55 + x, 0.5, 0.5 - x, 0.52], k * 10_000, true))
