@@ -130,7 +130,7 @@ def test_mavproxy_detects_every_vehicle_of_the_world(start_sitl, client_for, tmp
         mavproxy.kill()
 
 
-def test_message_intervals_are_per_system(world):
+def test_message_intervals_and_requests_are_per_system(world):
     gcs, _, _ = world("multi_hover", 3)
     gcs.listen(0.3)
     gcs.command(mavlink2.MAV_CMD_SET_MESSAGE_INTERVAL, [mavlink2.MAVLINK_MSG_ID_ATTITUDE, -1],
@@ -144,6 +144,13 @@ def test_message_intervals_are_per_system(world):
     gcs.listen(0.1)
     counts = {s: len(m) for s, m in by_system(gcs.listen(1.0), "ATTITUDE").items()}
     assert min(counts.values()) >= 15 and sorted(counts) == [1, 2, 3], counts  # 20 Hz
+    # Requests are answered by the system asked.
+    gcs.command(mavlink2.MAV_CMD_REQUEST_MESSAGE, [mavlink2.MAVLINK_MSG_ID_AUTOPILOT_VERSION],
+                target=2)  # fmt: skip
+    msgs = gcs.listen(0.3)
+    versions = of_type(msgs, "AUTOPILOT_VERSION")
+    assert [(v.get_srcSystem(), v.uid) for v in versions] == [(2, 2)]
+    assert [a.get_srcSystem() for a in of_type(msgs, "COMMAND_ACK")] == [2]
     # A system the world does not have is not answered.
     gcs.command(mavlink2.MAV_CMD_SET_MESSAGE_INTERVAL, [mavlink2.MAVLINK_MSG_ID_ATTITUDE, -1],
                 target=7)  # fmt: skip

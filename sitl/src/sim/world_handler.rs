@@ -180,6 +180,8 @@ impl Sim {
         }
     }
 
+    // MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES is superseded but ground stations still send it.
+    #[allow(deprecated)]
     fn on_world_command(
         &mut self,
         link: Link,
@@ -206,7 +208,7 @@ impl Sim {
                     self.world_ack(link, out, header, c.command, result);
                 }
             }
-            MavCmd::MAV_CMD_REQUEST_MESSAGE => {
+            MavCmd::MAV_CMD_REQUEST_MESSAGE | MavCmd::MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES => {
                 self.on_message_request(link, header, c, targets, out);
             }
             _ => {
