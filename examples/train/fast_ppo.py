@@ -48,6 +48,7 @@ import flyloop.multi_agent  # noqa: E402
 import gymnasium as gym  # noqa: E402
 import numpy as np  # noqa: E402
 import torch  # noqa: E402
+from separation_shaping import SeparationShaping  # noqa: E402
 from torch import nn  # noqa: E402
 from training_envs import FRAMES, HOVER_SUCCESS_DISTANCE_M, preset  # noqa: E402
 
@@ -96,6 +97,11 @@ class Config:
     select_every: int = 0
     select_after: int = 0
     select_episodes: int = 100
+    # Multi-agent tasks: the learner's reward also takes separation_penalty per step and per
+    # observed neighbour closer than separation_radius (m), times (1 − d / separation_radius)
+    # (separation_shaping.py; 0: off). The reported returns stay the env's.
+    separation_penalty: float = 0.0
+    separation_radius: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -150,6 +156,16 @@ LANDER_MOVING = replace(
     select_after=30,
 )
 
+SWAP_LAYERS = Config(num_envs=128, rollout_steps=128, minibatches=8)
+# Swap-v0: the straight line collides in the middle, and on the env's reward alone PPO met the
+# collision as a cliff (0 % training success for 5M agent-steps). The learner's reward also
+# charges closeness to a neighbour (separation_shaping.py; docs/training.md).
+SWAP_V0 = replace(
+    SWAP_LAYERS,
+    separation_penalty=0.5,
+    separation_radius=0.8,
+)
+
 TASKS: dict[str, Task] = {
     # The rates interface (train_offboard.py adds its held-out checks and the export for
     # examples/px4_offboard.py): more envs per update, shorter rollouts, a slower step.
@@ -161,11 +177,19 @@ TASKS: dict[str, Task] = {
         title="PPO, thrust + body rates through PX4's rate loop, Iris randomised",
     ),
     # Four agents, one shared policy: each agent is a sub-env of flyloop.MultiAgentVectorEnv
-    # (32 worlds x 4 agents per update). Swap-v1 (layers 0.6 m, 1 m circle): training success
-    # 100 % from ~1.06M agent-steps (seed 0); on Swap-v0 3M gave 0 % (docs/training.md).
+    # (32 worlds x 4 agents per update). Swap-v0 (a 2 m circle, all at one height): SWAP_V0.
     "swap": Task(
         "swap",
-        Config(num_envs=128, rollout_steps=128, minibatches=8),
+        SWAP_V0,
+        timesteps=3_000_000,
+        eval_episodes=100,
+        title="PPO on Swap-v0, 4 agents, one shared policy",
+    ),
+    # Swap-v1 (layers 0.6 m, 1 m circle): training success 100 % from ~1.06M agent-steps
+    # (seed 0) with PPO's plain settings (docs/training.md).
+    "swap_layers": Task(
+        "swap_layers",
+        SWAP_LAYERS,
         timesteps=1_500_000,
         eval_episodes=100,
         title="PPO on Swap-v1, 4 agents, one shared policy",
@@ -367,6 +391,19 @@ def evaluate(
     )
 
 
+def start_from(folder: Path, model: ActorCritic, norm: RunningNorm) -> None:
+    """--init: the weights and observation statistics of an earlier run's policy.pt (the same
+    task and network; the optimiser starts afresh)."""
+    saved = torch.load(folder / "policy.pt", weights_only=False)
+    try:
+        model.load_state_dict(saved["model"])
+    except RuntimeError as exc:
+        raise ValueError(f"--init {folder}: not a policy of this task's network: {exc}") from exc
+    norm.mean, norm.var = saved["obs_mean"], saved["obs_var"]
+    # The statistics weigh as the observations they were taken over (one per env step).
+    norm.count = float(json.loads((folder / "summary.json").read_text())["env_steps"])
+
+
 def make_model(cfg: Config, obs_size: int, act_size: int) -> ActorCritic:
     """The actor-critic of cfg; with cfg.time_limit_terminal the critic also sees the time
     remaining."""
@@ -421,6 +458,7 @@ class Rollout:
         self.resetting = np.zeros(n, bool)  # the previous step ended: this step resets
         self.episode_return = np.zeros(n)
         self.episode_length = np.zeros(n, np.int64)
+        self.shaping: SeparationShaping | None = None  # the learner's extra term, if any
 
     def collect(self, envs, model: ActorCritic, norm: RunningNorm, obs: np.ndarray):
         """Flies the sampled policy for the rollout from obs; returns the last observation and
@@ -445,6 +483,9 @@ class Rollout:
                 to_env(model.to_actions(self.act[t]), space)
             )
             self.record(t, reward, terminated, truncated, infos, ended)
+            if self.shaping is not None:
+                live = self.valid[t] & infos.get("active", True)
+                self.rew[t] += np.where(live, self.shaping(obs) * self.reward_scale, 0.0)
         self.obs[t_len] = norm(obs)
         if self.time is not None:
             self.time[t_len] = 1.0 - self.episode_length / self.max_steps
@@ -594,8 +635,13 @@ def train(args: argparse.Namespace, backend: str, cfg: Config) -> dict:
     max_steps = time_limit(cfg, args.env)
     optimiser = torch.optim.Adam(model.parameters(), lr=cfg.learning_rate, eps=1e-5)
     norm = RunningNorm(obs_size)
+    if args.init is not None:
+        start_from(args.init, model, norm)
     rng = np.random.default_rng(args.seed)
     rollout = Rollout(cfg, obs_size, act_size, max_steps)
+    if cfg.separation_penalty > 0.0:
+        layout = envs.observation_layout
+        rollout.shaping = SeparationShaping(layout, cfg.separation_penalty, cfg.separation_radius)
 
     obs, _ = envs.reset(seed=args.seed)
     norm.update(obs)
@@ -739,6 +785,8 @@ def summarise(args: argparse.Namespace, backend: str, cfg: Config, run: dict, cp
         action=p.default_action,
         backend=backend,
         seed=args.seed,
+        # The run this one went on from (--init), or None.
+        init=None if args.init is None else str(args.init),
         config=asdict(cfg),
         env_steps=steps,
         wall_time_s=wall,
@@ -862,6 +910,12 @@ def main(argv: list[str] | None = None) -> int:
         help="the multirotor of --env hover (the core's rotor tables; default the quad X)",
     )
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--init",
+        type=Path,
+        help="go on from an earlier run's OUT/BACKEND folder (its policy.pt: weights and "
+        "observation statistics)",
+    )
     parser.add_argument("--eval-episodes", type=int, help="default: the task's")
     parser.add_argument("--out", type=Path, default=Path("runs/fast_ppo"))
     parser.add_argument("--curve", type=Path, help="also draw the learning curve to this file")

@@ -131,20 +131,24 @@ OFFBOARD_RANDOMIZE = {
     "action_latency": (0.0, 0.04),
 }
 
+SWAP = Preset(
+    name="swap",
+    env_id="flyloop/Swap-v0",
+    env_kwargs={"num_agents": 4, "max_steps": 250, "dt": 0.02},
+    actions=None,
+    success=swap_success,
+    success_text="every agent within 0.5 m of the opposite point at the time limit, "
+    "no collision or crash",
+    outcomes=("all four swapped places", "the swap failed"),
+)
+
 PRESETS: dict[str, Preset] = {
-    # Four agents exchange places across a 1 m circle, each on its own altitude layer
-    # (flyloop.parallel_env's Swap-v1), one policy for all: 5 s episodes (250 steps of 20 ms),
-    # no wind. Trained through flyloop.MultiAgentVectorEnv (one sub-env per agent).
-    "swap": Preset(
-        name="swap",
-        env_id="flyloop/Swap-v1",
-        env_kwargs={"num_agents": 4, "max_steps": 250, "dt": 0.02},
-        actions=None,
-        success=swap_success,
-        success_text="every agent within 0.5 m of the opposite point at the time limit, "
-        "no collision or crash",
-        outcomes=("all four swapped places", "the swap failed"),
-    ),
+    # Four agents exchange places through the middle of a 2 m circle (flyloop.parallel_env's
+    # Swap-v0, the task), one policy for all: 5 s episodes (250 steps of 20 ms), no
+    # wind. Trained through flyloop.MultiAgentVectorEnv (one sub-env per agent).
+    "swap": SWAP,
+    # The same on Swap-v1: a 1 m circle, each agent on its own altitude layer.
+    "swap_layers": replace(SWAP, name="swap_layers", env_id="flyloop/Swap-v1"),
     "hover": Preset(
         name="hover",
         env_id="flyloop/QuadHover-v0",

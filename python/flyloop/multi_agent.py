@@ -339,6 +339,8 @@ class MultiAgentVectorEnv(gymnasium.vector.VectorEnv):
         self._arrays = _Arrays(self._batch)
         obs_space, act_space, d = _spaces(self._batch)
         self._info_layout = d["info_layout"]
+        # One agent's observation groups: (name, number of values), in order.
+        self.observation_layout = d["observation_layout"]
         self.num_worlds = num_worlds
         self.num_agents = self._batch.num_agents
         self.num_envs = num_worlds * self.num_agents
