@@ -36,4 +36,10 @@ def test_fast_ppo_swap_runs_a_few_updates_and_evaluates_held_out_worlds(tmp_path
     )
     assert again.returncode == 0, again.stderr[-3000:]
     s = json.loads((tmp_path / "again" / "native" / "summary.json").read_text())
-    assert s["init"] == str(tmp_path / "native") and s["env_steps"] == 4096
+    assert s["init"] == str(tmp_path / "native") and s["earlier"]["env_steps"] == 8192
+    # One training of three updates: the earlier two, then this one.
+    assert s["env_steps"] == 8192 + 4096 and [r["env_steps"] for r in s["rows"]] == [
+        4096,
+        8192,
+        12288,
+    ]
