@@ -311,6 +311,11 @@ fn bad_faults_are_refused_naming_the_field_and_its_bound() {
         e.contains("`effectiveness` = 1.2 is out of range: it must be in [0, 1]"),
         "{e}"
     );
+    let e = err(
+        TaskKind::Hover,
+        "[[fault_randomization]]\nkinds = ['motor_off', 'link_delay']",
+    );
+    assert!(e.contains("`link_delay` cannot be drawn"), "{e}");
     let e = err(TaskKind::Hover, "[[faults]]\nkind = 'motor_off'\nat = 10");
     assert!(e.contains("can never fire") && e.contains("10 s"), "{e}");
     let e = err(

@@ -194,6 +194,11 @@ fn bad_faults_are_refused_naming_the_field() {
     assert!(e.contains("`agent`"), "{e}");
     let e = config_error(4, "[[faults]]\nkind = \"gust\"\n");
     assert!(e.contains("`gust`") && e.contains("multi-agent"), "{e}");
+    let e = config_error(4, "[[faults]]\nkind = \"link_loss\"\nduration = 1\n");
+    assert!(
+        e.contains("`link_loss`") && e.contains("multi-agent"),
+        "{e}"
+    );
     let e = config_error(
         4,
         "[[fault_randomization]]\nkinds = [\"motor_off\", \"wind_shear\"]\n",

@@ -70,7 +70,22 @@ def plan_text(faults: Any, fault_randomization: Any) -> str | None:
     every value and names the one it refuses."""
     lines = _tables("faults", "faults", faults)
     lines += _tables("fault_randomization", "fault_randomization", fault_randomization)
+    _refuse_link(faults)
     return "\n".join(lines) + "\n" if lines else None
+
+
+def _refuse_link(faults: Any) -> None:
+    """Refuses `link_loss` / `link_delay`: they act on flyloop-sitl's own links (its lockstep
+    link, PX4's, ArduPilot's), which the in-process backend does not have, so the gym would
+    fly different bits by backend."""
+    entries = [faults] if isinstance(faults, Mapping) else list(faults or [])
+    for i, entry in enumerate(entries):
+        kind = entry.get("kind") if isinstance(entry, Mapping) else None
+        if isinstance(kind, str) and kind.startswith("link_"):
+            raise ValueError(
+                f"faults[{i}]: kind {kind!r} acts on a link of flyloop-sitl (its --config "
+                "[[faults]] in task, PX4 or ArduPilot mode); the gym has no link for it"
+            )
 
 
 def _label(kind: float, target: float) -> str:

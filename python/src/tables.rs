@@ -219,6 +219,7 @@ pub fn fault_catalogue(py: Python<'_>) -> PyResult<(Bound<'_, PyList>, Vec<&'sta
             Target::Motor => "motor",
             Target::Sensor => "sensor",
             Target::Vehicle => "vehicle",
+            Target::Link => "link",
         };
         row.set_item("target", target)?;
         row.set_item("effect", k.effect)?;

@@ -121,3 +121,6 @@ def test_the_plan_is_the_toml_the_core_reads_and_the_catalogue_is_the_cores():
         plan_text([{"kind": "gust", "north": {"x": 1}}], None)
     with pytest.raises(TypeError, match="faults"):
         plan_text("motor_off", None)
+    # Link faults act on flyloop-sitl's links: the in-process backend has none.
+    with pytest.raises(ValueError, match=r"faults\[1\]: kind 'link_loss' acts on a link"):
+        plan_text([{"kind": "gust"}, {"kind": "link_loss", "duration": 1}], None)

@@ -29,6 +29,7 @@ pub mod fleet;
 pub mod fuzz;
 pub mod gcs_streams;
 pub mod kinematics;
+pub mod link_line;
 pub mod pacer;
 pub mod param_protocol;
 pub mod param_table;

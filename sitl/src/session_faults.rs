@@ -7,7 +7,9 @@
 use crate::control_link::ControlLink;
 use flyloop_core::ParamError;
 use flyloop_core::faults::px4::unit;
-use flyloop_core::faults::{Delivered, FaultKind, FaultPlan, SensorId, VehicleFaults};
+use flyloop_core::faults::{
+    Delivered, FaultKind, FaultPlan, LinkCondition, SensorId, VehicleFaults,
+};
 use flyloop_core::sensors::{GpsFix, SensorParams, SensorReading};
 use flyloop_core::vehicle::Vehicle;
 use mavlink::dialects::common::MavSeverity;
@@ -148,6 +150,25 @@ impl SessionFaults {
         match &mut self.faults {
             Some(f) => f.gps(fix, time_us as f64 * 1e-6, p),
             None => Some(fix),
+        }
+    }
+
+    /// What the link faults in effect do to the autopilot's link now (a clear link without
+    /// faults).
+    pub fn link(&self) -> LinkCondition {
+        (self.faults.as_ref()).map_or_else(LinkCondition::default, |f| f.state().link())
+    }
+
+    /// [`SessionFaults::link`] for a message arriving at `time_us`: the faults due by then
+    /// fired first (the step that starts now fires them again as a no-op), so a link lost
+    /// from time t drops what arrives for the step starting at t.
+    pub fn link_at(&mut self, vehicle: &mut dyn Vehicle, time_us: u64) -> LinkCondition {
+        match &mut self.faults {
+            Some(f) => {
+                f.begin_step(time_us as f64 * 1e-6, vehicle);
+                f.state().link()
+            }
+            None => LinkCondition::default(),
         }
     }
 

@@ -50,6 +50,8 @@ pub struct Stats {
     /// A multi-agent world: datagrams that ended with some, not all, commands of a step in
     /// (the step waits for the rest; answered by a STATUSTEXT naming the missing vehicles).
     pub held_steps: u64,
+    /// Lockstep commands dropped by a `link_loss` fault (the command in effect held).
+    pub link_dropped: u64,
     /// Wall time from a datagram's arrival to its reply being sent (controller link).
     pub busy: Duration,
     /// Of which in the handler (decoding, physics, encoding; no socket calls).
@@ -94,7 +96,7 @@ impl fmt::Display for Stats {
              unknown_message={} malformed={} garbage={} refused_controls={} clamped_controls={} \
              unknown_vehicle={} ignored_messages={} refused_requests={} io_errors={} \
              repeated_steps={} stale_controls={} unflagged_controls={} gcs_controls={} \
-             refusal_texts={} refusal_texts_held={} held_steps={} \
+             refusal_texts={} refusal_texts_held={} held_steps={} link_dropped={} \
              busy_us_per_datagram={:.2} handling_us_per_datagram={:.2} physics_us_per_step={:.2}",
             self.datagrams,
             self.gcs_datagrams,
@@ -120,6 +122,7 @@ impl fmt::Display for Stats {
             self.refusal_texts,
             self.refusal_texts_held,
             self.held_steps,
+            self.link_dropped,
             us_per(self.busy, self.datagrams),
             us_per(self.handling, self.datagrams),
             us_per(self.physics, self.steps),

@@ -1,8 +1,10 @@
 //! One simulated vehicle: its system id, its parameter sets, its core task instance, its
 //! simulation clock and seed sequence.
 
+use crate::link_line::ReplyLine;
 use crate::task_frame::FrameHeader;
 use flyloop_core::ParamError;
+use flyloop_core::faults::LinkCondition;
 use flyloop_core::tasks::registry::{
     ControlError, TaskConfig, TaskInstance, TaskKind, clamp_controls,
 };
@@ -42,6 +44,8 @@ pub struct Vehicle {
     /// taken for the new episode's first step.
     pub last_step: Option<u64>,
     pub last_reply: Option<Vec<u8>>,
+    /// The replies through the task's link faults (used only while it has faults).
+    pub link_line: ReplyLine,
 }
 
 /// What one step did.
@@ -76,6 +80,7 @@ impl Vehicle {
             frame_values: Vec::new(),
             last_step: None,
             last_reply: None,
+            link_line: ReplyLine::default(),
         };
         v.reset(seed)?;
         Ok(v)
@@ -93,7 +98,14 @@ impl Vehicle {
         self.last = FrameHeader::default();
         self.command = self.task.motors_off();
         self.last_reply = None;
+        self.link_line.clear();
         Ok(())
+    }
+
+    /// What the task's link faults do to the lockstep link now (`None`: the task has no
+    /// faults, the link is untouched).
+    pub fn link(&self) -> Option<LinkCondition> {
+        self.task.fault_state().map(|f| f.link())
     }
 
     /// The task's control period in whole microseconds.

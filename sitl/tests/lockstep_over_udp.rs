@@ -19,7 +19,7 @@ use std::net::{SocketAddr, UdpSocket};
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
-struct Sitl {
+pub(crate) struct Sitl {
     child: Child,
     addr: SocketAddr,
 }
@@ -33,7 +33,7 @@ impl Drop for Sitl {
 }
 
 impl Sitl {
-    fn start(args: &[&str]) -> Sitl {
+    pub(crate) fn start(args: &[&str]) -> Sitl {
         let mut child = Command::new(env!("CARGO_BIN_EXE_flyloop-sitl"))
             .args([
                 "--listen",
@@ -66,7 +66,7 @@ impl Sitl {
     }
 
     /// SIGTERM, then the exit status must be success.
-    fn stop(&mut self) {
+    pub(crate) fn stop(&mut self) {
         let status = Command::new("kill")
             .args(["-TERM", &self.child.id().to_string()])
             .status()
@@ -76,13 +76,13 @@ impl Sitl {
     }
 }
 
-struct Client {
+pub(crate) struct Client {
     socket: UdpSocket,
     encoder: Encoder,
 }
 
 impl Client {
-    fn new(sitl: &Sitl) -> Client {
+    pub(crate) fn new(sitl: &Sitl) -> Client {
         let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
         socket
             .set_read_timeout(Some(Duration::from_secs(5)))
@@ -94,7 +94,11 @@ impl Client {
         }
     }
 
-    fn exchange(&mut self, from_system: u8, messages: &[MavMessage]) -> Vec<(u8, MavMessage)> {
+    pub(crate) fn exchange(
+        &mut self,
+        from_system: u8,
+        messages: &[MavMessage],
+    ) -> Vec<(u8, MavMessage)> {
         let mut out = Vec::new();
         for m in messages {
             self.encoder.push(&mut out, from_system, m);
@@ -111,7 +115,7 @@ impl Client {
     }
 }
 
-fn controls(action: [f32; 4]) -> MavMessage {
+pub(crate) fn controls(action: [f32; 4]) -> MavMessage {
     let mut c = [0.0; 16];
     c[..4].copy_from_slice(&action);
     MavMessage::HIL_ACTUATOR_CONTROLS(HIL_ACTUATOR_CONTROLS_DATA {

@@ -4,6 +4,7 @@
 
 mod handler_fuzz;
 mod inject_failure;
+mod link_faults;
 mod lockstep_over_udp;
 mod lockstep_resend;
 mod refused_controls;

@@ -43,6 +43,9 @@ pub enum Target {
     Sensor,
     /// The vehicle as a whole (battery, air, GPS-only faults).
     Vehicle,
+    /// The SITL's link to whoever flies the vehicle: the autopilot's (PX4, ArduPilot) or
+    /// the lockstep client's. Only the SITL has one: the gym and the FMUs refuse these.
+    Link,
 }
 
 /// The sensors a sensor fault may name.
@@ -118,6 +121,8 @@ pub enum FaultKind {
     LowBattery,
     Gust,
     WindShear,
+    LinkLoss,
+    LinkDelay,
 }
 
 /// A fault kind's row: name, target, parameters and what it does.
@@ -342,8 +347,17 @@ const SHEAR_ROUGHNESS: FieldSpec = field(
     "Surface roughness length z0 (MIL-F-8785C: 0.15 ft for category C)",
 );
 
+const LINK_DELAY: FieldSpec = field(
+    "delay",
+    "s",
+    1e-3,
+    10.0,
+    0.2,
+    "Age of what the link delivers: the samples (or replies) reach the other side this late",
+);
+
 /// The catalogue, one row per kind.
-pub static CATALOGUE: [KindSpec; 17] = [
+pub static CATALOGUE: [KindSpec; 19] = [
     KindSpec {
         kind: FaultKind::MotorEffectiveness,
         name: "motor_effectiveness",
@@ -469,6 +483,20 @@ pub static CATALOGUE: [KindSpec; 17] = [
         target: Target::Vehicle,
         fields: &[SHEAR_SPEED, SHEAR_DIRECTION, SHEAR_HEIGHT, SHEAR_ROUGHNESS],
         effect: "MIL-F-8785C wind shear: W(h) = speed · ln(h / z0) / ln(h_ref / z0), 0 below z0",
+    },
+    KindSpec {
+        kind: FaultKind::LinkLoss,
+        name: "link_loss",
+        target: Target::Link,
+        fields: &[],
+        effect: "The link carries nothing new for `duration` (required): commands are dropped (the motors hold the last one that got through), the other side gets no new data; the lockstep tick goes on, so neither side waits forever",
+    },
+    KindSpec {
+        kind: FaultKind::LinkDelay,
+        name: "link_delay",
+        target: Target::Link,
+        fields: &[LINK_DELAY],
+        effect: "The data the link delivers is `delay` old (the sensors or the replies); commands act at once",
     },
 ];
 

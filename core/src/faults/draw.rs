@@ -131,6 +131,12 @@ impl FaultDraw {
                 "fault_randomization needs `kinds`: the fault kinds to draw from".into(),
             ));
         }
+        if let Some(k) = d.kinds.iter().find(|k| k.spec().target == Target::Link) {
+            return Err(ParamError::Parse(format!(
+                "fault_randomization: `{}` cannot be drawn yet; write it as a [[faults]] entry with its time and duration",
+                k.name()
+            )));
+        }
         if d.sensors.is_empty() {
             return Err(ParamError::Parse(
                 "fault_randomization: `sensors` must name at least one sensor".into(),
@@ -196,7 +202,7 @@ impl FaultDraw {
         match kind.spec().target {
             Target::Motor => fault.motor = motor,
             Target::Sensor => fault.sensor = Some(sensor),
-            Target::Vehicle => {}
+            Target::Vehicle | Target::Link => {}
         }
         for (i, f) in kind.spec().fields.iter().enumerate() {
             if let Some((_, lo, hi)) = self.ranges.iter().find(|(n, _, _)| n == f.name) {

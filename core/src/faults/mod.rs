@@ -29,5 +29,5 @@ pub use catalogue::{CATALOGUE, FaultKind, SensorId};
 pub use on_vehicle::{Delivered, VehicleFaults};
 pub use plan::FaultPlan;
 pub use spec::FaultSpec;
-pub use state::{FaultEvent, FaultState};
+pub use state::{FaultEvent, FaultState, LinkCondition};
 pub use trigger::{Conditions, Reach, Trigger};

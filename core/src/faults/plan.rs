@@ -2,6 +2,7 @@
 //! (`[[fault_randomization]]`), read from one TOML text that every front end passes as is
 //! (the SITL's config file holds it; the gym writes it), checked against the flight.
 
+use super::catalogue::Target;
 use super::draw::FaultDraw;
 use super::spec::FaultSpec;
 use super::trigger::Reach;
@@ -93,6 +94,24 @@ impl FaultPlan {
             d.check(reach)?;
         }
         Ok(())
+    }
+
+    /// Refuses link faults, naming the kind: `front_end` has no link for them.
+    pub fn refuse_link(&self, front_end: &str) -> Result<(), ParamError> {
+        match self
+            .faults
+            .iter()
+            .find(|f| f.kind.spec().target == Target::Link)
+        {
+            Some(f) => Err(ParamError::Relation {
+                name: "kind",
+                requirement: format!(
+                    "`{}` acts on a link of flyloop-sitl (the lockstep link, PX4's, ArduPilot's); {front_end} has none",
+                    f.kind.name()
+                ),
+            }),
+            None => Ok(()),
+        }
     }
 
     /// The schedule of the episode with `seed`: the written faults, then one drawn fault

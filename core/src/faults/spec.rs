@@ -91,7 +91,7 @@ impl FaultSpec {
         match spec.target {
             Target::Motor => keys.push("motor"),
             Target::Sensor => keys.push("sensor"),
-            Target::Vehicle => {}
+            Target::Vehicle | Target::Link => {}
         }
         keys.extend(spec.fields.iter().map(|f| f.name));
         keys.extend(TRIGGER_KEYS);
@@ -157,6 +157,11 @@ impl FaultSpec {
                     fault.set(key, number)?;
                 }
             }
+        }
+        if kind == FaultKind::LinkLoss && fault.duration.is_none() {
+            return Err(ParamError::Parse(
+                "fault `link_loss` needs a `duration` (s): a link lost for good would leave the autopilot or the client without data forever".into(),
+            ));
         }
         if kind.spec().target == Target::Sensor && !table.contains_key("sensor") {
             return Err(ParamError::Parse(format!(
@@ -262,6 +267,15 @@ mod tests {
         assert!(e.contains("more than one trigger"), "{e}");
         let e = err("kind = 'gust'\nduration = 0");
         assert!(e.contains("`duration` = 0"), "{e}");
+        let e = err("kind = 'link_loss'\nat = 3");
+        assert!(
+            e.contains("`link_loss` needs a `duration`"),
+            "a link lost for good: {e}"
+        );
+        let e = err("kind = 'link_delay'\ndelay = 20\nduration = 1");
+        assert!(e.contains("`delay` = 20 s is out of range"), "{e}");
+        let e = err("kind = 'link_loss'\nmotor = 1\nduration = 1");
+        assert!(e.contains("`motor` for fault `link_loss`"), "{e}");
         let f = parse("kind = 'motor_off'\nmotor = 5").unwrap();
         let reach = Reach {
             duration: None,

@@ -33,6 +33,22 @@ pub struct FaultEvent {
     pub fired: bool,
 }
 
+/// What the link faults in effect do to the link now.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LinkCondition {
+    /// A `link_loss` is in effect: nothing new gets through.
+    pub lost: bool,
+    /// Age of what the link delivers, s (the largest `link_delay` in effect; 0: none).
+    pub delay: f64,
+}
+
+impl LinkCondition {
+    /// Whether the link is healthy.
+    pub fn is_clear(&self) -> bool {
+        !self.lost && self.delay == 0.0
+    }
+}
+
 /// The faults of one vehicle over an episode.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FaultState {
@@ -226,6 +242,19 @@ impl FaultState {
     /// Whether a fault of `sensor` is in effect.
     pub fn acts_on_sensor(&self, sensor: SensorId) -> bool {
         !self.active(|s| s.sensor == Some(sensor)).is_empty()
+    }
+
+    /// What the link faults in effect do to the link (a healthy link without them).
+    pub fn link(&self) -> LinkCondition {
+        let mut c = LinkCondition::default();
+        for f in self.active(|s| s.kind.spec().target == Target::Link) {
+            match f.spec.kind {
+                FaultKind::LinkLoss => c.lost = true,
+                FaultKind::LinkDelay => c.delay = c.delay.max(f.spec.values[0]),
+                _ => {}
+            }
+        }
+        c
     }
 
     /// Whether an air fault is in effect.

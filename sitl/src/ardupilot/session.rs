@@ -7,6 +7,7 @@ use crate::autopilot_record::Sent;
 use crate::config::AutopilotVehicle;
 use crate::control_link::ControlLink;
 use crate::kinematics::attitude_ned;
+use crate::link_line::ReplyLine;
 use crate::session_faults::SessionFaults;
 use crate::speed::SpeedLog;
 use crate::stats::us_per;
@@ -52,6 +53,8 @@ pub struct Counters {
     pub non_finite: u64,
     /// Socket errors (logged, never fatal).
     pub io_errors: u64,
+    /// Servo frames dropped by a `link_loss` fault (the last command held).
+    pub link_dropped: u64,
     /// Time in the handler (decode, physics, IMU, encoding; no socket calls).
     pub handling: Duration,
     /// Of which physics and the IMU.
@@ -129,6 +132,9 @@ pub struct Session {
     pub speed: SpeedLog,
     /// The vehicle's faults and the control link (nothing runs without them).
     faults: SessionFaults,
+    /// With faults: the JSON frame made this step, and the frames a link fault holds back.
+    fresh: Vec<u8>,
+    link_line: ReplyLine,
 }
 
 /// What to do with a datagram.
@@ -164,6 +170,8 @@ impl Session {
             stats: Counters::default(),
             speed: SpeedLog::default(),
             faults,
+            fresh: Vec::new(),
+            link_line: ReplyLine::default(),
         })
     }
 
@@ -285,6 +293,7 @@ impl Session {
     fn connect(&mut self) {
         self.stats.connections += 1;
         self.faults.restart();
+        self.link_line.clear();
         self.track.connect();
     }
 
@@ -323,7 +332,13 @@ impl Session {
     /// 1200 Hz), then the state of the new time as the reply.
     fn step(&mut self, frame: &ServoFrame) {
         let start = Instant::now();
-        self.apply_motors(frame);
+        let link = (self.faults).link_at(self.vehicle.as_mut(), self.time_us);
+        if link.lost {
+            // A lost link: the servo frame never arrives; the last command holds.
+            self.stats.link_dropped += 1;
+        } else {
+            self.apply_motors(frame);
+        }
         let step_us = frame_step_us(frame.frame_rate);
         let dt = step_us as f64 * 1e-6;
         (self.faults).advance(self.vehicle.as_mut(), self.time_us, dt);
@@ -352,7 +367,16 @@ impl Session {
                 format_args!("non-finite state at t = {} s written as 0", state.timestamp),
             );
         }
-        reply::write(&mut self.reply, &state);
+        if self.faults.is_active() {
+            // The JSON frame through the link faults (see crate::link_line).
+            reply::write(&mut self.fresh, &state);
+            let link = self.faults.link();
+            let delivered = self.link_line.pass(self.time_us, &self.fresh, link);
+            self.reply.clear();
+            self.reply.extend_from_slice(delivered);
+        } else {
+            reply::write(&mut self.reply, &state);
+        }
         let sent = Sent::Imu(&imu);
         self.track.record(self.time_us, self.vehicle.as_ref(), sent);
     }
@@ -383,5 +407,7 @@ impl Session {
     }
 }
 
+#[cfg(test)]
+mod link_tests;
 #[cfg(test)]
 mod tests;

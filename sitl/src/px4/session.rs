@@ -6,6 +6,7 @@ use crate::autopilot_record::Sent;
 use crate::config::AutopilotVehicle;
 use crate::control_link::ControlLink;
 use crate::kinematics::Home;
+use crate::link_line::LinkLine;
 use crate::session_faults::SessionFaults;
 use crate::speed::SpeedLog;
 use crate::stats::Stats;
@@ -13,10 +14,11 @@ use crate::telemetry;
 use crate::track::SessionTrack;
 use crate::wire::{Encoder, StreamDecoder};
 use flyloop_core::ParamError;
+use flyloop_core::faults::LinkCondition;
 use flyloop_core::quadrotor::standing_multirotor;
-use flyloop_core::sensors::Sensors;
+use flyloop_core::sensors::{GpsFix, SensorReading, Sensors};
 use flyloop_core::vehicle::{Vehicle, VehicleStart};
-use mavlink::dialects::common::{COMMAND_LONG_DATA, MavCmd, MavMessage};
+use mavlink::dialects::common::{COMMAND_LONG_DATA, HilSensorUpdatedFlags, MavCmd, MavMessage};
 use std::time::Instant;
 
 /// System id of the simulator's messages to PX4.
@@ -58,6 +60,8 @@ pub struct Session {
     pub speed: SpeedLog,
     /// The vehicle's faults and the control link (nothing runs without them).
     faults: SessionFaults,
+    /// Samples held back by a `link_delay`.
+    link_line: LinkLine<Px4Sample>,
 }
 
 /// The start vehicle after one step with the motors off: the state PX4's first controls meet.
@@ -98,6 +102,7 @@ impl Session {
             stats: Stats::default(),
             speed: SpeedLog::default(),
             faults,
+            link_line: LinkLine::default(),
         })
     }
 
@@ -120,6 +125,7 @@ impl Session {
         self.decoder.clear();
         self.track.connect();
         self.faults.restart();
+        self.link_line.clear();
         self.emit(out);
     }
 
@@ -176,7 +182,15 @@ impl Session {
                         let (id, m) = (incoming.header.system_id, &incoming.message);
                         self.track.received(self.time_us, id, m);
                     }
-                    self.apply_controls(&c.controls);
+                    if (self.faults)
+                        .link_at(self.vehicle.as_mut(), self.time_us)
+                        .lost
+                    {
+                        // A lost link: the controls never arrive; the last ones hold.
+                        self.stats.link_dropped += 1;
+                    } else {
+                        self.apply_controls(&c.controls);
+                    }
                     if !self.lockstep {
                         tracing::info!(time_us = self.time_us, "first controls from PX4: lockstep");
                         self.lockstep = true;
@@ -238,24 +252,30 @@ impl Session {
         let k = self.vehicle.kinematics();
         let mut reading = self.sensors.sample(&k, dt);
         let sent_from = out.len();
-        let sensor = if self.faults.is_active() {
+        let link = self.faults.link();
+        if self.faults.is_active() {
             let (p, motors) = (self.sensors.params(), self.vehicle.actuator_states());
             let d = (self.faults).reading(&mut reading, self.time_us, dt, p, &motors);
             let fields = messages::delivered_fields(&d);
-            messages::hil_sensor_delivered(&reading, self.time_us, fields)
+            let fix = self.sensors.gps(&k, self.time_us as f64 * 1e-6);
+            let (p, time_us) = (self.sensors.params(), self.time_us);
+            let fix = fix.and_then(|f| self.faults.gps(f, time_us, p));
+            let sample = Px4Sample {
+                reading,
+                fields,
+                fix,
+            };
+            self.send_through_link(sample, link, out);
         } else {
-            messages::hil_sensor(&reading, self.time_us)
-        };
-        self.encoder.push(out, SIMULATOR_SYSTEM, &sensor);
-        let fix = self.sensors.gps(&k, self.time_us as f64 * 1e-6);
-        let (p, time_us) = (self.sensors.params(), self.time_us);
-        if let Some(fix) = fix.and_then(|f| self.faults.gps(f, time_us, p)) {
-            let stamp = self.gps_epoch_us + (fix.measured_at * 1e6).round() as u64;
-            self.encoder
-                .push(out, SIMULATOR_SYSTEM, &messages::hil_gps(&fix, stamp));
+            let sensor = messages::hil_sensor(&reading, self.time_us);
+            self.encoder.push(out, SIMULATOR_SYSTEM, &sensor);
+            let fix = self.sensors.gps(&k, self.time_us as f64 * 1e-6);
+            if let Some(fix) = fix {
+                self.push_gps(&fix, out);
+            }
         }
         if let Some(interval) = self.state_interval_us {
-            if self.time_us >= self.next_state_us {
+            if self.time_us >= self.next_state_us && !link.lost {
                 let state = telemetry::hil_state_quaternion_of(&k, &self.home, self.time_us);
                 self.encoder.push(out, SIMULATOR_SYSTEM, &state);
                 self.next_state_us += interval;
@@ -267,9 +287,52 @@ impl Session {
         let sent = Sent::Frames(&out[sent_from..]);
         self.track.record(self.time_us, self.vehicle.as_ref(), sent);
     }
+
+    /// A faulted sample to PX4 through the link faults. The HIL_SENSOR of every step goes
+    /// out stamped now — it is PX4's lockstep tick, and a tick that never came would stall
+    /// PX4 and flyloop for good — carrying: on a lost link no field (PX4 reads no new value)
+    /// and no HIL_GPS; on a delayed one the values sampled `delay` ago (the last delivered
+    /// until a sample is that old) and their fix, once.
+    fn send_through_link(&mut self, sample: Px4Sample, link: LinkCondition, out: &mut Vec<u8>) {
+        let time_us = self.time_us;
+        if link.lost {
+            let nothing = messages::hil_sensor_delivered(
+                &sample.reading,
+                time_us,
+                HilSensorUpdatedFlags::empty(),
+            );
+            self.encoder.push(out, SIMULATOR_SYSTEM, &nothing);
+            return;
+        }
+        let (sample, new) = {
+            let (s, new) = self.link_line.pass_new(time_us, sample, link);
+            (*s, new)
+        };
+        let sensor = messages::hil_sensor_delivered(&sample.reading, time_us, sample.fields);
+        self.encoder.push(out, SIMULATOR_SYSTEM, &sensor);
+        if let (Some(fix), true) = (sample.fix, new) {
+            self.push_gps(&fix, out);
+        }
+    }
+
+    fn push_gps(&mut self, fix: &GpsFix, out: &mut Vec<u8>) {
+        let stamp = self.gps_epoch_us + (fix.measured_at * 1e6).round() as u64;
+        self.encoder
+            .push(out, SIMULATOR_SYSTEM, &messages::hil_gps(fix, stamp));
+    }
+}
+
+/// One step's sensors for PX4 after the sensor faults: what a link fault holds back.
+#[derive(Debug, Clone, Copy)]
+struct Px4Sample {
+    reading: SensorReading,
+    fields: HilSensorUpdatedFlags,
+    fix: Option<GpsFix>,
 }
 
 #[cfg(test)]
 mod faults_tests;
+#[cfg(test)]
+mod link_tests;
 #[cfg(test)]
 pub(crate) mod tests;

@@ -69,7 +69,10 @@ impl Sim {
         let Some(i) = self.vehicle_to_command(header.system_id, c, from, now, out) else {
             return;
         };
-        if let Err(e) = self.set_controls(i, &c.controls) {
+        if self.vehicles[i].link().is_some_and(|l| l.lost) {
+            // A lost link: the command never arrives; the one in effect holds.
+            self.stats.link_dropped += 1;
+        } else if let Err(e) = self.set_controls(i, &c.controls) {
             self.refuse(Link::Controller, from, i, Refusal::BadValue(e), now, out);
             return;
         }
@@ -153,6 +156,11 @@ impl Sim {
         self.push_vehicle_reply(i, peer, out);
         self.record(i, &out[from..]);
         let v = &mut self.vehicles[i];
+        if let Some(link) = v.link() {
+            // The reply through the task's link faults (the fresh one on a clear link).
+            let fresh = out.split_off(from);
+            out.extend_from_slice(v.link_line.pass(v.clock_us, &fresh, link));
+        }
         v.last_step = (step != 0).then_some(step);
         if step != 0 {
             let cached = v.last_reply.get_or_insert_with(Vec::new);

@@ -67,6 +67,7 @@ impl AgentFaults {
             // The single-agent reader checks the rest of the table and names what it refuses.
             let mut one = FaultPlan::default();
             one.add(key, &table)?;
+            one.refuse_link("a multi-agent task")?;
             if let Some(spec) = one.faults.pop() {
                 refuse_air(std::slice::from_ref(&spec.kind))?;
                 self.written.push((agent, spec));

@@ -140,6 +140,17 @@ impl TaskInstance {
         }
     }
 
+    /// The flight tasks' fault state, if the vehicle has faults (the SITL's lockstep link
+    /// reads its link faults from it).
+    pub fn fault_state(&self) -> Option<&crate::faults::FaultState> {
+        let faults = match self {
+            TaskInstance::Hover(t) => t.vehicle().faults(),
+            TaskInstance::Waypoints(t) => t.vehicle().faults(),
+            TaskInstance::Landing(_) => None,
+        };
+        faults.map(|f| f.state())
+    }
+
     /// Remaining battery as a fraction of the full charge, if the model has a battery.
     pub fn battery_fraction(&self) -> Option<f64> {
         match self {

@@ -12,18 +12,18 @@ fn session(seed: u64) -> Session {
     .unwrap()
 }
 
-fn addr(port: u16) -> SocketAddr {
+pub(super) fn addr(port: u16) -> SocketAddr {
     SocketAddr::from(([127, 0, 0, 1], port))
 }
 
-fn servo(count: u32, pwm: u16) -> Vec<u8> {
+pub(super) fn servo(count: u32, pwm: u16) -> Vec<u8> {
     let mut channels = [0u16; 16];
     channels[..4].fill(pwm);
     encode_16(1200, count, &channels)
 }
 
 /// The numbers after `"key":` in a reply.
-fn field(reply: &[u8], key: &str) -> Vec<f64> {
+pub(super) fn field(reply: &[u8], key: &str) -> Vec<f64> {
     let text = std::str::from_utf8(reply).unwrap();
     let at = text.find(&format!("\"{key}\":")).unwrap() + key.len() + 3;
     let rest = &text[at..];

@@ -9,7 +9,7 @@ use mavlink::dialects::common::{COMMAND_ACK_DATA, MavResult};
 use std::net::UdpSocket;
 use std::time::Duration;
 
-fn faulty_session(faults: &str) -> Session {
+pub(super) fn faulty_session(faults: &str) -> Session {
     let text = format!("{}\n{faults}", crate::config::IRIS_PRESET);
     Session::new(&SessionOptions {
         vehicle: AutopilotVehicle::parse(&text).unwrap(),
