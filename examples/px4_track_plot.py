@@ -32,7 +32,10 @@ def read(path: Path) -> tuple[list[dict[str, float]], bool]:
     partial = not text.endswith("\n")
     if partial:
         text = text[: text.rfind("\n") + 1]
-    rows = [{k: float(v) for k, v in row.items()} for row in csv.DictReader(io.StringIO(text))]
+    rows = [
+        {k: float(v) for k, v in row.items() if k != "faults"}  # `faults`: event text
+        for row in csv.DictReader(io.StringIO(text))
+    ]
     return rows, partial and bool(rows)
 
 

@@ -8,7 +8,7 @@ use crate::control_link::ControlLink;
 use flyloop_core::ParamError;
 use flyloop_core::faults::px4::unit;
 use flyloop_core::faults::{
-    Delivered, FaultKind, FaultPlan, LinkCondition, SensorId, VehicleFaults,
+    Delivered, FaultEvent, FaultKind, FaultPlan, LinkCondition, SensorId, VehicleFaults,
 };
 use flyloop_core::sensors::{GpsFix, SensorParams, SensorReading};
 use flyloop_core::vehicle::Vehicle;
@@ -28,6 +28,8 @@ pub struct SessionFaults {
     next_poll_us: u64,
     /// Only the IMU is sent (ArduPilot): faults of other sensors are refused.
     imu_only: bool,
+    /// Events reported since the session last took them (for the track).
+    reported: Vec<FaultEvent>,
 }
 
 /// Why ArduPilot mode refuses a fault of a sensor other than the IMU.
@@ -87,6 +89,7 @@ impl SessionFaults {
             seed,
             next_poll_us: 0,
             imu_only: false,
+            reported: Vec::new(),
         })
     }
 
@@ -172,6 +175,11 @@ impl SessionFaults {
         }
     }
 
+    /// The faults that fired or cleared since the last call (for the track).
+    pub fn take_events(&mut self) -> Vec<FaultEvent> {
+        std::mem::take(&mut self.reported)
+    }
+
     /// Whether a sensor fault path runs (faults set or injected).
     pub fn is_active(&self) -> bool {
         self.faults.is_some()
@@ -215,6 +223,7 @@ impl SessionFaults {
         if let Some(f) = &mut self.faults {
             for e in f.new_events() {
                 tracing::warn!(time_s = e.time, fault = %e.label, fired = e.fired, "fault injected on the control link");
+                self.reported.push(e.clone());
             }
         }
     }
@@ -232,6 +241,7 @@ impl SessionFaults {
                 format!("fault cleared: {} at {:.3} s", e.label, e.time)
             };
             tracing::warn!("{text}");
+            self.reported.push(e.clone());
             if let Some(control) = &mut self.control {
                 control.announce(MavSeverity::MAV_SEVERITY_WARNING, &text);
             }

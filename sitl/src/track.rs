@@ -6,10 +6,14 @@
 //! `time_us` (simulation time = the autopilot's clock), `north,east,down` (m from home), `vn,ve,vd` (m/s),
 //! `roll,pitch,yaw` (rad, FRD → NED), `m0..m{n-1}` (motor states in [0, 1], one per rotor),
 //! `grounded` (0/1),
-//! `p,q,r` (body rates, rad/s, FRD).
+//! `p,q,r` (body rates, rad/s, FRD),
+//! `faults`: the faults that fired or cleared since the previous row, space-separated, each
+//! `+label@time` (fired) or `-label@time` (cleared), time in s (`+sensor_off:gps@30.000`,
+//! `-link_loss@32.004`); empty when none did.
 
 use crate::autopilot_record::{AutopilotRecorder, Sent};
 use crate::kinematics::attitude_ned;
+use flyloop_core::faults::FaultEvent;
 use flyloop_core::vehicle::Vehicle;
 use mavlink::dialects::common::MavMessage;
 use std::fs::File;
@@ -24,18 +28,32 @@ pub fn header(rotors: usize) -> String {
     format!("connection,time_us,{}", state_header(rotors))
 }
 
-/// The columns of a vehicle's state (after `connection,time_us`), `rotors` motor columns.
+/// The columns of a vehicle's state (after `connection,time_us`), `rotors` motor columns,
+/// and the fault events.
 pub fn state_header(rotors: usize) -> String {
     let motors: Vec<String> = (0..rotors).map(|i| format!("m{i}")).collect();
     format!(
-        "north,east,down,vn,ve,vd,roll,pitch,yaw,{},grounded,p,q,r",
+        "north,east,down,vn,ve,vd,roll,pitch,yaw,{},grounded,p,q,r,faults",
         motors.join(",")
     )
 }
 
+/// A fault event as the `faults` column writes it: `+label@time` (fired) or `-label@time`
+/// (cleared), time in s.
+pub fn fault_event(e: &FaultEvent) -> String {
+    let sign = if e.fired { '+' } else { '-' };
+    format!("{sign}{}@{:.3}", e.label, e.time)
+}
+
 /// `vehicle`'s state as the columns of [`state_header`]`(rotors)`, each after a comma (a
-/// vehicle with fewer rotors leaves the last motor columns empty), and the line's end.
-pub fn write_state(out: &mut impl Write, vehicle: &dyn Vehicle, rotors: usize) -> io::Result<()> {
+/// vehicle with fewer rotors leaves the last motor columns empty), `events` (the `faults`
+/// column) and the line's end.
+pub fn write_state(
+    out: &mut impl Write,
+    vehicle: &dyn Vehicle,
+    rotors: usize,
+    events: &str,
+) -> io::Result<()> {
     let k = vehicle.kinematics();
     let p = k.position_ned();
     let v = k.velocity_ned();
@@ -55,7 +73,7 @@ pub fn write_state(out: &mut impl Write, vehicle: &dyn Vehicle, rotors: usize) -
     }
     writeln!(
         out,
-        ",{},{:.5},{:.5},{:.5}",
+        ",{},{:.5},{:.5},{:.5},{events}",
         u8::from(vehicle.is_grounded()),
         w.x,
         w.y,
@@ -70,6 +88,8 @@ pub struct Track {
     next_us: u64,
     interval_us: u64,
     connection: u32,
+    /// Fault events since the last row (the `faults` column).
+    events: String,
 }
 
 impl Track {
@@ -83,6 +103,7 @@ impl Track {
             next_us: 0,
             interval_us,
             connection: 0,
+            events: String::new(),
         })
     }
 
@@ -100,7 +121,17 @@ impl Track {
         }
         self.next_us = time_us + self.interval_us;
         write!(self.out, "{},{time_us}", self.connection)?;
-        write_state(&mut self.out, vehicle, 0)
+        write_state(&mut self.out, vehicle, 0, &self.events)?;
+        self.events.clear();
+        Ok(())
+    }
+
+    /// A fault fired or cleared: in the next row's `faults` column.
+    pub fn fault_event(&mut self, e: &FaultEvent) {
+        if !self.events.is_empty() {
+            self.events.push(' ');
+        }
+        self.events.push_str(&fault_event(e));
     }
 
     /// Writes buffered rows out.
@@ -148,6 +179,15 @@ impl SessionTrack {
         }
         if let Some(recording) = &mut self.recording {
             recording.connect();
+        }
+    }
+
+    /// Fault events, into the track's next row.
+    pub fn fault_events(&mut self, events: &[FaultEvent]) {
+        if let Some(track) = &mut self.track {
+            for e in events {
+                track.fault_event(e);
+            }
         }
     }
 

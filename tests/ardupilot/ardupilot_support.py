@@ -144,7 +144,9 @@ class Flyloop:
 
     def rows(self) -> list[dict[str, float]]:
         with open(self.track) as f:
-            return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+            # Every column a number but `faults` (the fault events, text).
+            rows = csv.DictReader(f)
+            return [{k: float(v) for k, v in row.items() if k != "faults"} for row in rows]
 
     def stop(self) -> int:
         stop(self.proc)

@@ -106,11 +106,12 @@ def land_all(px4s, timeout: float = 120) -> None:
 
 def read_track(path: Path) -> dict[str, list[dict[str, float]]]:
     """A fleet track (`--track` in fleet mode): each vehicle's rows by its name, every other
-    column a number (an empty motor column of a vehicle with fewer rotors is left out)."""
+    column a number (an empty motor column of a vehicle with fewer rotors is left out) but
+    `faults`, the fault events (text: `+motor_off:1@30.000 -link_loss@32.004`)."""
     by_vehicle: dict[str, list[dict[str, float]]] = {}
     with open(path) as f:
         for row in csv.DictReader(f):
             name = row.pop("vehicle")
-            values = {k: float(v) for k, v in row.items() if v != ""}
+            values = {k: float(v) for k, v in row.items() if v != "" and k != "faults"}
             by_vehicle.setdefault(name, []).append(values)
     return by_vehicle

@@ -72,7 +72,7 @@ def check_fleet_track(track, px4s, frames, holds) -> None:
     header = track.read_text().splitlines()[0]
     assert header == (
         "vehicle,sysid,connection,time_us,north,east,down,vn,ve,vd,roll,pitch,yaw,"
-        "m0,m1,m2,m3,grounded,p,q,r"
+        "m0,m1,m2,m3,grounded,p,q,r,faults"
     ), header
     rows = read_track(track)
     assert sorted(rows) == ["px4-000", "px4-001"], sorted(rows)

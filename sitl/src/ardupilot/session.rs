@@ -378,6 +378,9 @@ impl Session {
             reply::write(&mut self.reply, &state);
         }
         let sent = Sent::Imu(&imu);
+        if self.faults.is_active() {
+            self.track.fault_events(&self.faults.take_events());
+        }
         self.track.record(self.time_us, self.vehicle.as_ref(), sent);
     }
 

@@ -56,7 +56,7 @@ impl FleetTrack {
                 "{},{},{},{time_us}",
                 m.name, m.sysid, m.connections
             )?;
-            write_state(&mut self.out, fleet.vehicle(i), self.rotors)?;
+            write_state(&mut self.out, fleet.vehicle(i), self.rotors, "")?;
         }
         Ok(())
     }

@@ -285,6 +285,9 @@ impl Session {
             }
         }
         let sent = Sent::Frames(&out[sent_from..]);
+        if self.faults.is_active() {
+            self.track.fault_events(&self.faults.take_events());
+        }
         self.track.record(self.time_us, self.vehicle.as_ref(), sent);
     }
 

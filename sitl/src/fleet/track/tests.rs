@@ -38,7 +38,7 @@ fn a_row_per_vehicle_each_interval_with_its_name_sysid_connection_and_state() {
     assert_eq!(
         lines[0],
         "vehicle,sysid,connection,time_us,north,east,down,vn,ve,vd,roll,pitch,yaw,\
-         m0,m1,m2,m3,m4,m5,grounded,p,q,r"
+         m0,m1,m2,m3,m4,m5,grounded,p,q,r,faults"
     );
     let rows: Vec<Vec<&str>> = lines[1..].iter().map(|l| l.split(',').collect()).collect();
     // t = 0, 8, 16 ms (rows every 8 ms of world time), each with both vehicles.
@@ -55,7 +55,7 @@ fn a_row_per_vehicle_each_interval_with_its_name_sysid_connection_and_state() {
         ]
     );
     for r in &rows {
-        assert_eq!(r.len(), 23, "{r:?}");
+        assert_eq!(r.len(), 24, "{r:?}");
     }
     // The quad's last two motor columns are empty; the hexa's are not.
     assert_eq!((rows[0][17], rows[0][18]), ("", ""));

@@ -186,3 +186,39 @@ fn inject_failure_on_the_control_link_is_acked_and_acts() {
     assert_eq!(answer(&client).1, "fault injected: sensor_off:gps");
     assert_eq!(count_gps(&fly(&mut s, 100, 0.4)), 0);
 }
+
+#[test]
+fn the_track_says_which_fault_fired_and_cleared_when() {
+    let path = std::env::temp_dir().join(format!("flyloop-fault-track-{}.csv", std::process::id()));
+    let mut s = faulty_session(
+        "[[faults]]\nkind = \"motor_off\"\nmotor = 1\nat = 0.1\nduration = 0.2\n\
+         [[faults]]\nkind = \"link_loss\"\nat = 0.25\nduration = 0.1",
+    );
+    s.track
+        .set(crate::track::Track::create(&path, 20_000, 4).unwrap());
+    let mut out = Vec::new();
+    s.connect(1_000_000, &mut out);
+    fly(&mut s, 150, 0.5);
+    s.track.flush();
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    let mut lines = text.lines();
+    assert!(lines.next().unwrap().ends_with(",grounded,p,q,r,faults"));
+    let events: Vec<(u64, &str)> = lines
+        .filter_map(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            let last = *cells.last().unwrap();
+            (!last.is_empty()).then(|| (cells[1].parse().unwrap(), last))
+        })
+        .collect();
+    // Each event in the first row at or after it (rows every 20 ms of simulation time).
+    assert_eq!(
+        events,
+        [
+            (104_000, "+motor_off:1@0.100"),
+            (264_000, "+link_loss@0.252"),
+            (304_000, "-motor_off:1@0.300"),
+            (364_000, "-link_loss@0.352"),
+        ]
+    );
+}
