@@ -210,12 +210,6 @@ fn start_fleet(args: Args) -> Result<(), StartError> {
             };
             quadrotor_only(&args, if args.px4 { "--px4" } else { "--ardupilot" })?;
             let vehicle = vehicle_config(&args)?;
-            if !vehicle.faults.is_empty() {
-                return Err(StartError::Options(
-                    "`[[faults]]`: fleet mode takes no faults yet (the PX4 and ArduPilot modes do)"
-                        .to_string(),
-                ));
-            }
             file::row(
                 autopilot,
                 usize::from(args.vehicles),

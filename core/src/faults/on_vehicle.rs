@@ -79,6 +79,14 @@ impl VehicleFaults {
     /// Before the physics step that starts at `time` s: fires and clears faults by their
     /// triggers, and sets the air faults' wind on `vehicle`.
     pub fn begin_step(&mut self, time: f64, vehicle: &mut dyn Vehicle) {
+        self.fire_due(time, vehicle);
+        let height = vehicle.kinematics().position.z;
+        vehicle.set_external_wind(self.state.wind(time, height));
+    }
+
+    /// Fires and clears faults by their triggers at `time` s (a vehicle in a world, whose
+    /// wind the world sets: no air faults).
+    pub fn fire_due(&mut self, time: f64, vehicle: &dyn Vehicle) {
         let k = vehicle.kinematics();
         self.state.update(&Conditions {
             time,
@@ -86,16 +94,24 @@ impl VehicleFaults {
             takeoff: (!vehicle.is_grounded()).then_some(time),
             waypoint: None,
         });
-        vehicle.set_external_wind(self.state.wind(time, k.position.z));
     }
 
     /// Advances `vehicle` by `dt` through the actuator path: while a motor fault or a battery
     /// acts, the motors get the faulted commands; afterwards the vehicle holds the autopilot's
     /// own commands again.
     pub fn advance(&mut self, vehicle: &mut dyn Vehicle, dt: f64) {
+        let commanded = self.before_advance(vehicle, dt);
+        vehicle.advance(dt);
+        Self::after_advance(vehicle, commanded);
+    }
+
+    /// The actuator path before `vehicle` advances by `dt` (alone, or in a world with the
+    /// others): while a motor fault or a battery acts, the motors get the faulted commands;
+    /// returns the autopilot's commands for [`VehicleFaults::after_advance`] (`None`:
+    /// nothing changed).
+    pub fn before_advance(&mut self, vehicle: &mut dyn Vehicle, dt: f64) -> Option<Vec<f64>> {
         if !self.state.acts_on_motors() {
-            vehicle.advance(dt);
-            return;
+            return None;
         }
         let commanded = vehicle.actuators();
         let mut motors = commanded.clone();
@@ -104,8 +120,14 @@ impl VehicleFaults {
             .motor_commands(&commanded, &states, dt, &mut motors);
         // Same length as the vehicle's own command, each value in [0, 1]: accepted.
         let _ = vehicle.set_actuators(&motors);
-        vehicle.advance(dt);
-        let _ = vehicle.set_actuators(&commanded);
+        Some(commanded)
+    }
+
+    /// After `vehicle` advanced: it holds the autopilot's `commanded` values again.
+    pub fn after_advance(vehicle: &mut dyn Vehicle, commanded: Option<Vec<f64>>) {
+        if let Some(commanded) = commanded {
+            let _ = vehicle.set_actuators(&commanded);
+        }
     }
 
     /// The sensor path on `r` (sampled at `time` s, `dt` s after the previous sample, with

@@ -25,10 +25,12 @@
 //! frame is still stepped and answered so ArduPilot's lockstep never stalls.
 //!
 //! - [`packet`]: the servo packet (16 or 32 channels) and its errors,
+//! - [`faulted_imu`]: the IMU through the sensor faults,
 //! - [`reply`]: the JSON line,
 //! - [`session`]: one vehicle flown by ArduPilot, without sockets,
 //! - [`server`]: the UDP socket, pacing and silence.
 
+pub mod faulted_imu;
 pub mod packet;
 pub mod reply;
 pub mod server;

@@ -14,7 +14,7 @@ use crate::stats::us_per;
 use crate::track::SessionTrack;
 use flyloop_core::ParamError;
 use flyloop_core::quadrotor::standing_multirotor;
-use flyloop_core::sensors::{ImuReading, SensorReading, Sensors, baro};
+use flyloop_core::sensors::{ImuReading, Sensors};
 use flyloop_core::vehicle::{Kinematics, Vehicle, VehicleStart};
 use nalgebra::Vector3;
 use std::fmt;
@@ -387,21 +387,11 @@ impl Session {
     /// The IMU through the sensor path; an off gyro or accelerometer holds its last value
     /// (ArduPilot needs both in every frame: a frame without one would be dropped).
     fn faulted_imu(&mut self, imu: ImuReading, k: &Kinematics, dt: f64) -> ImuReading {
-        let mut r = SensorReading {
-            imu,
-            mag: Vector3::zeros(),
-            baro: baro::reading(k.position.z, 0.0),
-        };
         let motors = self.vehicle.actuator_states();
-        let p = self.sensors.params();
-        let d = (self.faults).reading(&mut r, self.time_us, dt, p, &motors);
-        let last = self.last_imu.unwrap_or(imu);
-        let out = ImuReading {
-            accel: if d.accel { r.imu.accel } else { last.accel },
-            gyro: if d.gyro { r.imu.gyro } else { last.gyro },
-        };
-        self.last_imu = Some(out);
-        out
+        let (faults, p, time_us) = (&mut self.faults, self.sensors.params(), self.time_us);
+        super::faulted_imu::apply(imu, k, &mut self.last_imu, |r| {
+            faults.reading(r, time_us, dt, p, &motors)
+        })
     }
 
     /// The body rates without noise, FRD (for tests).

@@ -1,9 +1,11 @@
 //! One ArduPilot of the fleet, without sockets: servo packets in, JSON state lines out.
 
+use crate::ardupilot::faulted_imu;
 use crate::ardupilot::packet::{self, MAX_PWM, ServoFrame};
 use crate::ardupilot::reply::{self, State};
 use crate::ardupilot::session::frame_step_us;
 use crate::kinematics::attitude_ned;
+use flyloop_core::faults::VehicleFaults;
 use flyloop_core::sensors::{ImuReading, Sensors};
 use flyloop_core::vehicle::Kinematics;
 use std::net::SocketAddr;
@@ -48,6 +50,8 @@ pub struct ArduPilotMember {
     reply: Vec<u8>,
     /// Time of the last reply, µs.
     last_us: u64,
+    /// The IMU sample last sent while faults act (what an off gyro or accel repeats).
+    last_imu: Option<ImuReading>,
     pub peer: Option<SocketAddr>,
     pub stats: Counters,
 }
@@ -61,6 +65,7 @@ impl ArduPilotMember {
             replied: None,
             reply: Vec::with_capacity(512),
             last_us: 0,
+            last_imu: None,
             peer: None,
             stats: Counters::default(),
         }
@@ -112,11 +117,23 @@ impl ArduPilotMember {
         Some(outputs.iter().map(|&p| packet::motor_command(p)).collect())
     }
 
-    /// The state at `time_us` as the reply to the last frame; returns the IMU sample in it.
-    pub fn answer(&mut self, k: &Kinematics, time_us: u64) -> ImuReading {
+    /// The state at `time_us` as the reply to the last frame, its IMU through the vehicle's
+    /// sensor faults if it has any; returns the IMU sample in it.
+    pub fn answer(
+        &mut self,
+        k: &Kinematics,
+        time_us: u64,
+        faults: Option<(&mut VehicleFaults, &[f64])>,
+    ) -> ImuReading {
         let dt = (time_us.saturating_sub(self.last_us)).max(1) as f64 * 1e-6;
         self.last_us = time_us;
-        let imu = self.sensors.sample_imu(k, dt);
+        let mut imu = self.sensors.sample_imu(k, dt);
+        if let Some((f, motors)) = faults {
+            let (p, t) = (self.sensors.params(), time_us as f64 * 1e-6);
+            imu = faulted_imu::apply(imu, k, &mut self.last_imu, |r| {
+                f.reading(r, t, dt, p, motors)
+            });
+        }
         let q = attitude_ned(&k.attitude);
         let state = State {
             timestamp: time_us as f64 / 1e6,

@@ -3,6 +3,9 @@
 //! from `--px4 --vehicles N` / `--ardupilot --vehicles N`; checked before any socket opens.
 
 use crate::config::AutopilotVehicle;
+use flyloop_core::faults::catalogue::Target;
+use flyloop_core::faults::plan::FAULTS_TABLE;
+use flyloop_core::faults::{FaultKind, Reach};
 use flyloop_core::quadrotor::Frame;
 use flyloop_core::world::WorldParams;
 use serde::Deserialize;
@@ -89,6 +92,9 @@ struct FileEntries {
     world: Option<toml::Table>,
     #[serde(default)]
     vehicle: Vec<VehicleEntry>,
+    /// `[[faults]]` tables, each naming its vehicle (`vehicle = "px4-001"`).
+    #[serde(default)]
+    faults: Vec<toml::Table>,
 }
 
 /// Loopback: the autopilots run on this machine.
@@ -179,9 +185,12 @@ pub fn parse(text: &str, dir: &Path) -> Result<FleetSpec, FleetError> {
             file.vehicle.len()
         )));
     }
-    let vehicles = (file.vehicle.into_iter().enumerate())
+    let mut vehicles = (file.vehicle.into_iter().enumerate())
         .map(|(i, entry)| vehicle(i, entry, dir))
         .collect::<Result<Vec<_>, FleetError>>()?;
+    for (i, table) in file.faults.into_iter().enumerate() {
+        add_fault(&mut vehicles, i, table)?;
+    }
     let spec = FleetSpec {
         world: world_params(file.world)?,
         vehicles,
@@ -236,12 +245,6 @@ fn vehicle(i: usize, e: VehicleEntry, dir: &Path) -> Result<FleetVehicle, FleetE
         Some(path) => crate::config::load_autopilot_vehicle(&dir.join(path))
             .map_err(|err| item(format!("config: {err}")))?,
     };
-    if !vehicle.faults.is_empty() {
-        return Err(item(
-            "config: `[[faults]]`: fleet mode takes no faults yet (the PX4 and ArduPilot modes do)"
-                .to_string(),
-        ));
-    }
     if let Some(frame) = &e.frame {
         vehicle.frame = Frame::named(frame).map_err(|err| item(format!("frame: {err}")))?;
     }
@@ -255,10 +258,77 @@ fn vehicle(i: usize, e: VehicleEntry, dir: &Path) -> Result<FleetVehicle, FleetE
     })
 }
 
+/// The key of a fleet file's `[[faults]]` table that names its vehicle.
+pub const VEHICLE_KEY: &str = "vehicle";
+
+/// Fleet file `[[faults]]` table `i`: added to the plan of the vehicle its `vehicle` names.
+fn add_fault(
+    vehicles: &mut [FleetVehicle],
+    i: usize,
+    mut table: toml::Table,
+) -> Result<(), FleetError> {
+    let names: Vec<&str> = vehicles.iter().map(|v| v.name.as_str()).collect();
+    let names = names.join("`, `");
+    let name = match table.remove(VEHICLE_KEY) {
+        Some(toml::Value::String(name)) => name,
+        _ => {
+            return Err(FleetError(format!(
+                "[[faults]] {i}: needs `{VEHICLE_KEY}`, the name of the vehicle it is for (`{names}`)"
+            )));
+        }
+    };
+    let Some(v) = vehicles.iter_mut().find(|v| v.name == name) else {
+        return Err(FleetError(format!(
+            "[[faults]] {i}: vehicle `{name}` is not in the fleet; its vehicles: `{names}`"
+        )));
+    };
+    (v.vehicle.faults)
+        .add(FAULTS_TABLE, &toml::Value::Table(table))
+        .map_err(|e| FleetError(format!("[[faults]] {i} (vehicle `{name}`): {e}")))
+}
+
+/// Rotor count of `v`'s frame.
+fn rotors_of(v: &FleetVehicle) -> usize {
+    v.vehicle.frame.rotor_count()
+}
+
+/// Refuses faults a fleet vehicle cannot have: a motor its frame lacks, an air fault (the
+/// world's wind field sets every vehicle's wind), a link fault (the fleet's barrier holds
+/// the world for every autopilot: not yet).
+fn check_faults(vehicle: &AutopilotVehicle, rotors: usize) -> Result<(), String> {
+    let plan = &vehicle.faults;
+    plan.check(&Reach {
+        duration: None,
+        waypoints: None,
+        rotors,
+    })
+    .map_err(|e| format!("faults: {e}"))?;
+    let kinds =
+        (plan.faults.iter().map(|f| f.kind)).chain(plan.draws.iter().flat_map(|d| d.kinds.clone()));
+    for kind in kinds {
+        let refused = match kind.spec().target {
+            Target::Link => Some("link faults are not flown in fleet mode yet"),
+            _ if matches!(kind, FaultKind::Gust | FaultKind::WindShear) => Some(
+                "the world's wind field sets every vehicle's wind in fleet mode (use [world]'s wind)",
+            ),
+            _ => None,
+        };
+        if let Some(why) = refused {
+            return Err(format!("faults: `{}`: {why}", kind.name()));
+        }
+    }
+    Ok(())
+}
+
 impl FleetSpec {
-    /// Refuses duplicate names, ports (of one transport) and system ids.
+    /// Refuses duplicate names, ports (of one transport) and system ids, and faults a
+    /// vehicle cannot have.
     pub fn check(&self) -> Result<(), FleetError> {
         let v = &self.vehicles;
+        for (i, v) in v.iter().enumerate() {
+            check_faults(&v.vehicle, rotors_of(v))
+                .map_err(|what| FleetError(format!("vehicle {i} (`{}`): {what}", v.name)))?;
+        }
         for (j, b) in v.iter().enumerate() {
             for (i, a) in v[..j].iter().enumerate() {
                 let clash = if a.name == b.name {

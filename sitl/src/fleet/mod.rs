@@ -25,6 +25,7 @@ pub mod view_record;
 use ardupilot_member::{ArduPilotMember, Frame};
 use file::{Autopilot, FleetSpec};
 use flyloop_core::ParamError;
+use flyloop_core::faults::{FaultEvent, VehicleFaults};
 use flyloop_core::quadrotor::standing_multirotor_at;
 use flyloop_core::sensors::Sensors;
 use flyloop_core::vehicle::AirVehicleStart;
@@ -66,6 +67,13 @@ pub struct Member {
     rotors: usize,
     /// Connections of its autopilot so far (a reconnect or restart counts again).
     pub connections: u32,
+    /// Its faults (`[[faults]]` of its config or of the fleet file; none: healthy, stepped
+    /// exactly as without), restarted with each connection.
+    faults: Option<VehicleFaults>,
+    /// Seed of its vehicle, sensors and fault draws.
+    seed: u64,
+    /// Every fault that fired or cleared, in order (the track's `faults` column).
+    pub fault_log: Vec<FaultEvent>,
 }
 
 /// Something worth a log line and a STATUSTEXT.
@@ -127,6 +135,11 @@ impl Fleet {
                 ),
             };
             steps.push(step);
+            let rotors = c.frame.rotor_count();
+            let faults = (!c.faults.is_empty())
+                .then(|| VehicleFaults::new(c.faults.clone(), rotors, c.quadrotor.mass, s))
+                .transpose()
+                .map_err(err)?;
             members.push(Member {
                 name: v.name.clone(),
                 autopilot: v.autopilot,
@@ -134,8 +147,11 @@ impl Fleet {
                 listen: v.listen,
                 link,
                 out: Vec::new(),
-                rotors: c.frame.rotor_count(),
+                rotors,
                 connections: 0,
+                faults,
+                seed: s,
+                fault_log: Vec::new(),
             });
             vehicles.push((v.name.clone(), start.take()));
             starts.push(start);
@@ -208,20 +224,31 @@ impl Fleet {
         self.world.replace_vehicle(i, self.start[i].take());
     }
 
+    /// Vehicle i's faults start again (a new connection: nothing fired).
+    fn restart_faults(&mut self, i: usize) {
+        let m = &mut self.members[i];
+        if let Some(f) = &mut m.faults {
+            f.restart(m.seed);
+        }
+    }
+
     /// PX4 i connected: its vehicle back at its start, the first HIL_SENSOR queued in its
     /// `out`.
     pub fn px4_connected(&mut self, i: usize) {
         self.reset_vehicle(i);
+        self.restart_faults(i);
         self.lockstep.connect(i, false);
         self.members[i].connections += 1;
         let now = self.lockstep.now_us();
         let epoch = self.gps_epoch_us;
         let k = self.world.kinematics(i);
+        let motors = self.world.vehicle(i).actuator_states();
         let m = &mut self.members[i];
         m.out.clear();
         if let Link::Px4(p) = &mut m.link {
             p.connect(now, epoch);
-            p.emit(&k, now, &mut m.out);
+            let faults = m.faults.as_mut().map(|f| (f, motors.as_slice()));
+            p.emit(&k, now, &mut m.out, faults);
         }
         let text = format!(
             "{}: PX4 connected at t={:.3} s, vehicle at its start",
@@ -329,6 +356,7 @@ impl Fleet {
                 if first {
                     let restarted = self.lockstep.slot(i).phase != Phase::Absent;
                     self.reset_vehicle(i);
+                    self.restart_faults(i);
                     self.lockstep.connect(i, true);
                     self.members[i].connections += 1;
                     let text = format!(
@@ -375,19 +403,24 @@ impl Fleet {
         for (i, command) in commands {
             self.set_command(i, &command);
         }
-        self.world.step(dt_us as f64 * 1e-6);
+        let dt = dt_us as f64 * 1e-6;
+        let held = self.faults_before_step(dt);
+        self.world.step(dt);
+        self.faults_after_step(held);
         let now = self.lockstep.now_us();
         let mut sent = Vec::new();
         for &i in &due {
             let k = self.world.kinematics(i);
             let m = &mut self.members[i];
             let from = m.out.len();
+            let motors = self.world.vehicle(i).actuator_states();
+            let faults = m.faults.as_mut().map(|f| (f, motors.as_slice()));
             let sample = match &mut m.link {
                 Link::Px4(p) => {
-                    p.emit(&k, now, &mut m.out);
+                    p.emit(&k, now, &mut m.out, faults);
                     Sample::Px4From(from)
                 }
-                Link::ArduPilot(a) => Sample::Imu(a.answer(&k, now)),
+                Link::ArduPilot(a) => Sample::Imu(a.answer(&k, now, faults)),
             };
             if self.view_record.is_on() {
                 sent.push((i, sample));
@@ -408,7 +441,42 @@ impl Fleet {
         }
         Ok(due)
     }
+
+    /// Before the world steps by `dt`: each faulted vehicle's faults due fire, and its motors
+    /// get the actuator path's commands; returns its autopilot's, to hold again after.
+    fn faults_before_step(&mut self, dt: f64) -> Vec<(usize, Option<Vec<f64>>)> {
+        let time = self.lockstep.now_us() as f64 * 1e-6;
+        let mut held = Vec::new();
+        for (i, m) in self.members.iter_mut().enumerate() {
+            if let Some(f) = &mut m.faults {
+                let v = self.world.vehicle_mut(i);
+                f.fire_due(time, v);
+                held.push((i, f.before_advance(v, dt)));
+            }
+        }
+        held
+    }
+
+    /// After the world stepped: the autopilots' commands held again, and every fault that
+    /// fired or cleared a notice (log, STATUSTEXT) and a track event.
+    fn faults_after_step(&mut self, held: Vec<(usize, Option<Vec<f64>>)>) {
+        for (i, commanded) in held {
+            VehicleFaults::after_advance(self.world.vehicle_mut(i), commanded);
+            let m = &mut self.members[i];
+            let Some(f) = &mut m.faults else { continue };
+            let events = f.new_events().to_vec();
+            let name = m.name.clone();
+            for e in events {
+                let verb = if e.fired { "fired" } else { "cleared" };
+                let text = format!("{name}: fault {verb}: {} at {:.3} s", e.label, e.time);
+                self.members[i].fault_log.push(e);
+                self.notice(MavSeverity::MAV_SEVERITY_WARNING, text);
+            }
+        }
+    }
 }
 
+#[cfg(test)]
+mod fault_tests;
 #[cfg(test)]
 mod tests;

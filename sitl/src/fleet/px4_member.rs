@@ -4,6 +4,7 @@
 use crate::px4::messages;
 use crate::stats::Stats;
 use crate::wire::{Encoder, StreamDecoder};
+use flyloop_core::faults::VehicleFaults;
 use flyloop_core::sensors::Sensors;
 use flyloop_core::vehicle::Kinematics;
 use mavlink::dialects::common::MavMessage;
@@ -94,14 +95,36 @@ impl Px4Member {
     }
 
     /// HIL_SENSOR at `time_us` (PX4 refuses time 0: stamped at least 1 µs), and HIL_GPS
-    /// when a fix is delivered, appended to `out`.
-    pub fn emit(&mut self, k: &Kinematics, time_us: u64, out: &mut Vec<u8>) {
+    /// when a fix is delivered, appended to `out`; through the vehicle's sensor faults
+    /// (with its motor states) if it has any.
+    pub fn emit(
+        &mut self,
+        k: &Kinematics,
+        time_us: u64,
+        out: &mut Vec<u8>,
+        faults: Option<(&mut VehicleFaults, &[f64])>,
+    ) {
         let dt = (time_us.saturating_sub(self.last_us)).max(1) as f64 * 1e-6;
         self.last_us = time_us;
-        let reading = self.sensors.sample(k, dt);
-        let sensor = messages::hil_sensor(&reading, time_us.max(1));
-        self.encoder.push(out, SIMULATOR_SYSTEM, &sensor);
-        if let Some(fix) = self.sensors.gps(k, time_us as f64 * 1e-6) {
+        let mut reading = self.sensors.sample(k, dt);
+        let t = time_us as f64 * 1e-6;
+        let fix = match faults {
+            None => {
+                let sensor = messages::hil_sensor(&reading, time_us.max(1));
+                self.encoder.push(out, SIMULATOR_SYSTEM, &sensor);
+                self.sensors.gps(k, t)
+            }
+            Some((f, motors)) => {
+                let p = self.sensors.params();
+                let d = f.reading(&mut reading, t, dt, p, motors);
+                let fields = messages::delivered_fields(&d);
+                let sensor = messages::hil_sensor_delivered(&reading, time_us.max(1), fields);
+                self.encoder.push(out, SIMULATOR_SYSTEM, &sensor);
+                let fix = self.sensors.gps(k, t);
+                fix.and_then(|fix| f.gps(fix, t, self.sensors.params()))
+            }
+        };
+        if let Some(fix) = fix {
             let stamp = self.gps_epoch_us + (fix.measured_at * 1e6).round() as u64;
             self.encoder
                 .push(out, SIMULATOR_SYSTEM, &messages::hil_gps(&fix, stamp));

@@ -1,12 +1,12 @@
 //! The fleet's ground-truth track (`--track FILE` in fleet mode): the columns of the
 //! single-vehicle track (docs/sitl.md, [`crate::track`]) after `vehicle,sysid`, a row per
 //! vehicle every `--track-interval-us` of world time, the vehicles in the fleet's (name)
-//! order. `connection` counts its autopilot's connections (0: none yet, 1: the first,
+//! order, the `faults` column each vehicle's own events. `connection` counts its autopilot's connections (0: none yet, 1: the first,
 //! 2 after a reconnect or restart, …); a vehicle with fewer rotors than the fleet's most
 //! leaves the last motor columns empty.
 
 use super::Fleet;
-use crate::track::{state_header, write_state};
+use crate::track::{fault_event, state_header, write_state};
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
@@ -23,6 +23,8 @@ pub struct FleetTrack {
     next_us: u64,
     interval_us: u64,
     rotors: usize,
+    /// Per vehicle, the fault events already written (of its `fault_log`).
+    written: Vec<usize>,
 }
 
 impl FleetTrack {
@@ -40,6 +42,7 @@ impl FleetTrack {
             next_us: 0,
             interval_us,
             rotors,
+            written: vec![0; fleet.members().len()],
         })
     }
 
@@ -56,7 +59,15 @@ impl FleetTrack {
                 "{},{},{},{time_us}",
                 m.name, m.sysid, m.connections
             )?;
-            write_state(&mut self.out, fleet.vehicle(i), self.rotors, "")?;
+            let log = m.fault_log.get(self.written[i]..).unwrap_or_default();
+            let events: Vec<String> = log.iter().map(fault_event).collect();
+            self.written[i] = m.fault_log.len();
+            write_state(
+                &mut self.out,
+                fleet.vehicle(i),
+                self.rotors,
+                &events.join(" "),
+            )?;
         }
         Ok(())
     }
