@@ -185,12 +185,6 @@ fn start_px4(args: Args) -> Result<(), StartError> {
 /// lockstep until a signal.
 fn start_fleet(args: Args) -> Result<(), StartError> {
     use crate::fleet::{self, file};
-    if args.control.is_some() {
-        return Err(StartError::Options(
-            "--control injects faults into one autopilot's vehicle; fleet mode has none yet"
-                .to_string(),
-        ));
-    }
     let mut spec = match &args.fleet {
         Some(path) => {
             let fleet_err = |source| StartError::FleetFile {
@@ -227,6 +221,11 @@ fn start_fleet(args: Args) -> Result<(), StartError> {
     let step_us = (args.px4_step * 1e6).round() as u64;
     let mut fleet = fleet::Fleet::new(&spec, args.seed, step_us)?;
     fleet_view_record(&args, &mut fleet.view_record)?;
+    let control = control_link(&args)?;
+    let control_text = control_field(control.as_ref())?;
+    if let Some(control) = control {
+        fleet.set_control(control);
+    }
     let sockets = fleet::server::bind(&fleet)
         .map_err(|(name, addr, source)| StartError::FleetBind { name, addr, source })?;
     let outputs = fleet_outputs(&args, &fleet)?;
@@ -247,7 +246,7 @@ fn start_fleet(args: Args) -> Result<(), StartError> {
     };
     let speed = args.speed_factor;
     let ready = format!(
-        "flyloop-sitl ready mode=fleet vehicles={} members={} speed_factor={speed} seed={}",
+        "flyloop-sitl ready mode=fleet vehicles={} members={} speed_factor={speed} seed={}{control_text}",
         fleet.members().len(),
         ports.join(","),
         args.seed

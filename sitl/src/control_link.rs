@@ -28,6 +28,8 @@ pub struct ControlLink {
     buf: Vec<u8>,
     out: Vec<u8>,
     text_id: u16,
+    /// System ids it takes commands for (0 = all of them, always).
+    systems: Vec<u8>,
 }
 
 impl ControlLink {
@@ -41,6 +43,7 @@ impl ControlLink {
             buf: vec![0; 2048],
             out: Vec::with_capacity(256),
             text_id: 0,
+            systems: vec![SYSTEM_ID],
         })
     }
 
@@ -48,9 +51,24 @@ impl ControlLink {
         self.socket.local_addr()
     }
 
+    /// Takes commands for the vehicles of `systems` (a fleet's sysids) instead of
+    /// [`SYSTEM_ID`].
+    pub fn set_systems(&mut self, systems: Vec<u8>) {
+        self.systems = systems;
+    }
+
     /// Handles every datagram waiting: `inject` fires PX4's failure code (unit, type,
     /// instance) on the vehicle. Socket errors are logged, never fatal.
     pub fn poll(&mut self, mut inject: impl FnMut(u8, u8, u8) -> Result<String, ParamError>) {
+        self.poll_addressed(|_, unit, failure, instance| inject(unit, failure, instance));
+    }
+
+    /// [`ControlLink::poll`] for several vehicles: `inject` also gets the command's
+    /// target system (one of [`ControlLink::set_systems`]'s, or 0 = all).
+    pub fn poll_addressed(
+        &mut self,
+        mut inject: impl FnMut(u8, u8, u8, u8) -> Result<String, ParamError>,
+    ) {
         loop {
             let (n, from) = match self.socket.recv_from(&mut self.buf) {
                 Ok(got) => got,
@@ -97,13 +115,15 @@ impl ControlLink {
         c: &COMMAND_LONG_DATA,
         sender: (u8, u8),
         from: SocketAddr,
-        inject: &mut impl FnMut(u8, u8, u8) -> Result<String, ParamError>,
+        inject: &mut impl FnMut(u8, u8, u8, u8) -> Result<String, ParamError>,
     ) {
-        if c.target_system != SYSTEM_ID && c.target_system != 0 {
+        let target = c.target_system;
+        if target != 0 && !self.systems.contains(&target) {
             return;
         }
         let (result, text) = if c.command == MavCmd::MAV_CMD_INJECT_FAILURE {
-            let (result, severity, text) = crate::commands::inject_outcome(c, inject);
+            let (result, severity, text) =
+                crate::commands::inject_outcome(c, |u, f, n| inject(target, u, f, n));
             (result, Some((severity, text)))
         } else {
             (MavResult::MAV_RESULT_UNSUPPORTED, None)

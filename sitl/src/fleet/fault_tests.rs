@@ -5,6 +5,7 @@
 use super::file;
 use super::tests::answer;
 use super::*;
+use crate::control_link::ControlLink;
 use std::path::Path;
 
 const FLEET: &str = r#"
@@ -133,4 +134,51 @@ fn bad_fleet_faults_name_the_item() {
         e.contains("`link_loss`") && e.contains("not flown in fleet mode"),
         "{e}"
     );
+}
+
+#[test]
+fn the_fleets_control_link_injects_into_the_vehicle_its_sysid_names() {
+    use crate::px4::session::faults_tests::{answer, inject};
+    use mavlink::dialects::common::MavResult;
+    use std::net::UdpSocket;
+    let text = FLEET.split("[[faults]]").next().unwrap();
+    let spec = file::parse(text, Path::new(".")).unwrap();
+    let mut f = Fleet::new(&spec, 3, PX4_STEP_US).unwrap();
+    let link = ControlLink::new(UdpSocket::bind("127.0.0.1:0").unwrap()).unwrap();
+    let addr = link.local_addr().unwrap();
+    f.set_control(link);
+    let client = UdpSocket::bind("127.0.0.1:0").unwrap();
+    client
+        .set_read_timeout(Some(std::time::Duration::from_secs(5)))
+        .unwrap();
+    client.connect(addr).unwrap();
+    f.px4_connected(0);
+    f.px4_connected(1);
+    fly(&mut f, 0.5, 0.05);
+    // FAILURE_UNIT_SYSTEM_MOTOR (101), OFF (1), motor 1, for sysid 2 (`px4-001`).
+    client.send(&inject(101.0, 1.0, 1.0, 2)).unwrap();
+    fly(&mut f, 0.5, 0.05);
+    let (ack, said) = answer(&client);
+    assert_eq!(ack.result, MavResult::MAV_RESULT_ACCEPTED);
+    assert_eq!(said, "px4-001: fault injected: motor_off:1");
+    // A motor the quad lacks: UNSUPPORTED, naming the instance.
+    client.send(&inject(101.0, 1.0, 7.0, 1)).unwrap();
+    fly(&mut f, 0.5, 0.05);
+    let (ack, said) = answer(&client);
+    assert_eq!(ack.result, MavResult::MAV_RESULT_UNSUPPORTED);
+    assert!(said.contains("instance 7"), "{said}");
+    fly(&mut f, 0.5, 0.3);
+    let (healthy, faulty) = (
+        f.vehicle(0).actuator_states(),
+        f.vehicle(1).actuator_states(),
+    );
+    assert!((healthy[0] - 0.5).abs() < 1e-3, "{healthy:?}");
+    assert!(faulty[0] < 0.01, "{faulty:?}");
+    let log: Vec<String> = f.members()[1]
+        .fault_log
+        .iter()
+        .map(crate::track::fault_event)
+        .collect();
+    assert_eq!(log.len(), 1, "{log:?}");
+    assert!(log[0].starts_with("+motor_off:1@0.0"), "{log:?}");
 }

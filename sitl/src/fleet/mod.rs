@@ -22,10 +22,11 @@ pub mod server;
 pub mod track;
 pub mod view_record;
 
+use crate::control_link::ControlLink;
 use ardupilot_member::{ArduPilotMember, Frame};
 use file::{Autopilot, FleetSpec};
 use flyloop_core::ParamError;
-use flyloop_core::faults::{FaultEvent, VehicleFaults};
+use flyloop_core::faults::{FaultEvent, FaultPlan, VehicleFaults};
 use flyloop_core::quadrotor::standing_multirotor_at;
 use flyloop_core::sensors::Sensors;
 use flyloop_core::vehicle::AirVehicleStart;
@@ -72,6 +73,8 @@ pub struct Member {
     faults: Option<VehicleFaults>,
     /// Seed of its vehicle, sensors and fault draws.
     seed: u64,
+    /// Mass of its vehicle, kg (for faults injected at run time).
+    mass: f64,
     /// Every fault that fired or cleared, in order (the track's `faults` column).
     pub fault_log: Vec<FaultEvent>,
 }
@@ -100,7 +103,14 @@ pub struct Fleet {
     pub gps_epoch_us: u64,
     /// The live view's stream and the recording, if asked for.
     pub view_record: ViewRecord,
+    /// `--control`: MAV_CMD_INJECT_FAILURE addressed to each vehicle's sysid (0 = all).
+    control: Option<ControlLink>,
+    /// World time of the next look at the control link, µs.
+    next_poll_us: u64,
 }
+
+/// World time between two looks at the control link, µs.
+const CONTROL_POLL_US: u64 = 10_000;
 
 /// PX4's simulator step, µs (`--px4-step`).
 pub const PX4_STEP_US: u64 = 4000;
@@ -151,6 +161,7 @@ impl Fleet {
                 connections: 0,
                 faults,
                 seed: s,
+                mass: c.quadrotor.mass,
                 fault_log: Vec::new(),
             });
             vehicles.push((v.name.clone(), start.take()));
@@ -167,6 +178,8 @@ impl Fleet {
             stale_controls: 0,
             gps_epoch_us: 0,
             view_record: ViewRecord::default(),
+            control: None,
+            next_poll_us: 0,
         })
     }
 
@@ -222,6 +235,46 @@ impl Fleet {
     /// Vehicle i back at its start (standing at its start position, motors off).
     fn reset_vehicle(&mut self, i: usize) {
         self.world.replace_vehicle(i, self.start[i].take());
+    }
+
+    /// Takes MAV_CMD_INJECT_FAILURE on `control` from now on, for each vehicle's sysid.
+    pub fn set_control(&mut self, mut control: ControlLink) {
+        control.set_systems(self.members.iter().map(|m| m.sysid).collect());
+        self.control = Some(control);
+    }
+
+    /// Reads the control link when due: a fault injected into the vehicle the command
+    /// addresses (0: every vehicle), now.
+    fn poll_control(&mut self) {
+        let now = self.lockstep.now_us();
+        let Some(control) = &mut self.control else {
+            return;
+        };
+        if now < self.next_poll_us {
+            return;
+        }
+        self.next_poll_us = now + CONTROL_POLL_US;
+        let members = &mut self.members;
+        control.poll_addressed(|target, unit, failure, instance| {
+            let mut done = Vec::new();
+            for m in members
+                .iter_mut()
+                .filter(|m| target == 0 || m.sysid == target)
+            {
+                let f = match &mut m.faults {
+                    Some(f) => f,
+                    None => m.faults.insert(VehicleFaults::new(
+                        FaultPlan::default(),
+                        m.rotors,
+                        m.mass,
+                        m.seed,
+                    )?),
+                };
+                let did = f.inject_px4(unit, failure, instance, m.rotors, now as f64 * 1e-6)?;
+                done.push(format!("{}: {did}", m.name));
+            }
+            Ok(done.join("; "))
+        });
     }
 
     /// Vehicle i's faults start again (a new connection: nothing fired).
@@ -400,6 +453,7 @@ impl Fleet {
             dt_us,
             due,
         } = self.lockstep.advance(free)?;
+        self.poll_control();
         for (i, command) in commands {
             self.set_command(i, &command);
         }

@@ -334,7 +334,7 @@ struct Px4Sample {
 }
 
 #[cfg(test)]
-mod faults_tests;
+pub(crate) mod faults_tests;
 #[cfg(test)]
 mod link_tests;
 #[cfg(test)]

@@ -98,7 +98,7 @@ fn without_faults_the_bits_are_the_same_as_before() {
     assert_eq!(fly(&mut a, 300, 0.6), fly(&mut b, 300, 0.6));
 }
 
-fn inject(unit: f32, failure: f32, instance: f32, target: u8) -> Vec<u8> {
+pub(crate) fn inject(unit: f32, failure: f32, instance: f32, target: u8) -> Vec<u8> {
     let m = MavMessage::COMMAND_LONG(COMMAND_LONG_DATA {
         command: MavCmd::MAV_CMD_INJECT_FAILURE,
         target_system: target,
@@ -113,7 +113,7 @@ fn inject(unit: f32, failure: f32, instance: f32, target: u8) -> Vec<u8> {
 }
 
 /// The control link's answers to one command: the ack and the STATUSTEXT's text.
-fn answer(client: &UdpSocket) -> (COMMAND_ACK_DATA, String) {
+pub(crate) fn answer(client: &UdpSocket) -> (COMMAND_ACK_DATA, String) {
     let mut buf = [0u8; 1024];
     let n = client.recv(&mut buf).unwrap();
     let mut ack = None;
