@@ -292,28 +292,32 @@ impl Session {
     }
 
     /// A faulted sample to PX4 through the link faults. The HIL_SENSOR of every step goes
-    /// out stamped now — it is PX4's lockstep tick, and a tick that never came would stall
-    /// PX4 and flyloop for good — carrying: on a lost link no field (PX4 reads no new value)
-    /// and no HIL_GPS; on a delayed one the values sampled `delay` ago (the last delivered
-    /// until a sample is that old) and their fix, once.
+    /// out stamped now, with an IMU sample: PX4 runs its rate loop, and so sends its next
+    /// controls, only on a new gyro sample, and a step never answered would stall PX4 and
+    /// flyloop for good (a real PX4 flight showed it). On a lost link it carries the last
+    /// IMU sample delivered again (no mag, baro or GPS); on a delayed one the values sampled
+    /// `delay` ago (the last delivered until a sample is that old) and their fix, once.
     fn send_through_link(&mut self, sample: Px4Sample, link: LinkCondition, out: &mut Vec<u8>) {
+        use HilSensorUpdatedFlags as F;
         let time_us = self.time_us;
-        if link.lost {
-            let nothing = messages::hil_sensor_delivered(
-                &sample.reading,
-                time_us,
-                HilSensorUpdatedFlags::empty(),
-            );
-            self.encoder.push(out, SIMULATOR_SYSTEM, &nothing);
-            return;
-        }
         let (sample, new) = {
             let (s, new) = self.link_line.pass_new(time_us, sample, link);
             (*s, new)
         };
-        let sensor = messages::hil_sensor_delivered(&sample.reading, time_us, sample.fields);
+        let fields = if link.lost {
+            let imu = F::HIL_SENSOR_UPDATED_XACC
+                | F::HIL_SENSOR_UPDATED_YACC
+                | F::HIL_SENSOR_UPDATED_ZACC
+                | F::HIL_SENSOR_UPDATED_XGYRO
+                | F::HIL_SENSOR_UPDATED_YGYRO
+                | F::HIL_SENSOR_UPDATED_ZGYRO;
+            sample.fields & imu
+        } else {
+            sample.fields
+        };
+        let sensor = messages::hil_sensor_delivered(&sample.reading, time_us, fields);
         self.encoder.push(out, SIMULATOR_SYSTEM, &sensor);
-        if let (Some(fix), true) = (sample.fix, new) {
+        if let (Some(fix), true, false) = (sample.fix, new, link.lost) {
             self.push_gps(&fix, out);
         }
     }
