@@ -49,8 +49,16 @@ fn a_link_loss_keeps_px4s_tick_but_sends_no_data_and_drops_its_controls() {
         "one HIL_SENSOR per step, stamped now: PX4's clock goes on"
     );
     // The IMU fields only, with the last sample delivered (the one of 0.5 s) again.
-    assert!(lost[1..].iter().all(|h| h.fields_updated.bits() == 0b11_1111));
-    assert!(lost[1..].iter().all(|h| (h.xacc, h.zgyro) == (lost[0].xacc, lost[0].zgyro)));
+    assert!(
+        lost[1..]
+            .iter()
+            .all(|h| h.fields_updated.bits() == 0b11_1111)
+    );
+    assert!(
+        lost[1..]
+            .iter()
+            .all(|h| (h.xacc, h.zgyro) == (lost[0].xacc, lost[0].zgyro))
+    );
     assert_eq!(gps, 0, "no HIL_GPS while the link is lost");
     assert_eq!(
         s.vehicle().actuators(),
@@ -61,7 +69,12 @@ fn a_link_loss_keeps_px4s_tick_but_sends_no_data_and_drops_its_controls() {
     // The controls answering 0.896 s are the last dropped; the samples from 0.904 s are whole.
     let (after, gps) = fly(&mut s, 50, 0.9);
     assert_eq!(s.stats.link_dropped, 100);
-    assert!(after[1..].iter().all(|h| h.fields_updated.bits() > 0b11_1111) && gps > 0);
+    assert!(
+        after[1..]
+            .iter()
+            .all(|h| h.fields_updated.bits() > 0b11_1111)
+            && gps > 0
+    );
     assert_eq!(s.vehicle().actuators(), [0.9f32 as f64; 4]);
 }
 
