@@ -20,7 +20,7 @@ REPO = Path(__file__).resolve().parents[1]
 for folder in ("sitl", "px4", "ardupilot", "fleet"):
     sys.path.insert(0, str(REPO / "tests" / folder))
 
-from ardupilot_support import GUIDED, LAND, ArduPilot, ardupilot_build, collect, settle  # noqa: E402
+from ardupilot_support import GUIDED, LAND, PARM, ArduPilot, ardupilot_build, collect, settle  # noqa: E402
 from fleet_px4 import cpu_model, cpu_seconds  # noqa: E402
 from fleet_support import HOME, FleetSitl, ardupilot_ports_free, free_block  # noqa: E402
 from flyloop import find_sitl_binary  # noqa: E402
@@ -40,7 +40,12 @@ def quiet(ap) -> None:
     mav.request_data_stream_send(ap.target, 1, mavutil.mavlink.MAV_DATA_STREAM_POSITION, 5, 1)
 
 
-def run(binary: Path, build, n: int, speed: float) -> dict:
+# The fleet's ArduPilot parameters, after the Iris's (docs/fleet.md).
+FLEET_PARM = REPO / "sitl" / "presets" / "ardupilot_fleet.parm"
+
+
+def start(binary: Path, build, n: int, speed: float, parm: str) -> tuple[FleetSitl, list]:
+    """flyloop-sitl with `n` ArduPilots (sysids 1..n, `parm` after copter.parm) in one world."""
     base = free_block(n, ardupilot_ports_free, 3, 150)
     listen = f"127.0.0.1:{9002 + 10 * base}"
     sitl = FleetSitl(
@@ -58,9 +63,27 @@ def run(binary: Path, build, n: int, speed: float) -> dict:
             home,
             "--sysid",
             str(k + 1),
+            parm=parm,
         )  # fmt: skip
         for k in range(n)
     ]
+    return sitl, aps
+
+
+def stop(sitl: FleetSitl, aps: list) -> tuple[list[float], float, dict[str, str]]:
+    """Stops the fleet: each ArduPilot's CPU seconds, flyloop's, flyloop's stop counters."""
+    try:
+        cpu_ap = [cpu_seconds(ap.proc.pid) for ap in aps]
+        cpu_flyloop = cpu_seconds(sitl.proc.pid)
+    finally:
+        for ap in aps:
+            ap.kill()
+        sitl.stop()
+    return cpu_ap, cpu_flyloop, sitl.counters()
+
+
+def run(binary: Path, build, n: int, speed: float, parm: str) -> dict:
+    sitl, aps = start(binary, build, n, speed, parm)
     try:
         for ap in aps:
             ap.connect(120)
@@ -88,13 +111,9 @@ def run(binary: Path, build, n: int, speed: float) -> dict:
                 300,
                 "HEARTBEAT",
             )
-        cpu_ap = sum(cpu_seconds(ap.proc.pid) for ap in aps)
-        cpu_flyloop = cpu_seconds(sitl.proc.pid)
     finally:
-        for ap in aps:
-            ap.kill()
-        sitl.stop()
-    c = sitl.counters()
+        cpu_ap, cpu_flyloop, c = stop(sitl, aps)
+    cpu_ap = sum(cpu_ap)
     return {
         "worst_m": worst,
         "rtf": float(c["real_time_factor"]),
@@ -111,14 +130,19 @@ def main() -> int:
     a.add_argument("--vehicles", type=int, default=8)
     a.add_argument("--runs", type=int, default=1)
     a.add_argument("--speed-factor", type=float, default=0.0)
+    a.add_argument(
+        "--stock", action="store_true", help="the Iris's parameters only (1200 Hz, logging)"
+    )
     args = a.parse_args()
+    parm = str(PARM) if args.stock else f"{PARM},{FLEET_PARM}"
     build = ardupilot_build(Path(tempfile.mkdtemp(prefix="bench-ap-build-")))
     binary = find_sitl_binary(build=True)
     print(f"cpu: {os.cpu_count()} x {cpu_model()}, load before: {os.getloadavg()[0]:.2f}")
+    print(f"flyloop {binary}, ArduPilot parameters {parm}")
     ok = True
     for k in range(args.runs):
         start = time.monotonic()
-        r = run(binary, build, args.vehicles, args.speed_factor)
+        r = run(binary, build, args.vehicles, args.speed_factor, parm)
         good = r["worst_m"] <= 0.3 and r["silenced"] == 0
         ok &= good
         print(

@@ -1,9 +1,9 @@
 //! One ArduPilot of the fleet, without sockets: servo packets in, JSON state lines out.
 
 use crate::ardupilot::faulted_imu;
+use super::frame_rate::FrameRate;
 use crate::ardupilot::packet::{self, MAX_PWM, ServoFrame};
 use crate::ardupilot::reply::{self, State};
-use crate::ardupilot::session::frame_step_us;
 use crate::kinematics::attitude_ned;
 use flyloop_core::faults::VehicleFaults;
 use flyloop_core::sensors::{ImuReading, Sensors};
@@ -52,6 +52,8 @@ pub struct ArduPilotMember {
     last_us: u64,
     /// The IMU sample last sent while faults act (what an off gyro or accel repeats).
     last_imu: Option<ImuReading>,
+    /// The frame rate it asks for, followed.
+    rate: FrameRate,
     pub peer: Option<SocketAddr>,
     pub stats: Counters,
 }
@@ -66,6 +68,7 @@ impl ArduPilotMember {
             reply: Vec::with_capacity(512),
             last_us: 0,
             last_imu: None,
+            rate: FrameRate::default(),
             peer: None,
             stats: Counters::default(),
         }
@@ -98,12 +101,13 @@ impl ArduPilotMember {
             self.sensors = self.start.clone();
             self.replied = None;
             self.last_us = now_us;
+            self.rate = FrameRate::default();
             self.peer = Some(from);
         }
         self.last = Some((frame.frame_count, from));
         Frame::New {
             command: self.command(&frame, rotors),
-            step_us: frame_step_us(frame.frame_rate),
+            step_us: self.rate.step_us(frame.frame_rate),
             first,
         }
     }

@@ -5,7 +5,8 @@
 //! - [`file`]: the fleet (autopilots, ports, system ids, start positions, vehicles),
 //! - [`lockstep`]: the barrier that lets autopilots of different step lengths share the
 //!   world's clock,
-//! - [`px4_member`], [`ardupilot_member`]: each autopilot's protocol, without sockets,
+//! - [`px4_member`], [`ardupilot_member`]: each autopilot's protocol, without sockets
+//!   ([`frame_rate`]: the step an ArduPilot's frame rate asks for),
 //! - [`server`]: the sockets, the wall clock, the timeouts,
 //! - [`outputs`], [`track`]: what is written beside the flight (`--track`),
 //! - [`view_record`]: the live view's stream and the recording (`--view`, `--record`).
@@ -15,6 +16,7 @@
 
 pub mod ardupilot_member;
 pub mod file;
+pub mod frame_rate;
 pub mod lockstep;
 pub mod outputs;
 pub mod px4_member;
