@@ -1,7 +1,7 @@
 //! One ArduPilot of the fleet, without sockets: servo packets in, JSON state lines out.
 
-use crate::ardupilot::faulted_imu;
 use super::frame_rate::FrameRate;
+use crate::ardupilot::faulted_imu;
 use crate::ardupilot::packet::{self, MAX_PWM, ServoFrame};
 use crate::ardupilot::reply::{self, State};
 use crate::kinematics::attitude_ned;
