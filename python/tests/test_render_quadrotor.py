@@ -1,7 +1,6 @@
 """QuadrotorView in rgb_array mode: frame format, and key elements drawn where the state says
 (pixel centroids of the hub and target colours against the camera projection)."""
 
-import math
 import os
 import subprocess
 import sys
@@ -98,7 +97,7 @@ def test_hub_tracks_a_moving_camera(view):
     s = scene(position=(0.5, 0.5, 1.0))
     view.render(s)
     view.camera.orbit(120.0, 15.0)
-    view.camera.move(0.3, -0.2, 0.1)
+    view.camera.look_at = view.camera.look_at + [0.3, -0.2, 0.1]
     frame = view.render(s)
     expected, _ = screen(view, np.array([0.5, 0.5, 1.0]))
     got, count = centroid(frame, qw.BODY)
@@ -116,29 +115,33 @@ def test_target_marker_is_where_the_target_is(view, target):
     assert np.hypot(*(got - expected)) < 3.0, (got, expected)
 
 
-def test_rotors_are_coloured_by_spin_at_their_px4_positions():
+@pytest.mark.parametrize("frame", ["quad_x", "hexa_x", "octo_x"])
+def test_each_rotor_is_drawn_coloured_by_spin_at_its_px4_position(frame):
     # Straight down from above, north up on screen; nose east (yaw 0).
     cam = OrbitCamera(look_at=np.array([0.0, 0.0, 1.0]), distance=3.0, azimuth_deg=0.0)
     cam.elevation_deg = 89.0
     v = QuadrotorView("rgb_array", width=640, height=480, hud=False, camera=cam)
-    s = scene(position=(0.0, 0.0, 1.0), motors=(0, 0, 0, 0))
-    frame = v.render(s).astype(float)
-    # PX4 quad-X: 0 front-right, 1 rear-left, 2 front-left, 3 rear-right; level, the nose
-    # (body +x) points east and the left (+y) north.
-    lever = s.arm_length * v.drone_scale / math.sqrt(2)
-    rotors = s.position + lever * np.array([(1, -1, 0), (-1, 1, 0), (1, 1, 0), (-1, -1, 0)])
+    table = flyloop._native.frames()[frame]  # (forward, left) in arm lengths, spin
+    s = scene(position=(0.0, 0.0, 1.0), motors=np.zeros(len(table)), frame=frame)
+    frame_px = v.render(s).astype(float)
+    # Level, the nose (body +x, forward) points east and the left (+y) north.
+    arm = s.arm_length * v.drone_scale
+    rotors = s.position + arm * np.array([(x, y, 0.0) for x, y, _ in table])
     uv, _ = screen(v, rotors)
-    ys, xs = np.mgrid[0 : frame.shape[0], 0 : frame.shape[1]]
-    for i, (u, w) in enumerate(uv):
+    ys, xs = np.mgrid[0 : frame_px.shape[0], 0 : frame_px.shape[1]]
+    drawn = []
+    for u, w in uv:
         # Sample a ring between the arm and the rim: the disc's own colour.
         r = np.hypot(xs - u, ys - w)
-        ring = (r > 4) & (r < 12)
-        red, green = frame[ring, 0].mean(), frame[ring, 1].mean()
-        ccw = i in (0, 1)
-        assert (green > red + 30) if ccw else (red > green + 30), (i, red, green)
-    # Motor 0 is front-right: east of the centre (nose east) and south (screen-down).
+        ring = (r > 4) & (r < 9)
+        red, green = frame_px[ring, 0].mean(), frame_px[ring, 1].mean()
+        drawn.append("CCW" if green > red + 30 else "CW" if red > green + 30 else "none")
+    assert drawn == ["CCW" if spin < 0 else "CW" for _, _, spin in table]
+    # Forward rotors east of the hub on screen, left ones north (up): the frame is not mirrored.
     centre, _ = screen(v, s.position)
-    assert uv[0][0] > centre[0] + 10 and uv[0][1] > centre[1] + 10
+    for (u, w), (x, y, _) in zip(uv, table, strict=True):
+        assert abs(x) < 0.1 or np.sign(u - centre[0]) == np.sign(x)
+        assert abs(y) < 0.1 or np.sign(centre[1] - w) == np.sign(y)
     v.close()
 
 

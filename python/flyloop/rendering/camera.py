@@ -27,7 +27,6 @@ class OrbitCamera:
     def __post_init__(self) -> None:
         self.look_at = np.asarray(self.look_at, dtype=float).reshape(3)
         self.elevation_deg = _clamp_elevation(self.elevation_deg)
-        self._home = (self.look_at.copy(), self.distance, self.azimuth_deg, self.elevation_deg)
         self._cache_key: tuple | None = None  # the pose _view last computed
 
     def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -60,22 +59,6 @@ class OrbitCamera:
         """Turn around the look-at point; elevation stays short of straight up/down."""
         self.azimuth_deg = (self.azimuth_deg + d_azimuth_deg) % 360.0
         self.elevation_deg = _clamp_elevation(self.elevation_deg + d_elevation_deg)
-
-    def ground_axes(self) -> tuple[np.ndarray, np.ndarray]:
-        """Unit vectors (forward, right) along the ground as the camera sees it."""
-        az = math.radians(self.azimuth_deg)
-        forward = np.array([math.sin(az), math.cos(az), 0.0])
-        return forward, np.array([forward[1], -forward[0], 0.0])
-
-    def move(self, forward: float, right: float, up: float) -> None:
-        """Shift the look-at point: forward/right along the ground as seen, up along +z."""
-        ahead, aside = self.ground_axes()
-        self.look_at = self.look_at + forward * ahead + right * aside + np.array([0, 0, up])
-
-    def reset(self) -> None:
-        """Back to the pose the camera was created with."""
-        look_at, self.distance, self.azimuth_deg, self.elevation_deg = self._home
-        self.look_at = look_at.copy()
 
 
 def _clamp_elevation(value: float) -> float:

@@ -271,19 +271,16 @@ class View:
         self._last_step = step
         return new_episode
 
-    def _events(self) -> list[Any] | None:
-        """This frame's window events; None once the user closed the window (QUIT, Escape)."""
+    def _drawable(self) -> bool:
+        """Whether to draw this frame: False once the user closed the window (QUIT, Escape)."""
         if self._closed:
             raise RuntimeError(f"this {type(self).__name__} is closed; create a new one to render")
-        if self.render_mode != "human" or not self.is_open:
-            return [] if self.is_open else None
-        pg = self._pg
-        events = pg.event.get()
-        for event in events:
-            if event.type == pg.QUIT or (event.type == pg.KEYDOWN and event.key == pg.K_ESCAPE):
-                self._shut()
-                return None
-        return events
+        if self.render_mode == "human" and self.is_open:
+            pg = self._pg
+            for event in pg.event.get():
+                if event.type == pg.QUIT or (event.type == pg.KEYDOWN and event.key == pg.K_ESCAPE):
+                    self._shut()
+        return self.is_open
 
     def _present(self) -> np.ndarray | None:
         """Show the frame (human, paced to fps) or return it as (H, W, 3) uint8."""

@@ -301,7 +301,7 @@ class LanderView(View):
 
     def render(self, scene: LanderScene) -> np.ndarray | None:
         """Draw one frame: returns it in rgb_array mode, None in human mode."""
-        if self._events() is None:
+        if not self._drawable():
             return None  # the user closed the window: nothing to draw on any more
         if self._follow(scene.step, scene.position):
             self._shades.clear()

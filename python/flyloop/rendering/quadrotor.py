@@ -1,5 +1,5 @@
 """The quadrotor view (tasks Hover and Waypoints): its scene, the 3D world through an orbit
-camera, the overlays and QuadrotorView with its window controls; the core's frames (world
+camera, the overlays and QuadrotorView; the core's frames (world
 ENU, body FLU, quaternion [w, x, y, z]) and PX4's motor order. Painter's algorithm: ground
 and lines, then solids far to near, the hub last (tests track its pixels)."""
 
@@ -8,7 +8,6 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
@@ -19,13 +18,10 @@ from .canvas import Painter, View
 
 # The core's quad X (core/src/quadrotor/frame.rs, PX4's motor order): rotor i sits at
 # (forward, left) * L/sqrt(2) in the body frame, spinning -1 counter-clockwise or +1 clockwise
-# seen from above. Read from the core's table, signs only, so the drawing stays as it was.
+# seen from above. The view's Frame.quad_x reads these signs (flyloop.view.scene).
 _QUAD_X = _native.frames()["quad_x"]
-ROTOR_POSITION_SIGNS = np.array(
-    [(math.copysign(1.0, x), math.copysign(1.0, y)) for x, y, _ in _QUAD_X]
-)
+ROTOR_POSITION_SIGNS = np.array([(math.copysign(1, x), math.copysign(1, y)) for x, y, _ in _QUAD_X])
 ROTOR_SPIN = tuple(spin for _, _, spin in _QUAD_X)
-ROTOR_NAMES = ("FR", "RL", "FL", "RR")
 GROUND, GRID, GRID_MAJOR, AXIS_X = (226, 230, 222), (188, 192, 186), (160, 165, 158), (220, 40, 40)
 AXIS_Y, AXIS_Z, BOUNDS, BODY = (30, 160, 60), (40, 90, 230), (150, 160, 200), (0, 100, 200)
 BODY_HIGHLIGHT, ROTOR_CCW, ROTOR_CW = (110, 175, 245), (70, 200, 90), (235, 90, 80)
@@ -34,14 +30,12 @@ WAYPOINT, UP, VELOCITY, WIND = (150, 60, 200), (255, 150, 0), (230, 0, 220), (20
 DROP, SHADOW, TRAIL = (128, 128, 128), (40, 40, 40), (60, 140, 220)
 TEXT, PANEL, BAD, BACKGROUND_TOP = (20, 20, 30), (255, 255, 236), (200, 0, 0), (232, 238, 248)
 BACKGROUND_BOTTOM = (246, 246, 250)
-ROTOR_COLORS = tuple(ROTOR_CCW if spin < 0 else ROTOR_CW for spin in ROTOR_SPIN)
-SPIN_NAMES = tuple("CCW" if spin < 0 else "CW" for spin in ROTOR_SPIN)
 
 
 @dataclass(frozen=True)
 class Rotors:
-    """A frame's rotors as drawn: position (forward, left) in arm lengths, colour, name and
-    spin name per rotor, in motor order."""
+    """A frame's rotors as drawn: position (forward, left) in arm lengths, colour, name
+    (compass sector: F, FL, L, RL, B, RR, R, FR) and spin name per rotor, in motor order."""
 
     positions: np.ndarray  # (n, 2)
     colors: tuple
@@ -49,28 +43,16 @@ class Rotors:
     spins: tuple[str, ...]
 
 
-def _sector(x: float, y: float) -> str:
-    """The compass name of the direction (x forward, y left) from the centre, in 45-degree
-    sectors: F, FL, L, RL, B, RR, R, FR."""
-    angle = math.degrees(math.atan2(y, x)) % 360.0
-    names = ("F", "FL", "L", "RL", "B", "RR", "R", "FR")
-    return names[round(angle / 45.0) % 8]
-
-
 @functools.cache
 def frame_rotors(frame: str) -> Rotors:
-    """The drawing of the core's shipped frame `frame` (its rotor table, `_native.frames()`);
-    the quad X as it was always drawn."""
-    if frame == "quad_x":
-        positions = ROTOR_POSITION_SIGNS / math.sqrt(2.0)
-        return Rotors(positions, ROTOR_COLORS, ROTOR_NAMES, SPIN_NAMES)
+    """The drawing of the core's shipped frame `frame` (its rotor table, `_native.frames()`)."""
     table = _native.frames()[frame]
-    spins = [spin for _, _, spin in table]
+    sectors = ("F", "FL", "L", "RL", "B", "RR", "R", "FR")
     return Rotors(
         np.array([(x, y) for x, y, _ in table]),
-        tuple(ROTOR_CCW if spin < 0 else ROTOR_CW for spin in spins),
-        tuple(_sector(x, y) for x, y, _ in table),
-        tuple("CCW" if spin < 0 else "CW" for spin in spins),
+        tuple(ROTOR_CCW if spin < 0 else ROTOR_CW for _, _, spin in table),
+        tuple(sectors[round(math.degrees(math.atan2(y, x)) % 360 / 45) % 8] for x, y, _ in table),
+        tuple("CCW" if spin < 0 else "CW" for _, _, spin in table),
     )
 
 
@@ -78,8 +60,6 @@ AXES = ((AXIS_X, "x E"), (AXIS_Y, "y N"), (AXIS_Z, "z"))
 TARGET_RADIUS_M, WAYPOINT_RADIUS_M, UP_ARROW_M, MAX_ARROW_M = 0.08, 0.06, 0.5, 2.0
 VELOCITY_SECONDS = 0.5  # the velocity arrow shows where the drone is in this many seconds
 WIND_M_PER_MPS = 0.12  # wind arrow length per m/s of wind
-DEGREES_PER_PIXEL, ZOOM_STEP, MIN_DISTANCE, MAX_DISTANCE = 0.3, 0.9, 0.5, 200.0
-MOVE_FRACTION = 0.012  # per frame, of the camera distance
 _CORE = HOVER.defaults  # what a scene shows when not told
 
 
@@ -187,11 +167,7 @@ def drone(p: Painter, pr: Projector, scene: QuadScene, scale: float) -> None:
     pos = scene.position
     arm = scene.arm_length * scale
     drawn = frame_rotors(scene.frame)
-    n = len(drawn.positions)
-    if scene.frame == "quad_x":
-        rotors = pos + np.c_[ROTOR_POSITION_SIGNS * (arm / math.sqrt(2.0)), np.zeros(4)] @ rot.T
-    else:
-        rotors = pos + np.c_[drawn.positions * arm, np.zeros(n)] @ rot.T
+    rotors = pos + np.c_[drawn.positions * arm, np.zeros(len(drawn.positions))] @ rot.T
     rotor_radius = 0.38 * arm
     disc_axes = rot.T[:2]  # body x and y in world coordinates
     cam = pr.camera
@@ -326,45 +302,6 @@ def motor_bars(p: Painter, scene: QuadScene) -> None:
         p.text(drawn.spins[i], (x + bar_w / 2, y0 + bar_h + 20), TEXT, 15, "midtop")
 
 
-def axis_gizmo(p: Painter, camera: OrbitCamera) -> None:
-    """Bottom-left: the world axes as the camera sees them (far axis drawn first)."""
-    height = p.surface.get_height()
-    origin = np.array([70.0, height - 70.0])
-    right, up, forward = camera.basis()
-    p.disc(origin, 50, (250, 250, 250), (180, 180, 180), 1)
-    items = []
-    for unit, (color, label) in zip(np.eye(3), AXES, strict=True):
-        tip = origin + np.array([unit @ right, -(unit @ up)]) * 36
-        items.append((float(unit @ forward), tip, color, label[0].upper()))
-    for _, tip, color, label in sorted(items, key=lambda item: -item[0]):
-        p.arrow(origin, tip, color, 3, head_px=8)
-        direction = tip - origin
-        norm = float(np.hypot(*direction))
-        label_at = tip + (direction / norm * 9 if norm > 1e-6 else 0)
-        p.text(label, label_at, color, 19, "center", bold=True)
-    p.disc(origin, 3, (0, 0, 0))
-
-
-def wind_dial(p: Painter, scene: QuadScene, camera: OrbitCamera) -> None:
-    """Top-right: the horizontal wind from above, up = where the camera looks; longer when
-    faster (full radius at 5 m/s)."""
-    width = p.surface.get_width()
-    center = np.array([width - 70.0, 72.0])
-    radius = 44.0
-    p.disc(center, radius, (255, 255, 255), (0, 0, 0), 2)
-    ground_forward, ground_right = camera.ground_axes()
-    dial = np.array([scene.wind @ ground_right, -(scene.wind @ ground_forward)])
-    speed = float(np.linalg.norm(scene.wind))
-    horizontal = float(np.hypot(*dial))
-    if horizontal > 0.05:
-        length = radius * 0.85 * min(1.0, 0.3 + horizontal / 5.0)
-        p.arrow(center, center + dial / horizontal * length, WIND, 4, head_px=11)
-    p.disc(center, 3, (0, 0, 0))
-    p.text("Wind", (center[0], center[1] - radius - 4), TEXT, 19, "midbottom", bold=True)
-    p.text(f"{speed:.2f} m/s", (center[0], center[1] + radius + 4), TEXT, 18, "midtop")
-    p.text(f"vz {scene.wind[2]:+.2f}", (center[0], center[1] + radius + 20), TEXT, 16, "midtop")
-
-
 LEGEND = (
     ("Drone body", BODY, "disc"),
     ("CCW rotor", ROTOR_CCW, "disc"),
@@ -380,10 +317,10 @@ LEGEND = (
 
 
 def legend(p: Painter) -> None:
-    """Right side, under the wind dial: what each colour means."""
+    """Top right: what each colour means."""
     width = p.surface.get_width()
     line_h = 20
-    x, y = width - 168, 170
+    x, y = width - 168, 20
     p.panel((x - 10, y - 8, 166, len(LEGEND) * line_h + 12), PANEL)
     for i, (label, color, kind) in enumerate(LEGEND):
         cy = y + i * line_h + 8
@@ -396,14 +333,12 @@ def legend(p: Painter) -> None:
         p.text(label, (x + 26, cy), TEXT, 17, "midleft")
 
 
-HINT = "drag: rotate   wheel: zoom   W/A/S/D: move   Q/E: down/up   R: reset   Esc: close"
-
-
 class QuadrotorView(View):
-    """Draws QuadScene frames: a window ("human") or (H, W, 3) uint8 arrays ("rgb_array").
-    In a window: drag to orbit, wheel to zoom, W/A/S/D to move, Q/E down/up, R to reset the
-    camera, Esc to close. The vehicle is drawn `drone_scale` times its size (a 0.1 m arm
-    stays visible); the trail keeps the episode's last `trail_steps` positions."""
+    """Draws QuadScene frames: a window ("human", Esc closes it) or (H, W, 3) uint8 arrays
+    ("rgb_array"), through `camera` (from the south-west unless given: to orbit, zoom and
+    scrub, watch the env in the Rerun view, flyloop.view.Watch). The vehicle is drawn
+    `drone_scale` times its size (a 0.1 m arm stays visible); the trail keeps the episode's
+    last `trail_steps` positions."""
 
     def __init__(
         self,
@@ -420,54 +355,15 @@ class QuadrotorView(View):
         self.drone_scale, self.hud, self.camera = float(drone_scale), hud, camera
         title = "flyloop - Quadrotor 3D"
         super().__init__(render_mode, (width, height), title, fps, max(2, trail_steps))
-        # W/S forward/back, D/A right/left, E/Q up/down.
-        moves = ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))
-        self._moves = {getattr(self._pg, f"K_{k}"): m for k, m in zip("wsdaeq", moves, strict=True)}
-        self._held: set[int] = set()
-        self._dragging = False
-
-    def _steer(self, camera: OrbitCamera, events: list[Any]) -> None:
-        """Apply this frame's events, then move for each key held or pressed in this frame (a
-        tap shorter than a frame still moves once). Held keys come from KEYDOWN/KEYUP events,
-        not pygame.key.get_pressed, so posted events move the camera as a person's do."""
-        pg = self._pg
-        tapped: set[int] = set()
-        for event in events:
-            if event.type in (pg.MOUSEBUTTONDOWN, pg.MOUSEBUTTONUP) and event.button == 1:
-                self._dragging = event.type == pg.MOUSEBUTTONDOWN
-            elif event.type == pg.MOUSEMOTION and self._dragging:
-                dx, dy = event.rel
-                # Dragging right turns the world right; dragging down looks from higher up.
-                camera.orbit(-dx * DEGREES_PER_PIXEL, dy * DEGREES_PER_PIXEL)
-            elif event.type == pg.MOUSEWHEEL:
-                distance = camera.distance * ZOOM_STEP ** float(event.y)
-                camera.distance = min(max(distance, MIN_DISTANCE), MAX_DISTANCE)
-            elif event.type == pg.KEYDOWN:
-                if event.key == pg.K_r:
-                    camera.reset()
-                elif event.key in self._moves:
-                    self._held.add(event.key)
-                    tapped.add(event.key)
-            elif event.type == pg.KEYUP:
-                self._held.discard(event.key)
-            elif event.type == pg.WINDOWFOCUSLOST:
-                self._held.clear()
-                self._dragging = False
-        step = MOVE_FRACTION * camera.distance
-        for key in self._held | tapped:
-            forward, right, up = self._moves[key]
-            camera.move(forward * step, right * step, up * step)
 
     def render(self, scene: QuadScene) -> np.ndarray | None:
         """Draw one frame: returns it in rgb_array mode, None in human mode."""
-        events = self._events()
+        if not self._drawable():
+            return None  # the user closed the window
         if self.camera is None:
             # Looking at the middle of the target box from the south-west, the box in view.
             h = scene.bounds_half_size
             self.camera = OrbitCamera(look_at=np.array([0.0, 0.0, 0.8 * h]), distance=4.2 * h)
-        if events is None:
-            return None  # the user closed the window
-        self._steer(self.camera, events)
         self._follow(scene.step, scene.position)
         p = self._painter
         width, height = self.size
@@ -477,9 +373,5 @@ class QuadrotorView(View):
         if self.hud:
             info_panel(p, scene)
             motor_bars(p, scene)
-            axis_gizmo(p, self.camera)
-            wind_dial(p, scene, self.camera)
             legend(p)
-            if self.render_mode == "human":  # bottom centre: how to move the camera
-                p.text(HINT, (width / 2, height - 8), (90, 90, 100), 17, "midbottom")
         return self._present()
