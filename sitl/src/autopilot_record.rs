@@ -2,7 +2,9 @@
 //! the MAVLink telemetry log of lockstep and real time ([`crate::record`]: each frame preceded
 //! by its simulation time in µs, big-endian), so one reader replays and plots every mode.
 //!
-//! Per connection of an autopilot: HOME_POSITION (the truth's local origin, `--home`). Per
+//! Per connection of an autopilot: HOME_POSITION (the truth's local origin, `--home`). Each
+//! line the session logs (the autopilot in lockstep, a fault that fires or clears) as
+//! STATUSTEXT from flyloop's system [`LINES_SYSTEM`] (the fleet's, 250). Per
 //! physics step: what the autopilot sent, as received (PX4: HIL_ACTUATOR_CONTROLS, with PX4's
 //! system id, stamped with the time it answers); the ground truth after the step
 //! (HIL_STATE_QUATERNION); the motor command the autopilot's outputs set (SERVO_OUTPUT_RAW,
@@ -21,12 +23,15 @@ use crate::telemetry;
 use crate::wire::Encoder;
 use flyloop_core::sensors::ImuReading;
 use flyloop_core::vehicle::Vehicle;
-use mavlink::dialects::common::MavMessage;
+use mavlink::dialects::common::{MavMessage, MavSeverity};
 use std::io;
 use std::path::Path;
 
 /// The system id of flyloop's truth in the recording (the view's and the lockstep's vehicle 1).
 const TRUTH_SYSTEM: u8 = 1;
+
+/// The system id of flyloop's own lines (STATUSTEXT): the fleet's, so one reader finds both.
+pub const LINES_SYSTEM: u8 = crate::fleet::server::FLEET_SYSTEM;
 
 /// The sensor samples the SITL sent the autopilot in one step.
 #[derive(Debug, Clone, Copy)]
@@ -51,6 +56,8 @@ pub struct AutopilotRecorder {
     frame: Vec<u8>,
     /// The systems whose HOME_POSITION is written (since the last connection).
     homes: Vec<u8>,
+    /// The last STATUSTEXT id (a long line's chunks share one).
+    texts: u16,
 }
 
 impl AutopilotRecorder {
@@ -62,6 +69,7 @@ impl AutopilotRecorder {
             home,
             frame: Vec::with_capacity(512),
             homes: Vec::new(),
+            texts: 0,
         })
     }
 
@@ -86,6 +94,14 @@ impl AutopilotRecorder {
             self.encoder.push(&mut self.frame, system_id, m);
         }
         self.write();
+    }
+
+    /// Appends a line flyloop logged at `time_us`: STATUSTEXT (chunked if long) from
+    /// [`LINES_SYSTEM`].
+    pub fn line(&mut self, time_us: u64, severity: MavSeverity, text: &str) {
+        self.texts = self.texts.wrapping_add(1).max(1);
+        let messages = telemetry::statustext(severity, text, self.texts);
+        self.messages(time_us, LINES_SYSTEM, &messages);
     }
 
     /// Appends the step that ended at `time_us`: truth, motor command, wind, sensor samples.

@@ -3,13 +3,15 @@
 //! preceded by 8 bytes, the vehicle's simulation time in µs (big-endian). Per step and
 //! vehicle: the ground truth (HIL_STATE_QUATERNION), the motor command (SERVO_OUTPUT_RAW),
 //! the wind (WIND_COV) and the task frame (DEBUG_FLOAT_ARRAY: reward, termination,
-//! observation, info). The same seeds and commands give the same bytes.
+//! observation, info). Each line announced to the ground station and the controllers (real
+//! time: a failsafe, an episode's reset) as STATUSTEXT from its vehicle. The same seeds and
+//! commands give the same bytes.
 
 use crate::kinematics::Home;
 use crate::telemetry;
 use crate::vehicle::Vehicle;
 use crate::wire::Encoder;
-use mavlink::dialects::common::MavMessage;
+use mavlink::dialects::common::{MavMessage, MavSeverity};
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
@@ -81,6 +83,8 @@ pub struct Recorder {
     out: TlogFile,
     encoder: Encoder,
     frame: Vec<u8>,
+    /// The last STATUSTEXT id (a long line's chunks share one).
+    texts: u16,
 }
 
 impl Recorder {
@@ -90,7 +94,20 @@ impl Recorder {
             out: TlogFile::create(path)?,
             encoder: Encoder::default(),
             frame: Vec::with_capacity(512),
+            texts: 0,
         })
+    }
+
+    /// Appends a line announced for vehicle `v` (STATUSTEXT, chunked if long, from its system
+    /// id at its simulation time).
+    pub fn line(&mut self, v: &Vehicle, severity: MavSeverity, text: &str) {
+        self.frame.clear();
+        self.texts = self.texts.wrapping_add(1).max(1);
+        for m in telemetry::statustext(severity, text, self.texts) {
+            self.frame.extend_from_slice(&v.clock_us.to_be_bytes());
+            self.encoder.push(&mut self.frame, v.system_id, &m);
+        }
+        self.out.write(&self.frame);
     }
 
     /// Appends what vehicle `v` did in the step that just ended (or the state a reset made).

@@ -30,6 +30,8 @@ pub struct SessionFaults {
     imu_only: bool,
     /// Events reported since the session last took them (for the track).
     reported: Vec<FaultEvent>,
+    /// The lines of faults that fired or cleared, until [`Self::take_lines`] (the recording's).
+    lines: Vec<String>,
 }
 
 /// Why ArduPilot mode refuses a fault of a sensor other than the IMU.
@@ -90,6 +92,7 @@ impl SessionFaults {
             next_poll_us: 0,
             imu_only: false,
             reported: Vec::new(),
+            lines: Vec::new(),
         })
     }
 
@@ -224,6 +227,7 @@ impl SessionFaults {
             for e in f.new_events() {
                 tracing::warn!(time_s = e.time, fault = %e.label, fired = e.fired, "fault injected on the control link");
                 self.reported.push(e.clone());
+                self.lines.push(event_line(e));
             }
         }
     }
@@ -235,16 +239,24 @@ impl SessionFaults {
             return;
         };
         for e in f.new_events() {
-            let text = if e.fired {
-                format!("fault fired: {} at {:.3} s", e.label, e.time)
-            } else {
-                format!("fault cleared: {} at {:.3} s", e.label, e.time)
-            };
+            let text = event_line(e);
             tracing::warn!("{text}");
             self.reported.push(e.clone());
             if let Some(control) = &mut self.control {
                 control.announce(MavSeverity::MAV_SEVERITY_WARNING, &text);
             }
+            self.lines.push(text);
         }
     }
+
+    /// The lines of the faults that fired or cleared since the last call.
+    pub fn take_lines(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.lines)
+    }
+}
+
+/// What is said of a fault that fired or cleared.
+fn event_line(e: &FaultEvent) -> String {
+    let what = if e.fired { "fired" } else { "cleared" };
+    format!("fault {what}: {} at {:.3} s", e.label, e.time)
 }

@@ -15,7 +15,7 @@ use crate::autopilot_record::{AutopilotRecorder, Sent};
 use crate::kinematics::attitude_ned;
 use flyloop_core::faults::FaultEvent;
 use flyloop_core::vehicle::Vehicle;
-use mavlink::dialects::common::MavMessage;
+use mavlink::dialects::common::{MavMessage, MavSeverity};
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
@@ -195,6 +195,24 @@ impl SessionTrack {
     pub fn received(&mut self, time_us: u64, system_id: u8, message: &MavMessage) {
         if let Some(recording) = &mut self.recording {
             recording.received(time_us, system_id, message);
+        }
+    }
+
+    /// A line the session logged at `time_us` (the autopilot in lockstep) into the
+    /// recording, as STATUSTEXT (INFO).
+    pub fn info(&mut self, time_us: u64, text: &str) {
+        if let Some(recording) = &mut self.recording {
+            recording.line(time_us, MavSeverity::MAV_SEVERITY_INFO, text);
+        }
+    }
+
+    /// The lines of faults that fired or cleared at `time_us` into the recording, as
+    /// STATUSTEXT (WARNING, as on the control link).
+    pub fn fault_lines(&mut self, time_us: u64, lines: &[String]) {
+        if let Some(recording) = &mut self.recording {
+            for text in lines {
+                recording.line(time_us, MavSeverity::MAV_SEVERITY_WARNING, text);
+            }
         }
     }
 

@@ -15,7 +15,7 @@ from ardupilot_support import GUIDED, TAKEOFF_ALT, settle
 from flyloop.plot import series_of
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "view"))
-from tlog import tlog_by_type  # noqa: E402
+from tlog import statustexts, tlog_by_type  # noqa: E402
 
 
 def test_ardupilot_takeoff_recorded_with_outputs_imu_and_truth(pair, tmp_path):
@@ -47,6 +47,11 @@ def test_ardupilot_takeoff_recorded_with_outputs_imu_and_truth(pair, tmp_path):
     assert all(m.servo5_raw == 0 for _, m in servo)
     # The IMU sample: about -g on z at rest (FRD specific force); accel and gyro flagged.
     assert abs(imu[0][1].zacc + 9.81) < 0.5 and imu[0][1].fields_updated == 0x3F
+
+    # flyloop's own line, as STATUSTEXT from its system 250 (the fleet's): ArduPilot connected.
+    lines = statustexts(by_type)
+    assert [(s, text) for _, s, text in lines] == [(250, "ArduPilot: connection 1: in lockstep")]
+    assert lines[0][0] <= states[0][0]
 
     # The truth equals the track's (mm against the CSV's 0.1 mm) at every step.
     ground = by_type["HOME_POSITION"][0][1].altitude / 1000

@@ -24,21 +24,10 @@ from test_fleet_px4 import start_fleet
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "view"))
 from flight import free_port  # noqa: E402
 from test_view_fleet import clusters  # noqa: E402
-from tlog import tlog_by_type  # noqa: E402
+from tlog import statustexts, tlog_by_type  # noqa: E402
 
 STEP_US = 4000
 FLEET_SYSTEM = 250
-
-
-def statustexts(by_type) -> list[tuple[int, int, str]]:
-    """(time µs, system id, text) of every STATUSTEXT, chunks joined."""
-    out, parts = [], {}
-    for t, m in by_type.get("STATUSTEXT", []):
-        key = (m.get_srcSystem(), m.id)
-        parts.setdefault(key, []).append(m.text)
-        if m.id == 0 or len(m.text) < 50:
-            out.append((t, m.get_srcSystem(), "".join(parts.pop(key))))
-    return out
 
 
 def test_two_px4s_in_the_view_and_the_recording_with_their_collision(

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import re
+import sys
 import time
 from pathlib import Path
 
@@ -22,6 +23,9 @@ from px4_support import (
     truth_vs_estimate,
 )
 from pymavlink import mavutil
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "view"))
+from tlog import statustexts, tlog_by_type  # noqa: E402
 
 
 def px4_texts(px4, seconds: float) -> list[tuple[float, str, int]]:
@@ -48,8 +52,9 @@ def px4_texts(px4, seconds: float) -> list[tuple[float, str, int]]:
 AUTO_LAND = 0x06040000
 
 
-def test_px4_loses_gps_in_a_hover_and_lands(pair):
-    flyloop = pair.flyloop("--control", "127.0.0.1:0")
+def test_px4_loses_gps_in_a_hover_and_lands(pair, tmp_path):
+    tlog = tmp_path / "gps.tlog"
+    flyloop = pair.flyloop("--control", "127.0.0.1:0", "--record", str(tlog))
     px4 = pair.px4()
     _, target = launch(px4)
     settle(px4, target, 0.5, 60)
@@ -71,6 +76,12 @@ def test_px4_loses_gps_in_a_hover_and_lands(pair):
     assert any(mode == AUTO_LAND for _, _, mode in events), events
     assert rows[-1]["grounded"] == 1.0, rows[-1]
     assert "Failsafe: blind land" in console and "Disarmed by landing" in console, said
+    # The recording holds the fault as flyloop's line (STATUSTEXT from its system 250), at
+    # the simulation time it fired.
+    fired = [(t, text) for t, s, text in statustexts(tlog_by_type(tlog)) if "fault" in text]
+    assert len(fired) == 1, fired
+    t, text = fired[0]
+    assert text == f"fault fired: sensor_off:gps at {t / 1e6:.3f} s", fired
 
 
 HEXA = Path(__file__).resolve().parents[2] / "sitl" / "presets" / "px4_hexa_x.toml"

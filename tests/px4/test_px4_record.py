@@ -15,7 +15,7 @@ from flyloop.plot import series_of
 from px4_support import TAKEOFF_ALT, settle
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "view"))
-from tlog import tlog_by_type  # noqa: E402
+from tlog import statustexts, tlog_by_type  # noqa: E402
 
 STEP_US = 4000
 
@@ -52,6 +52,13 @@ def test_px4_takeoff_recorded_with_controls_sensors_and_truth(pair, tmp_path):
     got = np.array([[m.servo1_raw, m.servo2_raw, m.servo3_raw, m.servo4_raw] for _, m in pairs])
     assert np.array_equal(want, got)
     assert got.max() > 1300, "PX4 spun the motors up"
+
+    # flyloop's own line, as STATUSTEXT from its system 250 (the fleet's), at its time: PX4's
+    # first controls, the start of lockstep.
+    lines = statustexts(by_type)
+    first = controls[0][0]
+    said = f"PX4: first controls at t={first / 1e6:.3f} s: in lockstep"
+    assert lines == [(first, 250, said)], lines
 
     # The truth equals the track's (1e-7 deg, mm against the CSV's 0.1 mm) at every row.
     alt = {t: m.alt / 1000 for t, m in states}

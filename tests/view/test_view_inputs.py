@@ -22,6 +22,7 @@ from flyloop.view import Watch, WatchVector
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "sitl"))
 from sitl_client import Client, Sitl, mavlink2  # noqa: E402
+from tlog import statustexts, tlog_by_type  # noqa: E402
 
 
 def run(*args: str, timeout: float = 60, env=None) -> subprocess.CompletedProcess:
@@ -68,6 +69,34 @@ def test_sitl_recording_holds_every_step_and_is_reproducible(binary, tmp_path):
         f"SITL recording: {len(a)} bytes for {t[-1] - t[0]:.2f} s:"
         f" {minute / 2**20:.2f} MiB per simulated minute"
     )
+
+
+def test_a_real_time_recording_holds_the_failsafe_line_at_its_step(binary, tmp_path):
+    """--record in real time: the line the controller is sent when its commands stop (the
+    failsafe) is in the .tlog as STATUSTEXT from the vehicle, at the simulation time of a
+    recorded step (pymavlink reads it back)."""
+    tlog = tmp_path / "rt.tlog"
+    args = ["--realtime", "--failsafe-timeout", "0.3", "--gcs", "off", "--record", str(tlog)]
+    sitl = Sitl(binary, *args)
+    client = Client(sitl.address)
+    try:
+        client.param_set("en_crash_det", 0)  # on the ground the episode goes on
+        client.reset(1)
+        end, hover = time.monotonic() + 0.5, [(9.81 / 40) ** 0.5] * 4
+        while time.monotonic() < end:
+            client.send_raw(client.controls(hover))
+            client.drain(0.02)
+        sent = [m for m in client.drain(1.0) if m.get_type() == "STATUSTEXT"]
+    finally:
+        client.close()
+        assert sitl.stop() == 0
+    by_type = tlog_by_type(tlog)
+    lines = statustexts(by_type)
+    failsafe = "vehicle 1: no command for 0.3 s, motors off (failsafe)"
+    assert [(system, text) for _, system, text in lines] == [(1, failsafe)], lines
+    assert "".join(m.text for m in sent) == failsafe  # what the controller got
+    steps = {t for t, _ in by_type["HIL_STATE_QUATERNION"]}
+    assert lines[0][0] in steps and 0.5e6 < lines[0][0] < 1.5e6, lines[0][0]
 
 
 def test_env_watch_records_every_step(tmp_path):

@@ -43,7 +43,7 @@ ESTIMATE_STREAMS = (
 GENERIC = mavlink2.MAV_AUTOPILOT_GENERIC
 AUTOPILOTS = {mavlink2.MAV_AUTOPILOT_PX4: "PX4", mavlink2.MAV_AUTOPILOT_ARDUPILOTMEGA: "ArduPilot"}
 ARRAY_LEN = 58  # DEBUG_FLOAT_ARRAY values per message (protocol.md §6)
-FLEET_SYSTEM = 250  # flyloop-sitl's fleet: its STATUSTEXT (docs/fleet.md)
+FLEET_SYSTEM = 250  # flyloop-sitl's own lines (a fleet's, an autopilot session's): STATUSTEXT
 COLLISION = "collision"  # the NAMED_VALUE_FLOAT a fleet sends for each vehicle in a collision
 TEXT_CHUNK = 50  # STATUSTEXT characters per message: a longer text comes in chunks
 # MAV_SEVERITY → the events log's level
@@ -216,7 +216,7 @@ class MavlinkScene:
         if self.is_autopilot(key):
             name = f"vehicle{self._truth_of(key)}_autopilot"
         else:
-            name = "fleet" if key[1] == FLEET_SYSTEM else f"vehicle{key[1]}"
+            name = "flyloop" if key[1] == FLEET_SYSTEM else f"vehicle{key[1]}"
         self.scene.event(name, text, LEVELS[min(m.severity, len(LEVELS) - 1)])
 
     # ---- an autopilot's estimate ----

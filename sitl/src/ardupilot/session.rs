@@ -295,6 +295,11 @@ impl Session {
         self.faults.restart();
         self.link_line.clear();
         self.track.connect();
+        let line = format!(
+            "ArduPilot: connection {}: in lockstep",
+            self.stats.connections
+        );
+        self.track.info(self.time_us, &line);
     }
 
     /// The vehicle and IMU back to their start state, physics time to 0.
@@ -342,6 +347,8 @@ impl Session {
         let step_us = frame_step_us(frame.frame_rate);
         let dt = step_us as f64 * 1e-6;
         (self.faults).advance(self.vehicle.as_mut(), self.time_us, dt);
+        let lines = self.faults.take_lines();
+        self.track.fault_lines(self.time_us, &lines);
         self.time_us += step_us;
         let k = self.vehicle.kinematics();
         let mut imu = self.sensors.sample_imu(&k, dt);

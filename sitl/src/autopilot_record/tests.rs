@@ -43,9 +43,19 @@ fn decode(frame: &[u8]) -> (u8, MavMessage) {
 
 /// A PX4 flight of `steps` controls at 0.7, recorded; the recording and the bytes sent.
 fn px4_flight(name: &str, seed: u64, steps: usize) -> (Vec<u8>, Vec<u8>) {
+    px4_flight_of(AutopilotVehicle::iris(), name, seed, steps)
+}
+
+/// [`px4_flight`] of `vehicle`.
+fn px4_flight_of(
+    vehicle: AutopilotVehicle,
+    name: &str,
+    seed: u64,
+    steps: usize,
+) -> (Vec<u8>, Vec<u8>) {
     let path = temp_path(name);
     let mut s = px4::session::Session::new(&px4::session::SessionOptions {
-        vehicle: AutopilotVehicle::iris(),
+        vehicle,
         step_us: 4000,
         seed,
     })
@@ -90,7 +100,13 @@ fn a_px4_step_holds_its_controls_the_sensors_sent_the_truth_motors_and_wind() {
     assert!(matches!(messages[0].2, MavMessage::HOME_POSITION(_)));
     let mut controls = 0;
     let mut servo = 0;
+    let mut lines = Vec::new();
     for (time, system_id, m) in &messages {
+        if let MavMessage::STATUSTEXT(s) = m {
+            assert_eq!(*system_id, super::LINES_SYSTEM);
+            lines.push((*time, s.text.to_str().unwrap().to_string()));
+            continue;
+        }
         assert_eq!(*system_id, 1);
         match m {
             MavMessage::HIL_ACTUATOR_CONTROLS(c) => {
@@ -114,6 +130,8 @@ fn a_px4_step_holds_its_controls_the_sensors_sent_the_truth_motors_and_wind() {
             other => panic!("unexpected {other:?}"),
         }
     }
+    let lockstep = "PX4: first controls at t=0.004 s: in lockstep";
+    assert_eq!(lines, [(4000, lockstep.to_string())]);
     assert_eq!((controls, servo), (300, 301));
     // 0.7 on every motor lifts the Iris: the recorded truth climbs.
     let last_alt = messages.iter().rev().find_map(|(_, _, m)| match m {
@@ -130,6 +148,31 @@ fn the_same_seed_and_controls_give_the_same_recording() {
     assert_eq!(a, b);
     let (c, _) = px4_flight("same-c", 8, 100);
     assert_ne!(a, c, "the seed reaches the sensor noise");
+}
+
+#[test]
+fn the_lockstep_line_and_a_fault_that_fires_and_clears_are_statustext_from_system_250() {
+    let faults = "[[faults]]\nkind = \"motor_off\"\nmotor = 1\nat = 0.1\nduration = 0.2";
+    let text = format!("{}\n{faults}", crate::config::IRIS_PRESET);
+    let vehicle = AutopilotVehicle::parse(&text).unwrap();
+    let (bytes, _) = px4_flight_of(vehicle, "lines", 1, 100);
+    let lines: Vec<(u64, u8, String)> = tlog_frames(&bytes)
+        .iter()
+        .filter_map(|(t, f)| match decode(f) {
+            (id, MavMessage::STATUSTEXT(s)) => Some((*t, id, s.text.to_str().unwrap().to_string())),
+            _ => None,
+        })
+        .collect();
+    let expect = [
+        (4000, "PX4: first controls at t=0.004 s: in lockstep"),
+        (100_000, "fault fired: motor_off:1 at 0.100 s"),
+        (300_000, "fault cleared: motor_off:1 at 0.300 s"),
+    ];
+    let got: Vec<(u64, &str)> = lines.iter().map(|(t, _, s)| (*t, s.as_str())).collect();
+    assert_eq!(got, expect);
+    assert!(lines.iter().all(|(_, id, _)| *id == super::LINES_SYSTEM));
+    let (same, _) = px4_flight_of(AutopilotVehicle::parse(&text).unwrap(), "lines-2", 1, 100);
+    assert_eq!(bytes, same, "the same seed and controls: the same bytes");
 }
 
 #[test]
@@ -176,6 +219,12 @@ fn an_ardupilot_step_holds_its_imu_the_motor_pwm_truth_and_wind() {
             MavMessage::HIL_STATE_QUATERNION(_)
             | MavMessage::WIND_COV(_)
             | MavMessage::HOME_POSITION(_) => {}
+            MavMessage::STATUSTEXT(s) => {
+                assert_eq!(
+                    (*time, s.text.to_str().unwrap()),
+                    (0, "ArduPilot: connection 1: in lockstep")
+                );
+            }
             other => panic!("unexpected {other:?}"),
         }
     }

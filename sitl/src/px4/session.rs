@@ -194,6 +194,9 @@ impl Session {
                     if !self.lockstep {
                         tracing::info!(time_us = self.time_us, "first controls from PX4: lockstep");
                         self.lockstep = true;
+                        let t = self.time_us as f64 * 1e-6;
+                        let line = format!("PX4: first controls at t={t:.3} s: in lockstep");
+                        self.track.info(self.time_us, &line);
                     }
                     self.advance(out);
                     steps += 1;
@@ -239,6 +242,8 @@ impl Session {
         let start = Instant::now();
         let dt = self.step_us as f64 * 1e-6;
         (self.faults).advance(self.vehicle.as_mut(), self.time_us, dt);
+        let lines = self.faults.take_lines();
+        self.track.fault_lines(self.time_us, &lines);
         self.time_us += self.step_us;
         self.stats.steps += 1;
         self.emit(out);

@@ -25,9 +25,12 @@ impl Sim {
         }
     }
 
-    /// A STATUSTEXT to the ground station and every live controller peer.
+    /// A STATUSTEXT to the ground station, every live controller peer and the recording.
     fn announce(&mut self, i: usize, severity: MavSeverity, text: &str) {
         tracing::info!("{text}");
+        if let Some(r) = &mut self.recorder {
+            r.line(&self.vehicles[i], severity, text);
+        }
         let mut gcs = std::mem::take(&mut self.gcs_outbox);
         self.push_text(Link::Gcs, &mut gcs, i, severity, text);
         self.gcs_outbox = gcs;
