@@ -15,10 +15,13 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from fleet_support import read_track
+from ardupilot_support import ArduPilot, ardupilot_ports_free
+from ardupilot_support import collect as ap_collect
+from fleet_support import HOME, FleetSitl, free_block, read_track
 from flyloop.plot import series_of
 from flyloop.view.screenshot import Browser, hub_pixels
-from px4_support import collect, launch, settle
+from px4_support import Px4, collect, fresh_dir, launch, px4_ports_free, settle
+from test_fleet_mixed import quiet
 from test_fleet_px4 import start_fleet
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "view"))
@@ -133,3 +136,124 @@ def test_two_px4s_in_the_view_and_the_recording_with_their_collision(
         assert len(replayed[f"/position/vehicle{s}/D/truth"][0]) == len(times[s])
         assert len(replayed[f"/sensors/vehicle{s}/accel/z"][0]) == len(sensors[s])
         assert f"/task/vehicle{s}/collision_speed" in replayed
+
+
+AP_SYSID = 240
+
+
+def test_a_px4_and_an_ardupilot_in_the_view_and_the_recording(
+    started, sitl_binary, px4_dir, ardupilot, tmp_path
+):
+    """A fleet file with one PX4 and one ArduPilot, 4 m apart on the ground: Chromium draws
+    both hubs, the .tlog holds both truths at every world step (each equal to the --track's)
+    with each autopilot's sensor samples and the fleet's lines, and the view's .rrd holds
+    each autopilot's estimate beside its truth (PX4's from its ground-station port,
+    ArduPilot's from its --serial1 telemetry)."""
+    px4_base = free_block(1, px4_ports_free, 10, 150)
+    ap_base = free_block(1, ardupilot_ports_free, 3, 150)
+    fleet = tmp_path / "fleet.toml"
+    fleet.write_text(
+        f'[[vehicle]]\nautopilot = "px4"\ninstance = {px4_base}\nposition = [0.0, 0.0]\n\n'
+        f'[[vehicle]]\nautopilot = "ardupilot"\ninstance = {ap_base}\nsysid = {AP_SYSID}\n'
+        "position = [0.0, 4.0]\n"
+    )
+    truth_port, ap_port = free_port(), free_port()
+    tlog, rrd, track = tmp_path / "fleet.tlog", tmp_path / "fleet.rrd", tmp_path / "track.csv"
+    sitl = FleetSitl(
+        sitl_binary, fresh_dir("flyloop-fleet-view-mixed-"), "--fleet", str(fleet),
+        "--view", f"127.0.0.1:{truth_port}", "--record", str(tlog), "--track", str(track),
+        speed=1,
+    )  # fmt: skip
+    started.append(sitl)
+    web, grpc = free_port(socket.SOCK_STREAM), free_port(socket.SOCK_STREAM)
+    view = subprocess.Popen(
+        [
+            sys.executable, "-m", "flyloop.view",
+            "--listen", f"127.0.0.1:{truth_port}", "--listen", f"127.0.0.1:{ap_port}",
+            "--connect", f"127.0.0.1:{18570 + px4_base}",
+            "--web-port", str(web), "--grpc-port", str(grpc),
+            "--save", str(rrd), "--wait", "120",
+        ],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        url = view.stdout.readline().split("open ", 1)[1].strip()
+        px4 = Px4(px4_dir, px4_base, fresh_dir("px4-fleet-view-mixed-"))
+        started.append(px4)
+        home = ",".join(str(v) for v in HOME)
+        ap = ArduPilot(
+            ardupilot, ap_base, 9002 + 10 * ap_base, fresh_dir("ap-fleet-view-mixed-"),
+            "--home", home, "--sysid", str(AP_SYSID),
+            "--serial1", f"udpclient:127.0.0.1:{ap_port}",
+        )  # fmt: skip
+        started.append(ap)
+        px4.heartbeat(120)
+        ap.connect(60)
+        quiet(ap)
+        browser = Browser()
+        try:
+            browser.open(url)
+            shot, _ = browser.wait_for_vehicle(60, timeout=120, until=lambda p: clusters(p) == 2)
+            (tmp_path / "fleet_mixed.png").write_bytes(shot)
+        finally:
+            browser.close()
+        # ArduPilot reports a local position (its estimate's) once its EKF has a GPS origin,
+        # ~40 s into the flight: from then on for 2 s.
+        ap.wait_for_gps(120)
+        ap_collect(ap, 2.0)
+    finally:
+        view.send_signal(signal.SIGINT)
+        view.wait(timeout=30)
+        sitl.stop()
+    assert view.returncode == 0, view.stderr.read()
+    assert clusters(hub_pixels(shot)) == 2, tmp_path
+
+    systems = (px4.target, AP_SYSID)
+    by_type = tlog_by_type(tlog)
+    states: dict[int, list] = {s: [] for s in systems}
+    for t, m in by_type["HIL_STATE_QUATERNION"]:
+        states[m.get_srcSystem()].append((t, m))
+    homes = {m.get_srcSystem(): m for _, m in by_type["HOME_POSITION"]}
+    assert sorted(homes) == sorted(systems)
+    # Every world step holds both vehicles' truth: the same times for both.
+    times = {s: [t for t, _ in states[s]] for s in systems}
+    assert times[px4.target] == times[AP_SYSID] and len(times[AP_SYSID]) > 5000
+    # Each autopilot's sensor samples under its own system id, from its connection on: PX4's
+    # one per 4 ms step, ArduPilot's IMU one per step it was due.
+    sensors = {s: [t for t, m in by_type["HIL_SENSOR"] if m.get_srcSystem() == s] for s in systems}
+    assert min(len(sensors[s]) for s in systems) > 1000, {s: len(v) for s, v in sensors.items()}
+    assert set(np.diff(sensors[px4.target][-500:])) == {STEP_US}
+    assert np.all(np.diff(sensors[AP_SYSID]) > 0)
+    # The truth equals the track's at every row of each vehicle; the two stand 4 m apart.
+    ground = homes[px4.target].altitude / 1000
+    tracks = read_track(track)
+    names = {px4.target: f"px4-{px4_base:03d}", AP_SYSID: f"ardupilot-{ap_base:03d}"}
+    assert sorted(tracks) == sorted(names.values())
+    for s in systems:
+        rows = tracks[names[s]]
+        down = {t: -(m.alt / 1000 - ground) for t, m in states[s]}
+        gap = [abs(down[int(r["time_us"])] - r["down"]) for r in rows if r["time_us"] in down]
+        assert len(gap) > 0.9 * len(rows) and max(gap) < 0.002, (s, len(gap), max(gap))
+    last = {s: tracks[names[s]][-1] for s in systems}
+    north = last[AP_SYSID]["north"] - last[px4.target]["north"]
+    assert abs(north - 4.0) < 0.2, last  # the fleet file's position = [north, east]
+    (_, a), (_, b) = states[px4.target][-1], states[AP_SYSID][-1]
+    # 1e-7 degree of latitude is 11.13 mm.
+    apart = np.hypot(
+        (a.lat - b.lat) * 0.01113, (a.lon - b.lon) * 0.01113 * np.cos(np.radians(47.4))
+    )
+    assert abs(apart - 4.0) < 0.2, apart
+    lines = [text for _, s, text in statustexts(by_type) if s == FLEET_SYSTEM]
+    assert any("PX4 connected" in t for t in lines), lines
+    assert any("ArduPilot connected" in t for t in lines), lines
+
+    # The view drew both truths and each autopilot's estimate beside its truth (both on the
+    # ground: their heights within 0.5 m); ArduPilot's from its GPS origin on only.
+    series = series_of(rrd)
+    for s, least in ((px4.target, 100), (AP_SYSID, 20)):
+        t_true, d_true = series[f"/position/vehicle{s}/D/truth"]
+        t_est, d_est = series[f"/position/vehicle{s}/D/estimate"]
+        assert len(t_true) > 1000 and len(t_est) >= least, (s, len(t_true), len(t_est))
+        both = t_est <= t_true[-1]
+        gap = np.abs(d_est[both] - np.interp(t_est[both], t_true, d_true))
+        assert gap.max() < 0.5, (s, gap.max())
