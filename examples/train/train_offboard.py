@@ -90,6 +90,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--eval-episodes", type=int, default=task.eval_episodes)
     parser.add_argument("--out", type=Path, default=Path("runs/offboard"))
     parser.add_argument("--no-progress-bar", action="store_true")
+    # fast_ppo.train reads fast_ppo's --init (a run to continue); this run starts fresh.
+    parser.set_defaults(init=None)
     args = parser.parse_args(argv)
     args.env = TASK
     cfg = task.config
