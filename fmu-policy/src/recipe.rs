@@ -4,6 +4,7 @@
 //! names the file and the field it failed on.
 
 use crate::error::PolicyError;
+use flyloop_core::tasks::flight::base_observation;
 use flyloop_core::tasks::flight_link::ESTIMATE_OBSERVATION;
 use serde::Deserialize;
 use std::path::Path;
@@ -36,20 +37,10 @@ pub enum Interface {
 }
 
 /// The observation groups of the "hover-motors" recipe (the gym's QuadHover motor
-/// interface), with their sizes for `rotors` motors.
+/// interface), with their sizes for `rotors` motors: the core's own table, so the two cannot
+/// drift apart.
 pub fn hover_motors_layout(rotors: usize) -> Vec<(&'static str, usize)> {
-    vec![
-        ("target_offset", 3),
-        ("velocity", 3),
-        ("acceleration", 3),
-        ("quaternion", 4),
-        ("body_rates", 3),
-        ("angular_acceleration", 3),
-        ("body_z_axis", 3),
-        ("wind", 3),
-        ("motor_states", rotors),
-        ("motor_commands", rotors),
-    ]
+    base_observation(rotors).to_vec()
 }
 
 /// `recipe.json` as read.
