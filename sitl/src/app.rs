@@ -229,13 +229,13 @@ fn start_fleet(args: Args) -> Result<(), StartError> {
     let sockets = fleet::server::bind(&fleet)
         .map_err(|(name, addr, source)| StartError::FleetBind { name, addr, source })?;
     let outputs = fleet_outputs(&args, &fleet)?;
-    let ports: Vec<String> = (fleet.members().iter())
-        .map(|m| {
+    let ports: Vec<String> = (fleet.members().iter().zip(&sockets))
+        .map(|(m, socket)| {
             format!(
                 "{}:{}:{}:{}",
                 m.name,
                 m.autopilot.name(),
-                m.listen.port(),
+                socket.port().unwrap_or(m.listen.port()),
                 m.sysid
             )
         })

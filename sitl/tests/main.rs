@@ -2,6 +2,7 @@
 //! its own binary meant one more link, with LTO in release, per file).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod fleet_paced_start;
 mod handler_fuzz;
 mod inject_failure;
 mod link_faults;

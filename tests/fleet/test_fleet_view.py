@@ -15,7 +15,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import pytest
 from ardupilot_support import ArduPilot, ardupilot_ports_free
 from ardupilot_support import collect as ap_collect
 from fleet_support import HOME, FleetSitl, free_block, read_track
@@ -34,11 +33,6 @@ STEP_US = 4000
 FLEET_SYSTEM = 250
 
 
-@pytest.mark.skip(
-    reason="flaky since this session's fleet changes (CI on ec71d8a): a PX4 of the fleet got no "
-    "sensors ([simulator_mavlink] poll timeout) and never sent a heartbeat; the same stall as "
-    "the mixed test below; to run it, remove this mark"
-)
 def test_two_px4s_in_the_view_and_the_recording_with_their_collision(
     started, sitl_binary, px4_dir, tmp_path
 ):
@@ -147,11 +141,6 @@ def test_two_px4s_in_the_view_and_the_recording_with_their_collision(
 AP_SYSID = 240
 
 
-@pytest.mark.skip(
-    reason="flaky, about 1 run in 4: the ArduPilot gets no JSON reply from the fleet and never "
-    "sends a heartbeat (cause not found yet; tests/fleet/test_fleet_mixed.py flies ArduPilots "
-    "in a fleet); to run it, remove this mark"
-)
 def test_a_px4_and_an_ardupilot_in_the_view_and_the_recording(
     started, sitl_binary, px4_dir, ardupilot, tmp_path
 ):

@@ -139,13 +139,16 @@ pub fn row(
     };
     let vehicles = (0..n)
         .map(|i| {
-            let port = u16::try_from(usize::from(base.port()) + stride * i).map_err(|_| {
-                FleetError(format!(
-                    "--vehicles {n}: vehicle {i}'s port {} + {} is past 65535",
-                    base.port(),
-                    stride * i
-                ))
-            })?;
+            // Port 0: every vehicle on an ephemeral port of its own (the ready line says which).
+            let port = match base.port() {
+                0 => 0,
+                first => u16::try_from(usize::from(first) + stride * i).map_err(|_| {
+                    FleetError(format!(
+                        "--vehicles {n}: vehicle {i}'s port {first} + {} is past 65535",
+                        stride * i
+                    ))
+                })?,
+            };
             // The instance whose default port this is sets (PX4) or is given (ArduPilot)
             // system id instance + 1; off the default ports, vehicle i's is i + 1.
             let instance = match autopilot {
@@ -333,7 +336,10 @@ impl FleetSpec {
             for (i, a) in v[..j].iter().enumerate() {
                 let clash = if a.name == b.name {
                     Some(format!("name `{}`", b.name))
-                } else if a.listen.port() == b.listen.port() && a.autopilot == b.autopilot {
+                } else if a.listen.port() == b.listen.port()
+                    && a.listen.port() != 0
+                    && a.autopilot == b.autopilot
+                {
                     Some(format!("port {}", b.listen.port()))
                 } else if a.sysid == b.sysid {
                     Some(format!("sysid {}", b.sysid))

@@ -27,6 +27,16 @@ pub enum Socket {
     ArduPilot(UdpSocket),
 }
 
+impl Socket {
+    /// The port it is bound to (an ephemeral one when asked for port 0).
+    pub fn port(&self) -> io::Result<u16> {
+        match self {
+            Socket::Px4(listener) => listener.local_addr().map(|a| a.port()),
+            Socket::ArduPilot(socket) => socket.local_addr().map(|a| a.port()),
+        }
+    }
+}
+
 /// How the fleet runs.
 #[derive(Debug, Clone, Copy)]
 pub struct FleetOptions {
@@ -388,6 +398,13 @@ impl Serving {
             }
             let t = self.fleet.lockstep().now_us();
             pacer::wait_for(self.options.pacing, &mut self.anchor, t, now);
+            if !lockstep {
+                // One free step per call: the next is due at `next_free`, which `serve`
+                // waits for while it hears the sockets. Looping here instead never let a
+                // paced fleet hear its starting PX4's first controls, a second PX4's
+                // connection or a stop: the pacer's sleep ends at `next_free` or after it.
+                return;
+            }
         }
     }
 
