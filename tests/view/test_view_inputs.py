@@ -6,6 +6,7 @@ traceback alone, never a hang."""
 from __future__ import annotations
 
 import os
+import signal
 import socket
 import subprocess
 import sys
@@ -174,7 +175,7 @@ def test_a_foreign_recording_is_one_line(tmp_path, content, expected):
     path.write_bytes(content)
     for args in (
         ["-m", "flyloop.plot", str(path)],
-        ["-m", "flyloop.view", str(path), "--seconds", "0"],
+        ["-m", "flyloop.view", str(path), "--seconds", "0", *free_view_ports()],
     ):
         out = run(*args)
         assert out.returncode == 1 and "Traceback" not in out.stderr, out.stderr
@@ -183,6 +184,31 @@ def test_a_foreign_recording_is_one_line(tmp_path, content, expected):
             and str(path) in out.stderr
             and len(out.stderr.strip().splitlines()) == 1
         )
+
+
+def free_view_ports() -> list[str]:
+    """--web-port and --grpc-port on free ports (not 9090/9876: another view may hold them)."""
+    web, grpc = free_port(socket.SOCK_STREAM), free_port(socket.SOCK_STREAM)
+    return ["--web-port", str(web), "--grpc-port", str(grpc)]
+
+
+def test_a_view_port_in_use_is_one_line(tmp_path):
+    """Regression: with its gRPC port taken (another view), the view printed the SDK's
+    errors and a traceback; now one line naming the port and the option."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        for option in ("--grpc-port", "--web-port"):
+            other = "--web-port" if option == "--grpc-port" else "--grpc-port"
+            out = run(
+                "-m", "flyloop.view", "--listen", f"127.0.0.1:{free_port()}", "--wait", "1",
+                option, str(port), other, str(free_port(socket.SOCK_STREAM)),
+            )  # fmt: skip
+            assert out.returncode == 1 and "Traceback" not in out.stderr, out.stderr
+            assert len(out.stderr.strip().splitlines()) == 1, out.stderr
+            assert f"port {port}: Address already in use" in out.stderr, out.stderr
+            assert option in out.stderr, out.stderr
 
 
 def test_a_truncated_recording_replays_what_it_holds(binary, tmp_path):
@@ -295,3 +321,41 @@ def test_frames_drawn_for_each_motor_count(n):
     assert len(f.rotors) == len(f.spins) == n and sum(f.spins) == 0
     radii = np.linalg.norm(f.rotors, axis=1)
     assert np.allclose(radii, radii[0]) and radii[0] > 0
+
+
+def test_a_view_slower_than_its_stream_stops_at_ctrl_c():
+    """Regression: a view that could not keep up with the MAVLink arriving (a loaded machine,
+    a fleet's stream) never left its read loop, so Ctrl-C never ended the watch and the view
+    ran until killed. Here a sender floods it with vehicle states far faster than it draws
+    them; Ctrl-C must still stop it, with its recording closed, within seconds."""
+    port = free_port()
+    view = subprocess.Popen(
+        [
+            sys.executable, "-m", "flyloop.view", "--listen", f"127.0.0.1:{port}",
+            "--web-port", str(free_port(socket.SOCK_STREAM)),
+            "--grpc-port", str(free_port(socket.SOCK_STREAM)),
+        ],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    mav = mavlink2.MAVLink(None, srcSystem=1)
+    state = mav.hil_state_quaternion_encode(
+        0, [1.0, 0.0, 0.0, 0.0], 0, 0, 0, 473977420, 85455940, 490000, 0, 0, 0, 0, 0, 0, 0, 0
+    )
+    datagram = state.pack(mav) * 8
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as flood:
+        try:
+            view.stdout.readline()  # the URL
+            view.stdout.readline()  # listening
+            end, sent = time.monotonic() + 3.0, 0
+            while time.monotonic() < end:
+                flood.sendto(datagram, ("127.0.0.1", port))
+                sent += 8
+            view.send_signal(signal.SIGINT)
+            stop = time.monotonic() + 15.0
+            while view.poll() is None and time.monotonic() < stop:
+                flood.sendto(datagram, ("127.0.0.1", port))  # the flood goes on
+                time.sleep(0.0005)
+            assert view.poll() == 0, f"no exit within 15 s of Ctrl-C ({sent} states sent)"
+        finally:
+            view.kill()
+            view.wait()

@@ -5,6 +5,7 @@ from a recording (.tlog of ``flyloop-sitl --record``, .rrd of ``--save`` and of 
 
 from __future__ import annotations
 
+import socket
 import time
 import urllib.parse
 import uuid
@@ -40,6 +41,21 @@ def new_stream() -> rr.RecordingStream:
     return rr.RecordingStream(APPLICATION, recording_id=uuid.uuid4())
 
 
+def _check_port_free(port: int, option: str, what: str) -> None:
+    """ViewError naming `option` when TCP `port` on 127.0.0.1 cannot be bound (0: any)."""
+    if port == 0:
+        return
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            probe.bind(("127.0.0.1", port))
+        except OSError as e:
+            raise ViewError(
+                f"cannot serve {what} port {port}: {e.strerror} (another flyloop.view? "
+                f"choose a free one with {option})"
+            ) from None
+
+
 class Viewer:
     """A recording stream served to Rerun's web viewer (``url``), and/or saved (``save``)."""
 
@@ -62,6 +78,10 @@ class Viewer:
                 raise ViewError(f"cannot write the recording {save}: {e.strerror}") from None
             sinks.append(rr.FileSink(str(save)))
         if serve:
+            # The SDK binds in a thread of its own and only logs a port in use: ask first.
+            _check_port_free(grpc_port, "--grpc-port", "the data's gRPC")
+            if web_port is not None:
+                _check_port_free(web_port, "--web-port", "the viewer's HTTP")
             sinks.append(rr.GrpcServerSink("127.0.0.1", grpc_port))
         try:
             self.rec.set_sinks(*sinks, default_blueprint=blueprint())

@@ -34,6 +34,8 @@ STREAMS = (
     mavlink2.MAVLINK_MSG_ID_DEBUG_FLOAT_ARRAY,
 )
 STREAM_INTERVAL_US = 40_000
+# Datagrams one listener handles per poll before the others (and the watch's clock) get a turn.
+BATCH_DATAGRAMS = 64
 # What the view asks an autopilot for at the same rate: its estimate.
 ESTIMATE_STREAMS = (
     mavlink2.MAVLINK_MSG_ID_LOCAL_POSITION_NED,
@@ -323,11 +325,13 @@ class Listener:
     def fileno(self) -> int:
         return self.sock.fileno()
 
-    def poll(self) -> int:
-        """Handles every datagram waiting; returns how many messages."""
+    def poll(self, most: int = BATCH_DATAGRAMS) -> int:
+        """Handles the datagrams waiting, at most `most` of them; returns how many messages.
+        Bounded: a view slower than its stream (a loaded machine) would otherwise never
+        leave this loop, nor hear Ctrl-C's end of the watch."""
         n = 0
         self._beat()
-        while True:
+        for _ in range(most):
             try:
                 data, peer = self.sock.recvfrom(65536)
             except (BlockingIOError, InterruptedError):
@@ -346,6 +350,7 @@ class Listener:
                         self._ask(peer, STREAM_INTERVAL_US)
                     elif msg.autopilot in AUTOPILOTS:
                         self._greet(peer)
+        return n
 
     def _commands(self, peer: tuple, commands: list[tuple]) -> None:
         """COMMAND_LONGs (command, param1, param2) to every system at `peer`, one datagram:
