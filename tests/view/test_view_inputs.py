@@ -327,7 +327,9 @@ def test_a_view_slower_than_its_stream_stops_at_ctrl_c():
     """Regression: a view that could not keep up with the MAVLink arriving (a loaded machine,
     a fleet's stream) never left its read loop, so Ctrl-C never ended the watch and the view
     ran until killed. Here a sender floods it with vehicle states far faster than it draws
-    them; Ctrl-C must still stop it, with its recording closed, within seconds."""
+    them; Ctrl-C must still stop it, with its recording closed, within seconds. It is
+    started the way a script's background job starts it, with SIGINT ignored (the second
+    regression: Python then left Ctrl-C ignored)."""
     port = free_port()
     view = subprocess.Popen(
         [
@@ -336,6 +338,7 @@ def test_a_view_slower_than_its_stream_stops_at_ctrl_c():
             "--grpc-port", str(free_port(socket.SOCK_STREAM)),
         ],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN),
     )  # fmt: skip
     mav = mavlink2.MAVLink(None, srcSystem=1)
     state = mav.hil_state_quaternion_encode(
@@ -359,3 +362,37 @@ def test_a_view_slower_than_its_stream_stops_at_ctrl_c():
         finally:
             view.kill()
             view.wait()
+
+
+def test_sigterm_ends_a_watch_with_its_recording_written(tmp_path):
+    """A supervisor's SIGTERM stops the view like Ctrl-C: exit 0, the .rrd complete (its
+    footer written) with the states that arrived."""
+    port, rrd = free_port(), tmp_path / "term.rrd"
+    view = subprocess.Popen(
+        [
+            sys.executable, "-m", "flyloop.view", "--listen", f"127.0.0.1:{port}",
+            "--web-port", str(free_port(socket.SOCK_STREAM)),
+            "--grpc-port", str(free_port(socket.SOCK_STREAM)), "--save", str(rrd),
+        ],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    mav = mavlink2.MAVLink(None, srcSystem=3)
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as out:
+        try:
+            view.stdout.readline()  # the URL
+            view.stdout.readline()  # listening
+            for k in range(50):
+                state = mav.hil_state_quaternion_encode(
+                    20_000 * (k + 1), [1.0, 0.0, 0.0, 0.0], 0, 0, 0,
+                    473977420, 85455940, 490000 + 10 * k, 0, 0, 0, 0, 0, 0, 0, 0,
+                )  # fmt: skip
+                out.sendto(state.pack(mav), ("127.0.0.1", port))
+                time.sleep(0.01)
+            time.sleep(0.5)
+            view.send_signal(signal.SIGTERM)
+            assert view.wait(timeout=30) == 0, view.stderr.read()
+        finally:
+            view.kill()
+            view.wait()
+    t, _ = series_of(rrd)["/position/vehicle3/D/truth"]
+    assert len(t) == 50 and t[-1] == pytest.approx(1.0), (len(t), t[-1:])

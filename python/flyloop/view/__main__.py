@@ -10,6 +10,7 @@ It prints the URL to open. docs/view.md says more."""
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 import time
 
@@ -63,8 +64,17 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     return p.parse_args(argv)
 
 
+def _stop(signum: int, frame) -> None:
+    raise KeyboardInterrupt
+
+
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
+    # Ctrl-C and a supervisor's SIGTERM both end the watch with the recording written out,
+    # also when started from a script whose background jobs ignore SIGINT (Python then
+    # leaves it ignored, and the view could only be killed, its .rrd cut short).
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.signal(signal.SIGTERM, _stop)
     try:
         viewer = Viewer(web_port=args.web_port, grpc_port=args.grpc_port, save=args.save)
     except ViewError as e:
