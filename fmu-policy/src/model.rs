@@ -15,10 +15,10 @@ use crate::network::Network;
 use crate::observation::{MOTOR_STATES, commands, normalised, observation};
 use crate::ports;
 use crate::recipe::Recipe;
-use flyloop_core::params::{ParamSpec, Parameters, ValueKind};
+use flyloop_core::params::{ParamSpec, Parameters};
 use flyloop_core::snapshot;
 use flyloop_core::variables::{InputRow, OutputRow, VariableTable};
-use flyloop_core::{InputError, ParamError, SnapshotError};
+use flyloop_core::{InputError, ParamError, SnapshotError, param};
 use flyloop_fmu::model::FmuModel;
 use serde::{Deserialize, Serialize};
 use std::cell::RefCell;
@@ -83,36 +83,9 @@ impl Default for Target {
 const TARGET_RANGE: f64 = 1e4;
 
 static TARGET_SPECS: [ParamSpec<Target>; 3] = [
-    ParamSpec {
-        name: "target_x",
-        unit: "m",
-        kind: ValueKind::Real,
-        min: -TARGET_RANGE,
-        max: TARGET_RANGE,
-        description: "Target east in the plant's frame (world ENU)",
-        get: |t| t.target_x,
-        set: |t, v| t.target_x = v,
-    },
-    ParamSpec {
-        name: "target_y",
-        unit: "m",
-        kind: ValueKind::Real,
-        min: -TARGET_RANGE,
-        max: TARGET_RANGE,
-        description: "Target north in the plant's frame (world ENU)",
-        get: |t| t.target_y,
-        set: |t, v| t.target_y = v,
-    },
-    ParamSpec {
-        name: "target_z",
-        unit: "m",
-        kind: ValueKind::Real,
-        min: -TARGET_RANGE,
-        max: TARGET_RANGE,
-        description: "Target height in the plant's frame (world ENU)",
-        get: |t| t.target_z,
-        set: |t, v| t.target_z = v,
-    },
+    param!(real target_x, "m", -TARGET_RANGE, TARGET_RANGE, "Target east in the plant's frame (world ENU)"),
+    param!(real target_y, "m", -TARGET_RANGE, TARGET_RANGE, "Target north in the plant's frame (world ENU)"),
+    param!(real target_z, "m", -TARGET_RANGE, TARGET_RANGE, "Target height in the plant's frame (world ENU)"),
 ];
 
 impl Parameters for Target {
@@ -130,16 +103,9 @@ pub struct PolicyStart {
     pub initial_motor: f64,
 }
 
-static START_SPECS: [ParamSpec<PolicyStart>; 1] = [ParamSpec {
-    name: "initial_motor",
-    unit: "1",
-    kind: ValueKind::Real,
-    min: 0.0,
-    max: 1.0,
-    description: "Motor command before the first tick (the plant's initial_motor)",
-    get: |s| s.initial_motor,
-    set: |s, v| s.initial_motor = v,
-}];
+static START_SPECS: [ParamSpec<PolicyStart>; 1] = [
+    param!(real initial_motor, "1", 0.0, 1.0, "Motor command before the first tick (the plant's initial_motor)"),
+];
 
 impl Parameters for PolicyStart {
     fn specs() -> &'static [ParamSpec<Self>] {
