@@ -204,6 +204,29 @@ pub trait VariableTable: Sized + 'static {
     fn set_parameter(&mut self, name: &'static str, value: f64) -> Result<(), ParamError>;
 }
 
+/// The members of a [`VariableTable`] impl that are the same for every model whose table
+/// never changes (`Shape = ()`): its rows are copies of the slices `$inputs` and `$outputs`.
+/// The impl adds `Params`, `Initial`, `params` and `set_parameter`, e.g.
+/// `impl VariableTable for M { type Params = P; type Initial = I; fixed_shape!(INPUTS, OUTPUTS); … }`.
+#[macro_export]
+macro_rules! fixed_shape {
+    ($inputs:expr, $outputs:expr) => {
+        type Shape = ();
+
+        fn inputs(_: &()) -> Vec<$crate::variables::InputRow<Self>> {
+            $inputs.to_vec()
+        }
+
+        fn outputs(_: &()) -> Vec<$crate::variables::OutputRow<Self>> {
+            $outputs.to_vec()
+        }
+
+        fn shape(&self) -> &() {
+            &()
+        }
+    };
+}
+
 /// Where a value reference points in a table ([`Rows::row`]): an input or output by its
 /// position in the rows, or a parameter row. Plain data, so a front end can look it up once
 /// and read through it on every call.

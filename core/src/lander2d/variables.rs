@@ -161,19 +161,7 @@ fn set_wind<const I: usize>(lander: &mut Lander2d, value: f64) -> Result<(), Inp
 impl VariableTable for Lander2d {
     type Params = Lander2dParams;
     type Initial = Lander2dInitial;
-    type Shape = ();
-
-    fn inputs(_: &()) -> Vec<InputRow<Self>> {
-        INPUTS.to_vec()
-    }
-
-    fn outputs(_: &()) -> Vec<OutputRow<Self>> {
-        OUTPUTS.to_vec()
-    }
-
-    fn shape(&self) -> &() {
-        &()
-    }
+    crate::fixed_shape!(INPUTS, OUTPUTS);
 
     fn params(&self) -> &Lander2dParams {
         Lander2d::params(self)

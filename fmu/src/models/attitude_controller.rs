@@ -18,7 +18,7 @@ use crate::table::ModelInfo;
 use flyloop_core::params::{ParamSpec, Parameters};
 use flyloop_core::snapshot;
 use flyloop_core::variables::{InputRow, OutputRow, Rows, VariableTable};
-use flyloop_core::{InputError, ParamError, SnapshotError, param};
+use flyloop_core::{InputError, ParamError, SnapshotError, fixed_shape, param};
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
 use std::f64::consts::PI;
@@ -224,19 +224,7 @@ static OUTPUTS: [OutputRow<AttitudeController>; 4] = [
 impl VariableTable for AttitudeController {
     type Params = AttitudeControllerParams;
     type Initial = NoStartValues;
-    type Shape = ();
-
-    fn inputs(_: &()) -> Vec<InputRow<Self>> {
-        INPUTS.to_vec()
-    }
-
-    fn outputs(_: &()) -> Vec<OutputRow<Self>> {
-        OUTPUTS.to_vec()
-    }
-
-    fn shape(&self) -> &() {
-        &()
-    }
+    fixed_shape!(INPUTS, OUTPUTS);
 
     fn params(&self) -> &AttitudeControllerParams {
         &self.params

@@ -20,7 +20,7 @@ use flyloop_core::params::{ParamSpec, Parameters};
 use flyloop_core::rate_loop::{RateLoop, RatesSetpoint};
 use flyloop_core::snapshot;
 use flyloop_core::variables::{InputRow, OutputRow, Rows, VariableTable};
-use flyloop_core::{InputError, ParamError, SnapshotError};
+use flyloop_core::{InputError, ParamError, SnapshotError, fixed_shape};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
@@ -243,19 +243,7 @@ static OUTPUTS: [OutputRow<RateController>; 4] = [
 impl VariableTable for RateController {
     type Params = Px4RateParams;
     type Initial = NoStartValues;
-    type Shape = ();
-
-    fn inputs(_: &()) -> Vec<InputRow<Self>> {
-        INPUTS.to_vec()
-    }
-
-    fn outputs(_: &()) -> Vec<OutputRow<Self>> {
-        OUTPUTS.to_vec()
-    }
-
-    fn shape(&self) -> &() {
-        &()
-    }
+    fixed_shape!(INPUTS, OUTPUTS);
 
     fn params(&self) -> &Px4RateParams {
         &self.px4_params
