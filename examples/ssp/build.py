@@ -17,7 +17,7 @@ from xml.sax.saxutils import quoteattr
 import fmpy
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from systems import SYSTEMS, Component, System  # noqa: E402
+from systems import PARAMETER_SET, SYSTEMS, Component, System  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 NS = (
@@ -25,10 +25,6 @@ NS = (
     'xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" '
     'xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues"'
 )
-
-# Every component's bindings share this name: ecos applies the named set at init (its
-# convention's name), fmpy gets them merged (engines.py).
-PARAMETER_SET = "initialValues"
 
 
 class WiringError(ValueError):

@@ -12,6 +12,7 @@ libcosim's fixed-step algorithm does as ecos does.
 So the two runs are the same closed loop sampled alike but not bit for bit the same.
 """
 
+import sys
 import time
 from pathlib import Path
 
@@ -19,7 +20,8 @@ import numpy as np
 from fmpy.ssp.simulation import simulate_ssp
 from fmpy.ssp.ssd import ParameterSet, read_ssd
 
-PARAMETER_SET = "initialValues"  # build.py's name of the components' parameter bindings
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from systems import PARAMETER_SET  # noqa: E402
 
 ENGINES = ("fmpy", "ecos", "libcosim")
 NANOSECONDS = 1_000_000_000  # libcosim's time unit

@@ -15,6 +15,9 @@ import tomllib
 
 HOVER = (9.81 / 40) ** 0.5  # motor state / normalised thrust that carries the 1 kg default quad X
 START_Z = 1.0  # m: the controller systems start at rest at this height
+# Every component's bindings share this name (build.py writes it): ecos applies the named set
+# at init (its convention's name), fmpy gets them merged (engines.py).
+PARAMETER_SET = "initialValues"
 
 # The policy systems fly a gym episode: the start and target QuadHover-v0 draws for the seed
 # (level start, no wind; tests/fmu/test_fmu_ssp.py checks the gym draws these), so the FMU
