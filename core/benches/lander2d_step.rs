@@ -14,6 +14,8 @@ use flyloop_core::tasks::Task;
 use flyloop_core::tasks::landing::{Landing, LandingParams};
 use std::hint::black_box;
 
+mod common;
+
 fn run(
     c: &mut Criterion,
     name: &str,
@@ -27,17 +29,7 @@ fn run(
         None => task.reset(0),
     };
     restart(&mut task);
-    let mut obs = [0f32; 12];
-    c.bench_function(name, |b| {
-        b.iter(|| {
-            let out = task.step(black_box(&action)).expect("valid action");
-            if out.terminated || out.truncated {
-                restart(&mut task);
-            }
-            task.write_observation(&mut obs[..task.observation_size()]);
-            black_box(&obs);
-        })
-    });
+    common::task_steps(c, name, &mut task, &action, restart);
 }
 
 fn lander2d_step(c: &mut Criterion) {

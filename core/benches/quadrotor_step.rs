@@ -16,12 +16,13 @@ use flyloop_core::tasks::hover::Hover;
 use nalgebra::Vector3;
 use std::hint::black_box;
 
+mod common;
+
 fn quadrotor_step(c: &mut Criterion) {
     let params = QuadrotorParams::default();
     let hover = params.hover_motor_state().unwrap_or(0.5);
-    let body = BodyState::at_rest(Vector3::new(0.0, 0.0, 1.5), 0.05, -0.03, 0.1, hover);
-    let mut quad = Quadrotor::new(params, body, SimRng::new(1)).expect("valid defaults");
-    quad.set_command([hover; 4]).expect("finite command");
+    let (position, attitude) = (Vector3::new(0.0, 0.0, 1.5), [0.05, -0.03, 0.1]);
+    let mut quad = common::hovering(params, position, attitude, 1);
     c.bench_function("quadrotor_control_step_10ms", |b| {
         b.iter(|| {
             quad.step(black_box(0.01));
@@ -32,8 +33,7 @@ fn quadrotor_step(c: &mut Criterion) {
         wind_enabled: false,
         ..QuadrotorParams::default()
     };
-    let mut calm = Quadrotor::new(still, body, SimRng::new(1)).expect("valid defaults");
-    calm.set_command([hover; 4]).expect("finite command");
+    let mut calm = common::hovering(still, position, attitude, 1);
     c.bench_function("quadrotor_control_step_10ms_no_wind", |b| {
         b.iter(|| {
             calm.step(black_box(0.01));
@@ -52,9 +52,8 @@ fn quadrotor_step(c: &mut Criterion) {
     // Other frames (issue 33): the same flight, six and eight rotors at their hover state.
     for name in ["hexa_x", "octo_x"] {
         let frame = Frame::named(name).expect("shipped frame");
-        let mut multi = Quadrotor::new(QuadrotorParams::default(), body, SimRng::new(1))
-            .expect("valid defaults")
-            .with_frame(frame);
+        let quad = common::hovering(QuadrotorParams::default(), position, attitude, 1);
+        let mut multi = quad.with_frame(frame);
         let h = multi.hover_motor_state().unwrap_or(0.5);
         multi
             .set_command(vec![h; multi.frame().rotor_count()])
@@ -71,17 +70,14 @@ fn quadrotor_step(c: &mut Criterion) {
     let mut task =
         Hover::new(QuadrotorParams::default(), FlightParams::default()).expect("valid defaults");
     let action = [hover; 4];
-    let mut obs = [0f32; 33];
-    c.bench_function("hover_task_step_with_observation", |b| {
-        b.iter(|| {
-            let out = task.step(black_box(&action)).expect("valid action");
-            if out.terminated || out.truncated {
-                task.reset(0);
-            }
-            task.write_observation(&mut obs);
-            black_box(&obs);
-        })
-    });
+    let restart = |task: &mut Hover| task.reset(0);
+    common::task_steps(
+        c,
+        "hover_task_step_with_observation",
+        &mut task,
+        &action,
+        restart,
+    );
 }
 
 criterion_group!(benches, quadrotor_step);

@@ -8,12 +8,13 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use flyloop_core::SimRng;
-use flyloop_core::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
+use flyloop_core::quadrotor::QuadrotorParams;
 use flyloop_core::sensors::{SensorParams, Sensors};
 use flyloop_core::vehicle::Vehicle;
 use nalgebra::Vector3;
 use std::hint::black_box;
+
+mod common;
 
 const DT: f64 = 0.004;
 
@@ -22,10 +23,7 @@ fn sensors_step(c: &mut Criterion) {
         wind_enabled: false,
         ..QuadrotorParams::default()
     };
-    let hover = params.hover_motor_state().unwrap_or(0.5);
-    let body = BodyState::at_rest(Vector3::new(0.0, 0.0, 5.0), 0.05, -0.03, 0.1, hover);
-    let mut quad = Quadrotor::new(params, body, SimRng::new(1)).unwrap();
-    quad.set_command([hover; 4]).unwrap();
+    let mut quad = common::hovering(params, Vector3::new(0.0, 0.0, 5.0), [0.05, -0.03, 0.1], 1);
     let mut sensors = Sensors::new(SensorParams::default(), 1).unwrap();
     c.bench_function("sensors_sample", |b| {
         b.iter(|| black_box(sensors.sample(black_box(&quad.kinematics()), DT)))

@@ -6,11 +6,12 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use flyloop_core::SimRng;
-use flyloop_core::quadrotor::{BodyState, Quadrotor, QuadrotorParams};
+use flyloop_core::quadrotor::{Quadrotor, QuadrotorParams};
 use flyloop_core::world::{World, WorldParams};
 use nalgebra::Vector3;
 use std::hint::black_box;
+
+mod common;
 
 /// N quads hovering on a square lattice 1 m apart, every third one 0.5 m higher.
 fn fleet(n: usize) -> Vec<(String, Quadrotor)> {
@@ -22,11 +23,7 @@ fn fleet(n: usize) -> Vec<(String, Quadrotor)> {
                 (k / side) as f64,
                 5.0 + 0.5 * (k % 3) as f64,
             );
-            let params = QuadrotorParams::default();
-            let hover = params.hover_motor_state().unwrap();
-            let body = BodyState::at_rest(position, 0.0, 0.0, 0.0, hover);
-            let mut quad = Quadrotor::new(params, body, SimRng::new(k as u64)).unwrap();
-            quad.set_command([hover; 4]).unwrap();
+            let quad = common::hovering(QuadrotorParams::default(), position, [0.0; 3], k as u64);
             (format!("v{k:04}"), quad)
         })
         .collect()

@@ -14,6 +14,9 @@ use std::ffi::CString;
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
 
+#[path = "../../fmu/benches/common/mod.rs"]
+mod common;
+
 fn folder() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../policies/hexa_hover")
 }
@@ -22,30 +25,10 @@ fn instance() -> fmi3Instance {
     flyloop_fmu_policy::register();
     let table = &table_for(&folder()).unwrap().table;
     let resources = CString::new(folder().display().to_string()).unwrap();
-    // SAFETY: valid strings; no logger (FMI 3.0 allows NULL).
-    unsafe {
-        let c = fmi3InstantiateCoSimulation(
-            c"bench".as_ptr(),
-            table.token3.as_ptr(),
-            resources.as_ptr(),
-            0,
-            0,
-            0,
-            0,
-            std::ptr::null(),
-            0,
-            std::ptr::null_mut(),
-            None,
-            None,
-        );
-        assert!(!c.is_null());
-        assert_eq!(
-            fmi3EnterInitializationMode(c, 0, 0.0, 0.0, 0, 0.0),
-            fmi3Status::fmi3OK
-        );
-        assert_eq!(fmi3ExitInitializationMode(c), fmi3Status::fmi3OK);
-        c
-    }
+    let c = common::initializing3(table, Some(&resources));
+    // SAFETY: a live instance.
+    assert_eq!(unsafe { fmi3ExitInitializationMode(c) }, fmi3Status::fmi3OK);
+    c
 }
 
 fn bench(c: &mut Criterion) {

@@ -15,76 +15,37 @@ use flyloop_fmu::fmi3_types::{fmi3Instance, fmi3Status};
 use flyloop_fmu::models::tables;
 use std::hint::black_box;
 
-#[allow(dead_code)]
-#[path = "../tests/support/importer_logger.rs"]
-mod importer_logger;
+mod common;
 
 fn instance(hover: f64) -> fmi2Component {
-    let callbacks = Box::leak(Box::new(importer_logger::callbacks(
-        importer_logger::quiet,
-        std::ptr::null_mut(),
-    )));
     let table = tables()[0];
     let vr = |name: &str| table.by_name(name).unwrap().value_reference;
-    // SAFETY: valid strings, callbacks leaked for the process's lifetime.
+    let c = common::initializing2(table);
+    let vrs = ["initial_motor", "seed"].map(vr);
+    // SAFETY: a live instance, arrays of the lengths passed.
     unsafe {
-        let c = fmi2Instantiate(
-            c"bench".as_ptr(),
-            fmi2CoSimulation,
-            table.guid.as_ptr(),
-            std::ptr::null(),
-            callbacks,
-            fmi2False,
-            fmi2False,
-        );
-        assert!(!c.is_null());
-        assert_eq!(
-            fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0),
-            fmi2Status::fmi2OK
-        );
-        assert_eq!(fmi2EnterInitializationMode(c), fmi2Status::fmi2OK);
-        let names = ["initial_motor", "seed"];
-        let vrs = names.map(vr);
         assert_eq!(fmi2SetReal(c, vrs.as_ptr(), 1, &hover), fmi2Status::fmi2OK);
         assert_eq!(
             fmi2SetInteger(c, vrs[1..].as_ptr(), 1, &1),
             fmi2Status::fmi2OK
         );
         assert_eq!(fmi2ExitInitializationMode(c), fmi2Status::fmi2OK);
-        c
     }
+    c
 }
 
 fn instance3(hover: f64) -> fmi3Instance {
     let table = tables()[0];
     let vr = |name: &str| table.by_name(name).unwrap().value_reference;
-    // SAFETY: valid strings; no logger (FMI 3.0 allows NULL).
+    let c = common::initializing3(table, None);
+    let (motor, seed) = (vr("initial_motor"), vr("seed"));
+    // SAFETY: a live instance, one value each.
     unsafe {
-        let c = fmi3InstantiateCoSimulation(
-            c"bench".as_ptr(),
-            table.token3.as_ptr(),
-            std::ptr::null(),
-            0,
-            0,
-            0,
-            0,
-            std::ptr::null(),
-            0,
-            std::ptr::null_mut(),
-            None,
-            None,
-        );
-        assert!(!c.is_null());
-        assert_eq!(
-            fmi3EnterInitializationMode(c, 0, 0.0, 0.0, 0, 0.0),
-            fmi3Status::fmi3OK
-        );
-        let (motor, seed) = (vr("initial_motor"), vr("seed"));
         assert_eq!(fmi3SetFloat64(c, &motor, 1, &hover, 1), fmi3Status::fmi3OK);
         assert_eq!(fmi3SetInt32(c, &seed, 1, &1, 1), fmi3Status::fmi3OK);
         assert_eq!(fmi3ExitInitializationMode(c), fmi3Status::fmi3OK);
-        c
     }
+    c
 }
 
 fn do_step3(c: &mut Criterion, hover: f64, outputs: &[u32]) {

@@ -13,40 +13,18 @@ use flyloop_fmu::fmi2_types::*;
 use flyloop_fmu::models::tables;
 use std::hint::black_box;
 
-#[allow(dead_code)]
-#[path = "../tests/support/importer_logger.rs"]
-mod importer_logger;
+mod common;
 
 const TICK: f64 = 0.004;
 
 /// An initialised RateController instance.
 fn rate_controller() -> fmi2Component {
-    let callbacks = Box::leak(Box::new(importer_logger::callbacks(
-        importer_logger::quiet,
-        std::ptr::null_mut(),
-    )));
     let table = tables()[3];
     assert_eq!(table.info.identifier, "RateController");
-    // SAFETY: valid strings, callbacks leaked for the process's lifetime.
-    unsafe {
-        let c = fmi2Instantiate(
-            c"bench".as_ptr(),
-            fmi2CoSimulation,
-            table.guid.as_ptr(),
-            std::ptr::null(),
-            callbacks,
-            fmi2False,
-            fmi2False,
-        );
-        assert!(!c.is_null());
-        assert_eq!(
-            fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0),
-            fmi2Status::fmi2OK
-        );
-        assert_eq!(fmi2EnterInitializationMode(c), fmi2Status::fmi2OK);
-        assert_eq!(fmi2ExitInitializationMode(c), fmi2Status::fmi2OK);
-        c
-    }
+    let c = common::initializing2(table);
+    // SAFETY: a live instance.
+    assert_eq!(unsafe { fmi2ExitInitializationMode(c) }, fmi2Status::fmi2OK);
+    c
 }
 
 fn do_step(c: &mut Criterion) {
