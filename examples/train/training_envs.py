@@ -40,6 +40,20 @@ def hover_success(terminated: bool, truncated: bool, info: Mapping[str, Any]) ->
     )
 
 
+# A Preset's success fields for the hover tasks (QuadHover-v0, whatever its actions).
+HOVER_SUCCESS = {
+    "success": hover_success,
+    "success_text": (
+        f"reached the time limit (no crash, not out of bounds) within "
+        f"{HOVER_SUCCESS_DISTANCE_M} m of the target"
+    ),
+    "outcomes": (
+        f"held the target (within {HOVER_SUCCESS_DISTANCE_M} m at the time limit)",
+        "did not hold the target",
+    ),
+}
+
+
 def swap_success(terminated: bool, truncated: bool, info: Mapping[str, Any]) -> bool:
     """Swap: every agent within its arrival radius at the end, no agent collided or crashed
     (the core's info['success'], the same for every agent of a world)."""
@@ -155,15 +169,7 @@ PRESETS: dict[str, Preset] = {
         # 5 s episodes (250 steps of 20 ms), the default wind (mean 0–5 m/s + turbulence).
         env_kwargs={"max_steps": 250, "dt": 0.02},
         actions=QUAD_ACTIONS,
-        success=hover_success,
-        success_text=(
-            f"reached the time limit (no crash, not out of bounds) within "
-            f"{HOVER_SUCCESS_DISTANCE_M} m of the target"
-        ),
-        outcomes=(
-            f"held the target (within {HOVER_SUCCESS_DISTANCE_M} m at the time limit)",
-            "did not hold the target",
-        ),
+        **HOVER_SUCCESS,
     ),
     # Lander2D-v1 (the landing reward; v0's seed reward pays for hovering, see its docstring).
     "lander": Preset(
@@ -244,15 +250,7 @@ def offboard_preset() -> Preset:
             "randomize": OFFBOARD_RANDOMIZE,
         },
         actions=None,
-        success=hover_success,
-        success_text=(
-            f"reached the time limit (no crash, not out of bounds) within "
-            f"{HOVER_SUCCESS_DISTANCE_M} m of the target"
-        ),
-        outcomes=(
-            f"held the target (within {HOVER_SUCCESS_DISTANCE_M} m at the time limit)",
-            "did not hold the target",
-        ),
+        **HOVER_SUCCESS,
     )
 
 
