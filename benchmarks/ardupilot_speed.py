@@ -33,14 +33,7 @@ sys.path.insert(0, str(REPO / "tests" / "sitl"))
 
 import ardupilot_support as aps  # noqa: E402
 from flyloop import find_sitl_binary  # noqa: E402
-
-TICK = os.sysconf("SC_CLK_TCK")
-
-
-def cpu_seconds(pid: int) -> float:
-    """utime + stime of a process and its threads, s."""
-    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / TICK
+from proc_cpu import cpu_seconds  # noqa: E402
 
 
 def fly_and_time(

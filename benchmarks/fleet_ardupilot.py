@@ -10,7 +10,6 @@ flyloop's share. The sibling of fleet_px4.py.
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import tempfile
 import time
@@ -21,9 +20,10 @@ for folder in ("sitl", "px4", "ardupilot", "fleet"):
     sys.path.insert(0, str(REPO / "tests" / folder))
 
 from ardupilot_support import GUIDED, LAND, PARM, ArduPilot, ardupilot_build, collect, settle  # noqa: E402
-from fleet_px4 import cpu_model, cpu_seconds  # noqa: E402
+from fleet_report import fleet_result, held, run_line  # noqa: E402
 from fleet_support import HOME, FleetSitl, ardupilot_ports_free, free_block  # noqa: E402
 from flyloop import find_sitl_binary  # noqa: E402
+from proc_cpu import cpu_seconds, machine_line  # noqa: E402
 from processes import fresh_dir  # noqa: E402
 
 ALT = 5.0
@@ -112,17 +112,8 @@ def run(binary: Path, build, n: int, speed: float, parm: str) -> dict:
                 "HEARTBEAT",
             )
     finally:
-        cpu_ap, cpu_flyloop, c = stop(sitl, aps)
-    cpu_ap = sum(cpu_ap)
-    return {
-        "worst_m": worst,
-        "rtf": float(c["real_time_factor"]),
-        "sim_s": float(c["time_s"]),
-        "cpu_flyloop_s": cpu_flyloop,
-        "cpu_ap_s": cpu_ap,
-        "share": cpu_flyloop / (cpu_flyloop + cpu_ap),
-        "silenced": sitl.stderr().count("silent for"),
-    }
+        cpu_ap, cpu_flyloop, _ = stop(sitl, aps)
+    return fleet_result(sitl, worst, cpu_flyloop, sum(cpu_ap))
 
 
 def main() -> int:
@@ -137,24 +128,14 @@ def main() -> int:
     parm = str(PARM) if args.stock else f"{PARM},{FLEET_PARM}"
     build = ardupilot_build(Path(tempfile.mkdtemp(prefix="bench-ap-build-")))
     binary = find_sitl_binary(build=True)
-    print(f"cpu: {os.cpu_count()} x {cpu_model()}, load before: {os.getloadavg()[0]:.2f}")
+    print(machine_line())
     print(f"flyloop {binary}, ArduPilot parameters {parm}")
     ok = True
     for k in range(args.runs):
         start = time.monotonic()
         r = run(binary, build, args.vehicles, args.speed_factor, parm)
-        good = r["worst_m"] <= 0.3 and r["silenced"] == 0
-        ok &= good
-        print(
-            f"run {k + 1}: {args.vehicles} ArduPilots"
-            f" {'all held 5 m and landed' if good else 'FAILED'} worst {r['worst_m']:.3f} m,"
-            f" world {r['sim_s']:.1f} s at {r['rtf']:.2f}x real time, CPU flyloop"
-            f" {r['cpu_flyloop_s']:.1f} s / ArduPilots {r['cpu_ap_s']:.1f} s (flyloop"
-            f" {100 * r['share']:.1f} %, {r['cpu_ap_s'] / args.vehicles:.1f} s per ArduPilot),"
-            f" silenced {r['silenced']}, wall {time.monotonic() - start:.0f} s,"
-            f" load {os.getloadavg()[0]:.2f}",
-            flush=True,
-        )
+        ok &= held(r)
+        print(run_line(k, args.vehicles, "ArduPilot", r, start), flush=True)
     return 0 if ok else 1
 
 

@@ -26,8 +26,8 @@ sys.path.insert(0, str(REPO / "benchmarks"))
 
 from ardupilot_support import PARM, ardupilot_build  # noqa: E402
 from fleet_ardupilot import FLEET_PARM, start, stop  # noqa: E402
-from fleet_px4 import cpu_model  # noqa: E402
 from flyloop import find_sitl_binary  # noqa: E402
+from proc_cpu import cpu_model  # noqa: E402
 
 
 def drain(aps, seconds: float) -> None:

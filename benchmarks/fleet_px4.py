@@ -9,7 +9,6 @@ seconds of flyloop and of the PX4s (from /proc), and flyloop's share.
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import tempfile
 import time
@@ -19,17 +18,11 @@ REPO = Path(__file__).resolve().parents[1]
 for folder in ("sitl", "px4", "ardupilot", "fleet"):
     sys.path.insert(0, str(REPO / "tests" / folder))
 
+from fleet_report import fleet_result, held, run_line  # noqa: E402
 from fleet_support import FleetSitl, free_block, land_all, px4_ports_free  # noqa: E402
 from flyloop import find_sitl_binary  # noqa: E402
+from proc_cpu import cpu_seconds, machine_line  # noqa: E402
 from px4_support import Px4, collect, fresh_dir, launch, px4_root, settle  # noqa: E402
-
-TICKS = os.sysconf("SC_CLK_TCK")
-
-
-def cpu_seconds(pid: int) -> float:
-    """User + system CPU time of a live process, s."""
-    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / TICKS
 
 
 def run(binary: Path, root: Path, n: int, speed: float) -> dict:
@@ -56,16 +49,7 @@ def run(binary: Path, root: Path, n: int, speed: float) -> dict:
         for p in px4s:
             p.kill()
         sitl.stop()
-    c = sitl.counters()
-    return {
-        "worst_m": worst,
-        "rtf": float(c["real_time_factor"]),
-        "sim_s": float(c["time_s"]),
-        "cpu_flyloop_s": cpu_flyloop,
-        "cpu_px4_s": cpu_px4,
-        "share": cpu_flyloop / (cpu_flyloop + cpu_px4),
-        "silenced": sitl.stderr().count("silent for"),
-    }
+    return fleet_result(sitl, worst, cpu_flyloop, cpu_px4)
 
 
 def main() -> int:
@@ -76,30 +60,14 @@ def main() -> int:
     args = a.parse_args()
     root = px4_root(Path(tempfile.mkdtemp(prefix="bench-px4-build-")))
     binary = find_sitl_binary(build=True)
-    print(f"cpu: {os.cpu_count()} x {cpu_model()}, load before: {os.getloadavg()[0]:.2f}")
+    print(machine_line())
     ok = True
     for k in range(args.runs):
         start = time.monotonic()
         r = run(binary, root, args.vehicles, args.speed_factor)
-        good = r["worst_m"] <= 0.3 and r["silenced"] == 0
-        ok &= good
-        print(
-            f"run {k + 1}: {args.vehicles} PX4s {'all held 5 m and landed' if good else 'FAILED'}"
-            f" worst {r['worst_m']:.3f} m, world {r['sim_s']:.1f} s at {r['rtf']:.2f}x real"
-            f" time, CPU flyloop {r['cpu_flyloop_s']:.1f} s / PX4s {r['cpu_px4_s']:.1f} s"
-            f" (flyloop {100 * r['share']:.1f} %, {r['cpu_px4_s'] / args.vehicles:.1f} s"
-            f" per PX4), silenced {r['silenced']}, wall {time.monotonic() - start:.0f} s,"
-            f" load {os.getloadavg()[0]:.2f}",
-            flush=True,
-        )
+        ok &= held(r)
+        print(run_line(k, args.vehicles, "PX4", r, start), flush=True)
     return 0 if ok else 1
-
-
-def cpu_model() -> str:
-    for line in Path("/proc/cpuinfo").read_text().splitlines():
-        if line.startswith("model name"):
-            return line.split(":", 1)[1].strip()
-    return "unknown"
 
 
 if __name__ == "__main__":

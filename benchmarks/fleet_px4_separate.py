@@ -27,13 +27,13 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-for folder in ("sitl", "px4", "fleet"):
+for folder in ("sitl", "px4", "ardupilot", "fleet"):
     sys.path.insert(0, str(REPO / "tests" / folder))
 
 import px4_support  # noqa: E402
-from fleet_px4 import cpu_model, cpu_seconds  # noqa: E402
 from fleet_support import free_block, px4_ports_free  # noqa: E402
 from flyloop import find_sitl_binary  # noqa: E402
+from proc_cpu import cpu_seconds, machine_line  # noqa: E402
 from px4_support import Flyloop, Px4, collect, fresh_dir, px4_root, settle  # noqa: E402
 
 # The time each stage may take on the wall clock (at 1x real time, PX4 needs ~15 s to arm).
@@ -86,7 +86,7 @@ def main() -> int:
     px4_support.SPEED = args.speed_factor
     root = px4_root(Path(tempfile.mkdtemp(prefix="bench-px4-build-")))
     binary = find_sitl_binary(build=True)
-    print(f"cpu: {os.cpu_count()} x {cpu_model()}, load before: {os.getloadavg()[0]:.2f}")
+    print(machine_line())
     base = free_block(n, px4_ports_free, 10, 240)
     start = time.monotonic()
     sitls = [

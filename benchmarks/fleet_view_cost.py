@@ -36,8 +36,9 @@ sys.path.insert(0, str(REPO / "benchmarks"))
 
 from fleet_support import FleetSitl, free_block, px4_ports_free  # noqa: E402
 from flyloop import find_sitl_binary  # noqa: E402
+from proc_cpu import cpu_seconds  # noqa: E402
 from px4_support import Px4, fresh_dir, launch, px4_root  # noqa: E402
-from view_cost import cpu_seconds, free_port, summary  # noqa: E402
+from view_cost import free_port, summary  # noqa: E402
 
 SETUPS = ("base", "view", "record")
 

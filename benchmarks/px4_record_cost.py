@@ -27,8 +27,9 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests" / "px4"))
 sys.path.insert(0, str(REPO / "benchmarks"))
 import px4_support  # noqa: E402
+from proc_cpu import cpu_seconds  # noqa: E402
 from px4_support import Flyloop, Px4, free_instance, fresh_dir, px4_root  # noqa: E402
-from view_cost import cpu_seconds, summary  # noqa: E402
+from view_cost import summary  # noqa: E402
 
 
 def flight(px4_dir: Path, seconds: float, record: Path | None) -> tuple[float, float, float]:

@@ -26,6 +26,7 @@ import time
 from pathlib import Path
 
 os.environ["MAVLINK20"] = "1"
+from proc_cpu import cpu_seconds  # noqa: E402
 from pymavlink.dialects.v20 import common as mavlink2  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
@@ -36,12 +37,6 @@ def free_port(kind: int = socket.SOCK_DGRAM) -> int:
     with socket.socket(socket.AF_INET, kind) as s:
         s.bind(("127.0.0.1", 0))
         return s.getsockname()[1]
-
-
-def cpu_seconds(pid: int) -> float:
-    """utime + stime of a process, s."""
-    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def steps_per_second(sitl_args: list[str], seconds: float) -> tuple[float, float, int]:
