@@ -35,4 +35,5 @@ say "Python system tests (pytest)"
 # On up to 4 workers (pytest-xdist): most suites wait on processes and sockets, and the
 # training tests keep one core each. conftest.py keeps the tests that share a resource on one.
 workers=$(( $(nproc) < 4 ? $(nproc) : 4 ))
-.venv/bin/pytest -q -n "$workers" --dist loadgroup
+# The slowest tests at the end of the log: the groups that set how long CI takes.
+.venv/bin/pytest -q -n "$workers" --dist loadgroup --durations=25
