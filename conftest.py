@@ -5,6 +5,7 @@
   never race for the same free ports or work directories;
 - fmu (with the README and docs snippets, which simulate the packed FMUs): the session's
   scripts/pack-fmus.sh rewrites dist/fmu/, which no other test may be reading meanwhile;
+- fleetview: the fleet view tests, beside the px4 group (minutes of real time each);
 - ray: one Ray on the machine at a time (the cluster test's `--address auto` must find its
   own head node).
 
@@ -21,6 +22,10 @@ ROOT = Path(__file__).resolve().parent
 GROUPS = {
     "tests/px4/": "px4",
     "tests/ardupilot/": "ardupilot",
+    # The fleet view tests (minutes of real time each, in a browser) run beside the PX4
+    # group instead of lengthening it: their instance blocks are drawn at random and checked
+    # free, as tests/view's PX4 flights are.
+    "tests/fleet/test_fleet_view.py": "fleetview",
     # Fleets start PX4s (and ArduPilots) in blocks of instance numbers: after the PX4 tests.
     "tests/fleet/": "px4",
     "tests/fmu/": "fmu",
