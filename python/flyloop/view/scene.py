@@ -30,8 +30,12 @@ GROUND, PAD, TRAIL, TARGET, WIND = (
     (0, 170, 60),
     (0, 80, 220),
 )
-TRAIL_POINTS = 600  # the trail's last points
-TRAIL_EVERY_S = 0.1  # the trail is re-drawn this often (simulated seconds)
+# The trail: a point every TRAIL_EVERY_S of simulated time, the last TRAIL_POINTS of them
+# (30 s), re-drawn with the vehicle's latest position at each new point. A point per pose
+# re-drawn whole ten times a second was most of a live view's bytes, and a browser that
+# could not ingest them fell minutes behind the flight.
+TRAIL_POINTS = 300
+TRAIL_EVERY_S = 0.1
 DRAW_SCALE = 3.0  # vehicles are drawn this many times their size (a 0.1 m arm is small)
 GROUND_HALF = 5.0  # m: the ground grid is ±this around home
 
@@ -215,11 +219,11 @@ class Scene:
         self._trail(path, p, ESTIMATE if estimate else TRAIL)
 
     def _trail(self, path: str, p: list[float], color) -> None:
-        trail = self._trails.setdefault(path, deque(maxlen=TRAIL_POINTS))
-        trail.append(p)
         now = self._now
         if now - self._trail_at.get(path, -math.inf) >= TRAIL_EVERY_S:
             self._trail_at[path] = now
+            trail = self._trails.setdefault(path, deque(maxlen=TRAIL_POINTS))
+            trail.append(p)
             self._log(f"{path}_trail", rr.LineStrips3D([list(trail)], colors=[color], radii=0.015))
 
     def motors(self, name: str, fractions) -> None:
