@@ -11,6 +11,12 @@ climbs to 5 + 2k m; then it flies a leg to the mirror point across the row, 10 m
 every leg crosses the others above or below them; it holds there and lands. Errors are
 PX4's position estimate (GLOBAL_POSITION_INT) against the target over a 2 s hold at each
 end of the leg. Exit 0 when every error is within --tolerance and all land and disarm.
+
+`--collide` sends two of them into each other instead: vehicles 0 and 1 take off to 5 m
+over their start points, then vehicle 1 flies to where vehicle 0 hovers. flyloop reports
+the collision as a STATUSTEXT from system 250 to its `--gcs` address (127.0.0.1:14550 by
+default); this script listens there (`--gcs`), prints every line flyloop sends, and exits 0
+once it has heard the collision (then both land).
 """
 
 from __future__ import annotations
@@ -39,6 +45,15 @@ class Vehicle:
         self.link = mavutil.mavlink_connection(
             f"udpout:127.0.0.1:{14580 + instance}", source_system=245, dialect="common"
         )
+        # PX4's offboard link answers only the first address that talks to it, for good: from
+        # PX4's own partner port (14540 + i; instances above 9 share 14549) every run of this
+        # script is that partner, so it can fly the same PX4s again. Taken (MAVSDK, another
+        # script): any port, and this PX4 answers this run only if it is its first partner.
+        if instance <= 9:
+            try:
+                self.link.port.bind(("127.0.0.1", 14540 + instance))
+            except OSError:
+                pass
         self.last_beat = 0.0
         self.ground_amsl = home[2]
 
@@ -51,7 +66,11 @@ class Vehicle:
             m = self.link.recv_match(type=kind, blocking=True, timeout=0.2)
             if m is not None and m.get_srcSystem() == self.target_system:
                 return m
-        raise TimeoutError(f"vehicle {self.instance}: no {kind} within {timeout} s")
+        raise TimeoutError(
+            f"vehicle {self.instance}: no {kind} from PX4 instance {self.instance} on udp "
+            f"{14580 + self.instance} within {timeout:g} s (is it running? it answers only the "
+            "first program that talked to that port: restart it after another one did)"
+        )
 
     def command(self, command: int, *params: float, timeout: float = 60) -> None:
         """COMMAND_LONG, again every second until accepted."""
@@ -127,6 +146,56 @@ class Vehicle:
         return bool(self.recv("HEARTBEAT", 10).base_mode & MAV.MAV_MODE_FLAG_SAFETY_ARMED)
 
 
+def fleet_lines(gcs: str):
+    """flyloop's own STATUSTEXT (system 250) on its ground-station address, or None with a
+    line saying why when that port is taken (a ground station listening there)."""
+    try:
+        return mavutil.mavlink_connection(f"udpin:{gcs}", dialect="common")
+    except OSError as e:
+        print(f"fleet_mission.py: cannot listen on udp {gcs} for flyloop's lines: {e}")
+        return None
+
+
+def collide(fleet, gcs: str, timeout: float = 60) -> int:
+    """Vehicles 0 and 1 up to 5 m, then 1 sent to 0's point; exit code 0 once flyloop said
+    `collision ...`."""
+    listener = fleet_lines(gcs)
+    if listener is None:
+        return 1
+    a, b = fleet[0], fleet[1]
+    for v in (a, b):
+        v.recv("HEARTBEAT", 120)
+        v.command(MAV.MAV_CMD_COMPONENT_ARM_DISARM, 1, timeout=120)
+        v.ground_amsl = v.recv("GLOBAL_POSITION_INT", 10).alt * 1e-3
+        nan = float("nan")
+        v.command(MAV.MAV_CMD_NAV_TAKEOFF, -1, 0, 0, nan, nan, nan, nan)
+    for v in (a, b):
+        v.goto(v.east, 0.0, 5.0)
+    for v in (a, b):
+        v.hold((v.east, 0.0, 5.0), 0.3)
+    print(f"vehicle 1 flies to vehicle 0 ({a.east:.1f} m east, 5 m up)")
+    b.goto(a.east, 0.0, 5.0)
+    heard = False
+    chunks: dict[int, str] = {}  # a line longer than 50 bytes comes in chunks with one id
+    end = time.monotonic() + timeout
+    while time.monotonic() < end and not heard:
+        m = listener.recv_match(type="STATUSTEXT", blocking=True, timeout=0.5)
+        if m is None or m.get_srcSystem() != 250:
+            continue
+        text = chunks.pop(m.id, "") + m.text
+        if m.id != 0 and len(m.text) == 50:
+            chunks[m.id] = text
+            continue
+        print(f"flyloop: {text}")
+        heard = text.startswith("collision ")
+    if not heard:
+        print(f"no collision reported on udp {gcs} within {timeout:.0f} s")
+    for v in (a, b):
+        v.command(MAV.MAV_CMD_NAV_LAND)
+    listener.close()
+    return 0 if heard else 1
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--vehicles", type=int, default=4, help="number of PX4s (default 4)")
@@ -135,12 +204,22 @@ def main(argv=None) -> int:
     p.add_argument("--home", default="47.397742,8.545594,488", help="flyloop's --home")
     p.add_argument("--tolerance", type=float, default=0.3, help="largest error allowed, m")
     p.add_argument("--leg", type=float, default=10.0, help="northward length of a leg, m")
+    p.add_argument(
+        "--collide", action="store_true", help="send vehicle 1 into vehicle 0 instead (2 or more)"
+    )
+    p.add_argument(
+        "--gcs", default="127.0.0.1:14550", help="flyloop's --gcs, where --collide listens"
+    )
     a = p.parse_args(argv)
     if a.vehicles < 1:
         p.error("--vehicles must be at least 1")
+    if a.collide and a.vehicles < 2:
+        p.error("--collide needs --vehicles 2 or more")
     home = tuple(float(x) for x in a.home.split(","))
     n = a.vehicles
     fleet = [Vehicle(a.first_instance + k, home, a.spacing * k) for k in range(n)]
+    if a.collide:
+        return collide(fleet, a.gcs)
     heights = [5.0 + 2.0 * k for k in range(n)]
     for v in fleet:
         v.recv("HEARTBEAT", 120)
@@ -180,4 +259,7 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    try:
+        sys.exit(main())
+    except TimeoutError as e:
+        sys.exit(f"fleet_mission.py: {e}")

@@ -5,12 +5,9 @@ from __future__ import annotations
 
 import subprocess
 import sys
-from pathlib import Path
 
 from fleet_support import HOME
-from test_fleet_px4 import start_fleet
-
-EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "fleet_mission.py"
+from test_fleet_px4 import EXAMPLE, start_fleet
 
 
 def test_four_px4s_fly_the_crossing_legs_within_0_3_m(started, sitl_binary, px4_dir):

@@ -4,13 +4,18 @@ hang the others; two PX4s sent into each other collide, and flyloop says so."""
 
 from __future__ import annotations
 
+import re
 import signal
+import subprocess
+import sys
 import time
+from pathlib import Path
 
-from fleet_support import FleetSitl, free_block, land_all, px4_ports_free, read_track
+from fleet_support import HOME, FleetSitl, free_block, land_all, px4_ports_free, read_track
 from px4_support import Px4, collect, fresh_dir, launch, settle, truth_vs_estimate
 
 TAKEOFF_ALT = 5.0
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "fleet_mission.py"
 
 
 def start_fleet(started, sitl_binary, px4_dir, n: int, *args: str, talk=True, speed=0, **params):
@@ -109,15 +114,36 @@ def test_a_silent_px4_does_not_hang_the_others_and_rejoins(started, sitl_binary,
 
 
 def test_two_px4s_sent_into_each_other_collide_and_flyloop_says_so(started, sitl_binary, px4_dir):
-    sitl, (a, b) = start_fleet(started, sitl_binary, px4_dir, 2)
-    frame_a, target_a = launch(a)
-    frame_b, target_b = launch(b)
-    settle(a, target_a, 0.3, 90)
-    settle(b, target_b, 0.3, 90)
-    # b flies to where a hovers.
-    b.goto(frame_b, frame_b.from_global(*frame_a.to_global(target_a)))
-    text = sitl.statustext("collision px4-000 px4-001", 60)
-    assert "closing at" in text or text.startswith("collision px4-000 px4-001")
+    """As docs/fleet.md tells a user: examples/fleet_mission.py --collide sends vehicle 1 to
+    where vehicle 0 hovers and hears flyloop's line on its ground-station address."""
+    sitl, px4s = start_fleet(started, sitl_binary, px4_dir, 2, talk=False)
+    gcs_port = sitl.gcs.port.getsockname()[1]
+    sitl.gcs.close()  # the example listens there instead
+    out = subprocess.run(
+        [
+            sys.executable,
+            str(EXAMPLE),
+            "--vehicles",
+            "2",
+            "--first-instance",
+            str(px4s[0].instance),
+            "--home",
+            ",".join(str(v) for v in HOME[:3]),
+            "--collide",
+            "--gcs",
+            f"127.0.0.1:{gcs_port}",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=400,
+    )
+    print(out.stdout)
+    assert out.returncode == 0, out.stdout + out.stderr + sitl.stderr()[-3000:]
+    # The whole line (STATUSTEXT chunks joined), and the same in flyloop's log.
+    said = re.search(
+        r"^flyloop: collision px4-000 px4-001 at t=\S+ s, closing at \S+ m/s$", out.stdout, re.M
+    )
+    assert said, out.stdout
     deadline = time.monotonic() + 5
     while "collision px4-000 px4-001" not in sitl.stderr() and time.monotonic() < deadline:
         time.sleep(0.1)
