@@ -22,7 +22,10 @@ What counts as a success:
   the target;
 - lander, lander_moving, lander_v0 (Lander2D-v1 static or moving pad, Lander2D-v0): the
   drone landed on the platform (info['landed']); the touch-down speed relative to the
-  platform and |angle| of the landings are reported too.
+  platform and |angle| of the landings are reported too;
+- swap, swap_layers (Swap-v0/-v1, a fast_ppo.py policy shared by the four agents): an
+  episode is one world, flown by fast_ppo.py's own held-out evaluation; success is the
+  task's (every agent arrived, none collided or crashed).
 """
 
 from __future__ import annotations
@@ -139,6 +142,8 @@ def evaluate(
         torch.set_num_threads(1)
     run = SavedRun(folder) if folder is not None else None
     p = preset_of(run, env)
+    if is_swarm(p):
+        return evaluate_swarm(run, folder, p, episodes, seed, backend)
     action = run.summary.get("action") if run is not None else None
     rng = np.random.default_rng(seed)
     e = make_env(p.name, action=action, backend=backend)
@@ -178,6 +183,37 @@ def evaluate(
         landing_speed_max_m_s=max(landing_speeds, default=None),
         landing_angle_mean_rad=_mean(landing_angles),
         landing_angle_max_rad=max(landing_angles, default=None),
+        success=p.success_text,
+    )
+
+
+def is_swarm(p) -> bool:
+    """A multi-agent preset (its env is a flyloop.parallel_env, not a gym.make env)."""
+    import flyloop.multi_agent
+
+    return p.env_id in flyloop.multi_agent.ENV_TASKS
+
+
+def evaluate_swarm(run, folder, p, episodes: int, seed: int, backend: str) -> dict[str, Any]:
+    """A multi-agent preset (swap): `episodes` worlds of its agents, each agent flown by the
+    shared policy, through fast_ppo.py's evaluation (the one its summary.json reports)."""
+    if run is None or run.summary.get("algo") != "fast_ppo":
+        raise ValueError(f"{p.name} is a multi-agent task: only a fast_ppo.py policy flies it")
+    import fast_ppo
+
+    figures = fast_ppo.evaluate(run.model, run.norm, p.name, backend, episodes, seed)
+    return dict(
+        env=p.name,
+        env_id=p.env_id,
+        policy=str(folder),
+        episodes=episodes,
+        first_seed=seed,
+        success_rate=figures["success_rate"],
+        mean_return=figures["mean_return"],
+        std_return=None,
+        mean_length=None,
+        median_final_distance_m=None,
+        landings=0,
         success=p.success_text,
     )
 
@@ -246,8 +282,11 @@ def print_figures(result: dict[str, Any], episodes: int, seed: int) -> None:
         f"(seeds {seed}..{seed + episodes - 1}):"
     )
     print(f"  success rate {100 * result['success_rate']:.1f} %  ({result['success']})")
-    print(f"  mean return {result['mean_return']:.1f} ± {result['std_return']:.1f}")
-    print(f"  mean episode length {result['mean_length']:.0f} steps")
+    if result["std_return"] is None:  # a multi-agent task: per agent, over all agents
+        print(f"  mean return per agent {result['mean_return']:.1f}")
+    else:
+        print(f"  mean return {result['mean_return']:.1f} ± {result['std_return']:.1f}")
+        print(f"  mean episode length {result['mean_length']:.0f} steps")
     if result["median_final_distance_m"] is not None:
         print(f"  median final distance to target {result['median_final_distance_m']:.3f} m")
     if result["landings"]:
@@ -274,7 +313,9 @@ def main(argv: list[str] | None = None) -> int:
     print_figures(result, args.episodes, args.seed)
     if args.json is not None:
         args.json.write_text(json.dumps(result, indent=2) + "\n")
-    if args.gif is not None:
+    if args.gif is not None and result["std_return"] is None:
+        print(f"  --gif: a swap policy's GIF is examples/train/swap_gif.py {args.run}")
+    elif args.gif is not None:
         shot = record(None if args.random else args.run, args.gif, args.seed, env=args.env)
         ending = shot["outcome"]
         print(f"  recorded seed {args.seed} ({shot['steps']} steps, {ending}) to {args.gif}")

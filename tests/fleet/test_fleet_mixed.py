@@ -3,13 +3,15 @@ and holds it within 0.3 m, all four at once, then lands and disarms. CI runs thi
 
 from __future__ import annotations
 
-from ardupilot_support import GUIDED, LAND, ArduPilot
+from ardupilot_support import GUIDED, LAND, PARM, ArduPilot
 from ardupilot_support import collect as ap_collect
 from ardupilot_support import settle as ap_settle
 from fleet_support import HOME, FleetSitl, ardupilot_ports_free, free_block, px4_ports_free
 from px4_support import Px4, collect, fresh_dir, launch, settle
 
 ALT = 5.0
+# docs/fleet.md: a fleet's ArduPilots get the fleet's parameter file last, after the frame's.
+FLEET_PARM = f"{PARM},{PARM.with_name('ardupilot_fleet.parm')}"
 
 
 def quiet(ap) -> None:
@@ -56,6 +58,7 @@ def test_two_px4s_and_two_ardupilots_fly_in_one_world(started, sitl_binary, px4_
             home,
             "--sysid",
             str(240 + k),
+            parm=FLEET_PARM,
         )
         for k in range(2)
     ]

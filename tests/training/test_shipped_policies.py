@@ -122,3 +122,20 @@ def test_a_shipped_swap_policy_swaps_held_back_worlds(name, env_id):
     result = fast_ppo.evaluate(model, norm, name, "native", 50, HELD_BACK_SEEDS)
     print(result)
     assert result["success_rate"] >= 0.82, result
+
+
+def test_evaluate_py_flies_a_swap_policy_as_fast_ppo_does():
+    """`evaluate.py policies/swap` (docs/training.md): the same worlds and figures as
+    fast_ppo.py's own evaluation, and one line pointing to swap_gif.py for --gif."""
+    import evaluate
+    import fast_ppo
+    import swap_gif
+
+    _, model, norm = swap_gif.load(POLICIES / "swap")
+    expected = fast_ppo.evaluate(model, norm, "swap", "native", 5, HELD_BACK_SEEDS)
+    result = evaluate.evaluate(POLICIES / "swap", 5, HELD_BACK_SEEDS)
+    assert result["env_id"] == "flyloop/Swap-v0" and result["episodes"] == 5
+    assert result["success_rate"] == expected["success_rate"]
+    assert result["mean_return"] == expected["mean_return"]
+    with pytest.raises(ValueError, match="only a fast_ppo.py policy flies it"):
+        evaluate.evaluate(None, 1, HELD_BACK_SEEDS, env="swap")
