@@ -152,7 +152,10 @@ def plot(series: dict, png: str | Path, title: str) -> Path:
                     ax.plot(t, v, style, color=color, lw=1.2, label=f"{axis} {kind}")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
-        ax.legend(loc="upper right", fontsize=7, ncol=2)
+        if ax.lines:
+            ax.legend(loc="upper right", fontsize=7, ncol=2)
+        else:  # e.g. a gym env's recording: the envs report no body rates
+            ax.text(0.5, 0.5, "not in this recording", transform=ax.transAxes, ha="center")
     motors = sorted(k for k in series if k.startswith(f"/motors/{name}_"))
     for key in motors:
         t, v = series[key]

@@ -132,6 +132,9 @@ def test_env_watch_records_every_step(tmp_path):
     png = tmp_path / "eval.png"
     plotted = run("-m", "flyloop.plot", str(tmp_path / "eval.rrd"), "-o", str(png))
     assert plotted.returncode == 0 and png.stat().st_size > 20_000, plotted.stderr
+    # An env reports no body rates: that panel says so, and no matplotlib warning (a new user's
+    # first plot printed "No artists with labels found to put in legend").
+    assert "Warning" not in plotted.stderr, plotted.stderr
 
 
 def test_vector_watch_records_the_chosen_env(tmp_path):
@@ -244,6 +247,12 @@ def test_a_view_pointed_at_nothing_says_so(tmp_path):
         f"no MAVLink on udp 127.0.0.1:{port} within 1 s" in out.stderr
         and "Traceback" not in out.stderr
     )
+
+
+def test_a_missing_recording_is_one_line_before_any_url(tmp_path):
+    missing = run("-m", "flyloop.view", str(tmp_path / "nothing.rrd"))
+    assert missing.returncode == 1 and "open http" not in missing.stdout
+    assert missing.stderr.strip() == f"flyloop.view: {tmp_path / 'nothing.rrd'}: no such file"
 
 
 def test_a_browser_that_cannot_start_is_one_line(tmp_path):

@@ -13,6 +13,7 @@ import argparse
 import signal
 import sys
 import time
+from pathlib import Path
 
 from . import Viewer, ViewError
 
@@ -75,6 +76,9 @@ def main(argv: list[str] | None = None) -> int:
     # leaves it ignored, and the view could only be killed, its .rrd cut short).
     signal.signal(signal.SIGINT, signal.default_int_handler)
     signal.signal(signal.SIGTERM, _stop)
+    if args.file and not Path(args.file).is_file():  # before a URL is printed for nothing
+        print(f"flyloop.view: {args.file}: no such file", file=sys.stderr)
+        return 1
     try:
         viewer = Viewer(web_port=args.web_port, grpc_port=args.grpc_port, save=args.save)
     except ViewError as e:
