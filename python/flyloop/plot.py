@@ -156,10 +156,17 @@ def plot(series: dict, png: str | Path, title: str) -> Path:
             ax.legend(loc="upper right", fontsize=7, ncol=2)
         else:  # e.g. a gym env's recording: the envs report no body rates
             ax.text(0.5, 0.5, "not in this recording", transform=ax.transAxes, ha="center")
-    motors = sorted(k for k in series if k.startswith(f"/motors/{name}_"))
-    for key in motors:
+    # flyloop's motor commands (/motors/vehicle1_m0) and an autopilot's outputs
+    # (/motors/vehicle1_autopilot/m0, all its 16 channels): the unused ones (never above 0)
+    # left out, the autopilot's labelled as such.
+    motors = []
+    for key in sorted(k for k in series if k.startswith(f"/motors/{name}_")):
         t, v = series[key]
-        axes[3].plot(t, v, lw=1.0, label=key.split("/")[-1])
+        if not np.any(np.asarray(v) > 0):
+            continue
+        source = "autopilot " if "_autopilot/" in key else ""
+        axes[3].plot(t, v, lw=1.0, label=f"{source}{key.split('/')[-1].split('_')[-1]}")
+        motors.append(key)
     axes[3].set_ylabel("motor commands [0, 1]")
     axes[3].set_xlabel("simulation time (s)")
     axes[3].grid(alpha=0.3)

@@ -2,7 +2,8 @@
 Chromium (Debian's package, driven by playwright; the web viewer's WebGL runs on SwiftShader,
 the software rasteriser). Waits for the viewer to load (its wasm takes ~20 s on 2 cores) and
 for the vehicle (the hub's colour) to appear, then writes the PNG. Used by the browser tests
-and for the README's picture (docs/view.md)."""
+and for the README's picture (docs/view.md). The browser: $FLYLOOP_CHROMIUM, else `chromium`
+on the PATH, else /usr/bin/chromium."""
 
 from __future__ import annotations
 
