@@ -50,8 +50,10 @@ def series_of_rrd(path: str | Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Entity path -> (sim time s, value) of every scalar series in an .rrd."""
     parts: dict[str, list] = defaultdict(list)
     for name, t, values in _columns(path, "Scalars:scalars"):
-        v = [x[0] if x else math.nan for x in values]
-        parts[name].append((t, np.asarray(v, float)))
+        width = max((len(x) for x in values if x), default=1)
+        for i in range(width):
+            v = [x[i] if x and len(x) > i else math.nan for x in values]
+            parts[_series_name(name, i, width)].append((t, np.asarray(v, float)))
     out = {}
     for name, pieces in parts.items():
         t = np.concatenate([p[0] for p in pieces])
@@ -59,6 +61,23 @@ def series_of_rrd(path: str | Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         order = np.argsort(t, kind="stable")
         out[name] = (t[order], v[order])
     return out
+
+
+# The view logs a group's series as one entity (scene.Scene._series): its i-th value is
+# the series named here, the names the view's recordings had when each was its own entity.
+_AXES = {"position": "NED", "attitude": ("roll", "pitch", "yaw"), "rates": "pqr"}
+
+
+def _series_name(path: str, i: int, width: int) -> str:
+    if width == 1:
+        return path
+    root = path.split("/")[1]
+    if root in _AXES:
+        prefix, kind = path.rsplit("/", 1)
+        return f"{prefix}/{_AXES[root][i]}/{kind}"
+    if root == "motors":
+        return f"{path}/m{i}"
+    return f"{path}/{'xyz'[i]}" if width == 3 else f"{path}/{i}"
 
 
 def events_of_rrd(path: str | Path) -> list[tuple[float, str, str]]:

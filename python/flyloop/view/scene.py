@@ -35,6 +35,7 @@ GROUND, PAD, TRAIL, TARGET, WIND = (
 # re-drawn whole ten times a second was most of a live view's bytes, and a browser that
 # could not ingest them fell minutes behind the flight.
 TRAIL_POINTS = 300
+EULER = ("roll", "pitch", "yaw")
 TRAIL_EVERY_S = 0.1
 DRAW_SCALE = 3.0  # vehicles are drawn this many times their size (a 0.1 m arm is small)
 GROUND_HALF = 5.0  # m: the ground grid is ±this around home
@@ -209,14 +210,21 @@ class Scene:
         p = [float(v) for v in position_ned]
         self._log(path, rr.Transform3D(translation=p, quaternion=rr.Quaternion(xyzw=[x, y, z, w])))
         kind = "estimate" if estimate else "truth"
-        for axis, value in zip("NED", p, strict=True):
-            self._log(f"/position/{name}/{axis}/{kind}", rr.Scalars(value))
-        roll, pitch, yaw = euler_ned([w, x, y, z])
-        for axis, value in zip(("roll", "pitch", "yaw"), (roll, pitch, yaw), strict=True):
-            self._log(f"/attitude/{name}/{axis}/{kind}", rr.Scalars(math.degrees(value)))
-        for axis, value in zip("pqr", rates_frd if rates_frd is not None else (), strict=False):
-            self._log(f"/rates/{name}/{axis}/{kind}", rr.Scalars(math.degrees(float(value))))
+        self._series(f"/position/{name}/{kind}", [f"{a}/{kind}" for a in "NED"], p)
+        attitude = [math.degrees(v) for v in euler_ned([w, x, y, z])]
+        self._series(f"/attitude/{name}/{kind}", [f"{a}/{kind}" for a in EULER], attitude)
+        if rates_frd is not None:
+            rates = [math.degrees(float(v)) for v in rates_frd]
+            self._series(f"/rates/{name}/{kind}", [f"{a}/{kind}" for a in "pqr"], rates)
         self._trail(path, p, ESTIMATE if estimate else TRAIL)
+
+    def _series(self, path: str, names: list[str], values) -> None:
+        """One entity of several series (one `rr.log` for all, its lines named once):
+        plot.series_of reads it back as one series per name."""
+        if path not in self._drawn:
+            self._drawn.add(path)
+            self._log(path, rr.SeriesLines(names=names), static=True)
+        self._log(path, rr.Scalars([float(v) for v in values]))
 
     def _trail(self, path: str, p: list[float], color) -> None:
         now = self._now
@@ -228,15 +236,15 @@ class Scene:
 
     def motors(self, name: str, fractions) -> None:
         """Motor commands in [0, 1], one series per motor."""
-        for i, f in enumerate(fractions):
-            self._log(f"/motors/{name}/m{i}", rr.Scalars(float(f)))
+        fractions = [float(f) for f in fractions]
+        self._series(f"/motors/{name}", [f"m{i}" for i in range(len(fractions))], fractions)
 
     def sensors(self, name: str, accel_frd, gyro_frd) -> None:
         """An IMU sample the SITL sent an autopilot (m/s², rad/s as deg/s; body FRD), as
         series under /sensors (the default layout's sensor panel)."""
-        for axis, a, g in zip("xyz", accel_frd, gyro_frd, strict=True):
-            self._log(f"/sensors/{name}/accel/{axis}", rr.Scalars(float(a)))
-            self._log(f"/sensors/{name}/gyro/{axis}", rr.Scalars(math.degrees(float(g))))
+        self._series(f"/sensors/{name}/accel", list("xyz"), accel_frd)
+        gyro = [math.degrees(float(g)) for g in gyro_frd]
+        self._series(f"/sensors/{name}/gyro", list("xyz"), gyro)
 
     def collision(self, name: str, position_ned, speed: float) -> None:
         """A collision the world reported for vehicle `name`: a red mark where it happened
