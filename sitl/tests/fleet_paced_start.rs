@@ -4,9 +4,10 @@
 //! stop. The real binary, PX4 ports on port 0 (each member an ephemeral port of its own),
 //! plain TCP clients in the PX4s' place.
 
-use std::io::{BufRead, BufReader, Read};
+use crate::lockstep_over_udp::spawn_ready;
+use std::io::Read;
 use std::net::TcpStream;
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Command};
 use std::time::{Duration, Instant};
 
 struct Fleet {
@@ -23,7 +24,8 @@ impl Drop for Fleet {
 }
 
 fn start_fleet(vehicles: &str, speed: &str) -> Fleet {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_flyloop-sitl"))
+    let mut command = Command::new(env!("CARGO_BIN_EXE_flyloop-sitl"));
+    command
         .args([
             "--px4",
             "--vehicles",
@@ -38,14 +40,8 @@ fn start_fleet(vehicles: &str, speed: &str) -> Fleet {
             "off",
             "--log-level",
             "warn",
-        ])
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
+        ]);
+    let (child, line) = spawn_ready(&mut command);
     assert!(line.starts_with("flyloop-sitl ready mode=fleet"), "{line}");
     // members=px4-000:px4:PORT:SYSID,...
     let members = line.split("members=").nth(1).unwrap();

@@ -32,9 +32,20 @@ impl Drop for Sitl {
     }
 }
 
+/// The SITL started by `command` (stdout piped) and its first stdout line, the ready line.
+pub(crate) fn spawn_ready(command: &mut Command) -> (Child, String) {
+    let mut child = command.stdout(Stdio::piped()).spawn().unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    (child, line)
+}
+
 impl Sitl {
     pub(crate) fn start(args: &[&str]) -> Sitl {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_flyloop-sitl"))
+        let mut command = Command::new(env!("CARGO_BIN_EXE_flyloop-sitl"));
+        command
             .args([
                 "--listen",
                 "127.0.0.1:0",
@@ -43,14 +54,8 @@ impl Sitl {
                 "--log-level",
                 "warn",
             ])
-            .args(args)
-            .stdout(Stdio::piped())
-            .spawn()
-            .unwrap();
-        let mut line = String::new();
-        BufReader::new(child.stdout.take().unwrap())
-            .read_line(&mut line)
-            .unwrap();
+            .args(args);
+        let (child, line) = spawn_ready(&mut command);
         assert!(line.starts_with("flyloop-sitl ready listen="), "{line}");
         let addr = line
             .split("listen=")
