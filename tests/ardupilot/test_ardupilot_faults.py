@@ -187,10 +187,11 @@ def test_ardupilot_hexa_loses_motor_1_in_a_hover_and_lands(pair):
     assert "mode LAND" in said and "disarmed" in said, said
     assert max(r["m0"] for r in hold[len(hold) // 2 :]) < 0.01
     assert last["grounded"] == 1.0 and max(last[f"m{i}"] for i in range(6)) < 0.01, last
-    # ArduCopter's mixer answers the dead motor the same way every run: servo 1 to its
-    # maximum, the opposite servo 2 to its minimum; on the four left the hexa comes down.
+    # ArduCopter's mixer answers the dead motor the same way every run: servo 1 at its
+    # maximum, the opposite servo 2 near its minimum (1150-1263 µs seen), hundreds of µs
+    # below the four left (1596-1757 µs); on those four the hexa comes down.
     late = [pwm for t, pwm in servos if t / 1e6 - start >= HOLD_S / 2]
-    assert late and all(p[0] >= 1900 and p[1] <= 1200 for p in late), late
+    assert late and all(p[0] >= 1900 and p[1] + 200 < min(p[2:]) for p in late), late
     assert touch is not None and touch < land_start * 1e6, "the hexa held on five motors"
     # Where it ends is not asserted: in LAND, when ArduPilot's land detector does not fire,
     # its motors lift the hexa off again and it hops (tilt up to 70°) until it is disarmed;

@@ -25,11 +25,18 @@ def free_port(kind: int = socket.SOCK_DGRAM) -> int:
 
 
 class Flight:
-    """Flies vehicle 1 to `target_ned` (changed with `fly_to`) at ~real time in a thread."""
+    """Flies vehicle 1 to `target_ned` (changed with `fly_to`) in a thread, a 0.01 s step
+    every `period` s of wall time (0.01: ~real time)."""
 
     def __init__(
-        self, binary: Path, gcs_port: int, record: Path | None = None, seed: int = 3
+        self,
+        binary: Path,
+        gcs_port: int,
+        record: Path | None = None,
+        seed: int = 3,
+        period: float = 0.01,
     ) -> None:
+        self.period = period
         args = ["--gcs", f"127.0.0.1:{gcs_port}", "--seed", str(seed)]
         args += ["--record", str(record)] if record else []
         self.sitl = Sitl(binary, *args)
@@ -53,7 +60,7 @@ class Flight:
             msgs = self.client.step(pd_motors(self.state, self.target))
             self.state = next(m for m in msgs if m.get_type() == "HIL_STATE_QUATERNION")
             self.truth.append((self.state.time_usec, local_ned(self.state)))
-            next_t += 0.01
+            next_t += self.period
             time.sleep(max(0.0, next_t - time.monotonic()))
 
     def stop(self) -> None:
