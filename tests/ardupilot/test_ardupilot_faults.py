@@ -194,5 +194,5 @@ def test_ardupilot_hexa_loses_motor_1_in_a_hover_and_lands(pair):
     assert late and all(p[0] >= 1900 and p[1] + 200 < min(p[2:]) for p in late), late
     assert touch is not None and touch < land_start * 1e6, "the hexa held on five motors"
     # Where it ends is not asserted: in LAND, when ArduPilot's land detector does not fire,
-    # its motors lift the hexa off again and it hops (tilt up to 70°) until it is disarmed;
+    # its motors lift the hexa off again and it hops (tilt up to 78°) until it is disarmed;
     # it came to rest 0.3-13.8 m from home in nine runs (docs/faults.md).
