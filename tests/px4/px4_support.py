@@ -330,6 +330,28 @@ class Px4:
         takeoff = mavutil.mavlink.MAV_CMD_NAV_TAKEOFF
         self.accepted(takeoff, lambda: self.command(takeoff, -1, 0, 0, nan, nan, nan, nan), 30)
 
+    def arm_and_take_off(self, timeout: float, attempts: int = 3) -> None:
+        """Arms as soon as PX4 accepts and commands the takeoff, again if PX4 disarmed in
+        between: PX4 disarms a vehicle still on the ground COM_DISARM_PRFLT (10 s of
+        simulation) after arming, which at several times real time is a second or two of
+        a loaded test process's time (a fleet test's PX4 once stayed on the ground so)."""
+        for _ in range(attempts):
+            self.arm_when_ready(timeout)
+            self.takeoff()
+            # The first heartbeat after the takeoff's acknowledgement (PX4 sends in order).
+            hb = self.wait_for(
+                "a heartbeat after the takeoff",
+                lambda m: (
+                    m.get_srcSystem() == self.target
+                    and m.autopilot == mavutil.mavlink.MAV_AUTOPILOT_PX4
+                ),
+                30,
+                "HEARTBEAT",
+            )
+            if self.armed(hb):
+                return
+        raise AssertionError(f"PX4 disarmed before its takeoff {attempts} times")
+
     def request(self, message_id: int, what: str, timeout: float = 30):
         """One message PX4 sends on request (MAV_CMD_REQUEST_MESSAGE, asked again every
         second: a datagram can be lost)."""
@@ -470,8 +492,7 @@ def launch(px4):
     """Waits for PX4, arms it as soon as it is ready and commands the takeoff; returns PX4's
     local frame and the takeoff target in it."""
     px4.heartbeat(60)
-    px4.arm_when_ready(60)
-    px4.takeoff()
+    px4.arm_and_take_off(60)
     frame = px4.frame()
     home = px4.home()
     return frame, (home[0], home[1], home[2] - TAKEOFF_ALT)

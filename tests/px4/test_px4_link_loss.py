@@ -3,7 +3,7 @@ hover (`link_loss` in flyloop's --config, 10 s after takeoff): every step PX4 st
 HIL_SENSOR (its lockstep tick) with the last IMU sample again and no mag or baro, no
 HIL_GPS, and its controls are dropped. What PX4 says on its console is printed and checked
 (docs/faults.md quotes it); flyloop's track records the loss; PX4 steps on through it and
-the vehicle still holds its hover after."""
+the vehicle holds its hover after, or PX4 calls a failsafe and lands it."""
 
 from __future__ import annotations
 
@@ -40,7 +40,13 @@ def test_px4_rides_out_a_two_second_link_loss(pair, tmp_path):
     assert len(fired) == 1 and len(cleared) == 1, events
     t_fired = float(fired[0].split("@")[1])
     assert abs(float(cleared[0].split("@")[1]) - t_fired - 2.0) < 0.01
-    # PX4 stepped on through the loss (the track goes on well past it) and still hovers.
+    # PX4 stepped on through the loss (the track goes on well past it) and either still
+    # hovers or, as it did in 2 of about 12 runs (docs/faults.md), declared its compass
+    # faulty after the loss, said so with a failsafe and came down ("blind land").
     assert rows[-1]["time_us"] * 1e-6 > t_fired + 10, rows[-1]["time_us"]
-    assert abs(rows[-1]["down"] + 5.0) < 1.0, rows[-1]
+    if any("Failsafe activated" in line for line in said):
+        assert any("Compass" in line for line in said), said
+        assert rows[-1]["down"] > -4.0, rows[-1]
+    else:
+        assert abs(rows[-1]["down"] + 5.0) < 1.0, rows[-1]
     assert any("BARO #0 failed:  TIMEOUT" in line for line in said), said

@@ -79,9 +79,13 @@ def fly_sequence(px4, hover: float) -> tuple[list[tuple[int, tuple]], int]:
         link.mav.set_attitude_target_send(time_ms, px4.target, 1, 128, [1, 0, 0, 0], p, q, r, t)
 
     def clock() -> int:
-        m = px4.wait_for(
-            "PX4's clock", lambda m: True, 10, ["ATTITUDE_QUATERNION", "LOCAL_POSITION_NED"]
-        )
+        # PX4's newest time this side has: whatever is queued is read first (a test process
+        # that lags under load would otherwise stamp its setpoints with an old time, and the
+        # model would apply them early by a lag that wanders).
+        kinds = ["ATTITUDE_QUATERNION", "LOCAL_POSITION_NED"]
+        m = px4.wait_for("PX4's clock", lambda m: True, 10, kinds)
+        while (newer := link.recv_match(type=kinds, blocking=False)) is not None:
+            m = newer
         return m.time_boot_ms
 
     now = clock()
@@ -153,8 +157,7 @@ def test_the_rate_loop_model_follows_px4s_body_rate_responses(pair, sitl_binary,
     for message in ("ATTITUDE_QUATERNION", "LOCAL_POSITION_NED"):
         message_id = getattr(mavutil.mavlink, f"MAVLINK_MSG_ID_{message}")
         px4.command(mavutil.mavlink.MAV_CMD_SET_MESSAGE_INTERVAL, message_id, 10_000)
-    px4.arm_when_ready(60)
-    px4.takeoff()
+    px4.arm_and_take_off(60)
     home = px4.home()
     settle(px4, (home[0], home[1], home[2] - TAKEOFF_ALT), 0.3, 60)
     collect(px4, 2.0)

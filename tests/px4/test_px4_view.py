@@ -46,8 +46,7 @@ def test_px4_takeoff_in_the_live_view_with_the_estimate_beside_the_truth(pair, t
             # otherwise first be seen with the vehicle already up.
             browser.open(url)
             ground, n_ground = browser.wait_for_vehicle(30, timeout=90)
-            px4.arm_when_ready(60)
-            px4.takeoff()
+            px4.arm_and_take_off(60)
             frame = px4.frame()
             home = px4.home()
             settle(px4, (home[0], home[1], home[2] - TAKEOFF_ALT), 0.3, 60)
