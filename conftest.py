@@ -14,6 +14,7 @@ Without xdist (a plain `pytest`), the groups change nothing.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import pytest
@@ -42,3 +43,35 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
         group = next((g for prefix, g in GROUPS.items() if path.startswith(prefix)), None)
         if group is not None:
             item.add_marker(pytest.mark.xdist_group(group))
+
+
+# Where CI's pytest time goes: per xdist worker, its tests' summed durations and the span from
+# its first test's start to its last's end; per group, the same. The longest span is the run.
+_SPANS: dict[str, list[float]] = {}
+
+
+def _account(key: str, report: pytest.TestReport) -> None:
+    span = _SPANS.setdefault(key, [math.inf, -math.inf, 0.0, 0])
+    span[0] = min(span[0], report.start)
+    span[1] = max(span[1], report.stop)
+    span[2] += report.duration
+    span[3] += report.when == "call"
+
+
+def pytest_runtest_logreport(report: pytest.TestReport) -> None:
+    if not hasattr(report, "start"):
+        return
+    worker = getattr(getattr(report, "node", None), "gateway", None)
+    group = report.nodeid.rsplit("@", 1)[1] if "@" in report.nodeid else "(no group)"
+    _account(f"worker {worker.id if worker else 'main'}", report)
+    _account(f"group {group}", report)
+
+
+def pytest_terminal_summary(terminalreporter) -> None:
+    if not _SPANS:
+        return
+    start = min(s[0] for s in _SPANS.values())
+    terminalreporter.section("where the time went (s from the first test's start)")
+    for key, (first, last, busy, n) in sorted(_SPANS.items()):
+        span = f"from {first - start:6.1f} to {last - start:6.1f}"
+        terminalreporter.write_line(f"{key:22} {n:4} tests  {busy:7.1f} s busy  {span}")
