@@ -62,7 +62,8 @@ def pytest_runtest_logreport(report: pytest.TestReport) -> None:
     if not hasattr(report, "start"):
         return
     worker = getattr(getattr(report, "node", None), "gateway", None)
-    group = report.nodeid.rsplit("@", 1)[1] if "@" in report.nodeid else "(no group)"
+    suffix = report.nodeid.rsplit("@", 1)[-1]  # xdist's "@group" (a test id may hold an @)
+    group = suffix if suffix in GROUPS.values() else "(no group)"
     _account(f"worker {worker.id if worker else 'main'}", report)
     _account(f"group {group}", report)
 

@@ -12,7 +12,6 @@ import os
 import time
 
 from flyloop.view import Viewer
-from flyloop.view.mavlink import MavlinkScene, read_tlog
 
 
 def main() -> None:
@@ -21,9 +20,8 @@ def main() -> None:
     a.add_argument("rrd", help="where the replay's recording is written")
     args = a.parse_args()
     viewer = Viewer(web_port=None, grpc_port=None, save=args.rrd, serve=False)
-    scene = MavlinkScene(viewer.scene)
     start = time.process_time()
-    n = read_tlog(args.tlog, scene)
+    n = viewer.replay(args.tlog)  # as `python -m flyloop.view FILE` and flyloop.plot replay it
     viewer.close()
     cpu = time.process_time() - start
     size = os.path.getsize(args.rrd) / 1e6

@@ -17,9 +17,10 @@ import gymnasium as gym
 import numpy as np
 import pytest
 from flight import free_port
-from flyloop import find_sitl_binary
+from flyloop import find_sitl_binary, plot
 from flyloop.plot import series_of
-from flyloop.view import Watch, WatchVector
+from flyloop.view import Viewer, Watch, WatchVector, scene
+from flyloop.view.mavlink import MavlinkScene, read_tlog
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "sitl"))
 from sitl_client import Client, Sitl, mavlink2  # noqa: E402
@@ -405,3 +406,37 @@ def test_sigterm_ends_a_watch_with_its_recording_written(tmp_path):
             view.wait()
     t, _ = series_of(rrd)["/position/vehicle3/D/truth"]
     assert len(t) == 50 and t[-1] == pytest.approx(1.0), (len(t), t[-1:])
+
+
+def _rows(rrd, column: str) -> dict[str, list]:
+    """Entity path -> [(sim time s, value)] of one column of an .rrd, in time order."""
+    out: dict[str, list] = {}
+    for name, t, values in plot._columns(rrd, column):
+        out.setdefault(name, []).extend(zip(t.tolist(), values, strict=True))
+    return {name: sorted(rows, key=lambda r: r[0]) for name, rows in out.items()}
+
+
+def test_a_replay_sent_in_columns_reads_back_as_logged_row_by_row(binary, tmp_path, monkeypatch):
+    """Regression: a replay logged every step's rows one `rr.log` each (a one-minute ArduPilot
+    flight took a minute); it now sends them as columns, in several batches here. Series,
+    poses and wind arrows must read back with the same times and values."""
+    record(binary, tmp_path / "run.tlog")
+    monkeypatch.setattr(scene, "BATCH_ROWS", 97)  # a batch ends mid-step, several times
+    columns_rrd, rows_rrd = tmp_path / "columns.rrd", tmp_path / "rows.rrd"
+    viewer = Viewer(web_port=None, grpc_port=None, save=columns_rrd, serve=False)
+    assert viewer.replay(tmp_path / "run.tlog") > 800
+    viewer.close()
+    viewer = Viewer(web_port=None, grpc_port=None, save=rows_rrd, serve=False)
+    read_tlog(str(tmp_path / "run.tlog"), MavlinkScene(viewer.scene))  # live: row by row
+    viewer.close()
+    wanted = (
+        "Scalars:scalars",
+        "Transform3D:translation",
+        "Transform3D:quaternion",
+        "Arrows3D:origins",
+        "Arrows3D:vectors",
+    )
+    for column in wanted:
+        batched, logged = _rows(columns_rrd, column), _rows(rows_rrd, column)
+        assert batched == logged, column
+        assert sum(map(len, logged.values())) >= 201, (column, list(logged))

@@ -119,7 +119,8 @@ class Viewer:
             self.rec.send_chunks(chunks)
             return len(chunks)
         try:
-            return read_tlog(str(path), MavlinkScene(self.scene))
+            with self.scene.batched():
+                return read_tlog(str(path), MavlinkScene(self.scene))
         except ValueError as e:
             raise ViewError(str(e)) from None
 
