@@ -33,17 +33,25 @@ if [[ -n "$missing" ]]; then
     fi
 fi
 
-say "Python venv .venv (test peers: fmpy, libcosimpy, pymavlink, MAVProxy, pytest)"
+say "Python venv .venv (test peers: fmpy, libcosimpy, pymavlink, MAVProxy, pytest), beside the Rust build"
 [[ -x .venv/bin/python ]] || python3 -m venv .venv
-.venv/bin/pip install -q --upgrade pip
-.venv/bin/pip install -q -r tests/requirements.txt
+# pip mostly downloads and unpacks (torch, ray: ~2.5 min) while cargo keeps both cores busy
+# compiling: run side by side, they save most of pip's time. The build only needs .venv's
+# interpreter (scripts/cargo-env.sh), which exists now.
+(.venv/bin/pip install -q --upgrade pip && .venv/bin/pip install -q -r tests/requirements.txt) &
+pip_job=$!
 
 . scripts/cargo-env.sh
 say "Rust build (release: the SITL, the FMU library, the extension's crate, the hover demo)"
 # Tests are built by scripts/test.sh, benchmarks by `cargo bench`. pack-fmus.sh, maturin and
 # the test suites reuse this build: scripts/cargo-env.sh and the workspace-hack crate keep
 # their cargo runs on the same dependency builds.
-cargo build --release --workspace --lib --bins --example hover
+if ! cargo build --release --workspace --lib --bins --example hover; then
+    wait "$pip_job" || true
+    fail "the Rust build failed (above)."
+fi
+say "Waiting for pip (the Python packages)"
+wait "$pip_job" || fail "pip install -r tests/requirements.txt failed (above)."
 
 say "Python package flyloop with its extension flyloop._native (editable, maturin)"
 # maturin builds the extension into the workspace's target/ with the release profile, so it
