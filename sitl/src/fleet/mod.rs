@@ -21,6 +21,7 @@ pub mod lockstep;
 pub mod outputs;
 pub mod px4_member;
 pub mod server;
+pub mod sockets;
 pub mod track;
 pub mod view_record;
 

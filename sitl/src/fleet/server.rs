@@ -1,41 +1,23 @@
-//! The sockets and the wall clock of fleet mode. A thread per autopilot reads its socket
-//! (PX4: accepts on its TCP port, one connection at a time; ArduPilot: its UDP port) and
-//! passes what it read to the fleet thread over one channel; the fleet thread owns the
-//! world, advances it whenever the barrier lets it, writes each due autopilot its sensors,
-//! paces simulation time against the wall clock and silences an autopilot that keeps the
-//! world waiting longer than the timeout.
+//! The wall clock of fleet mode. One fleet thread polls every autopilot's socket
+//! ([`super::sockets`]: PX4 accepts on its TCP port, one connection at a time; ArduPilot its
+//! UDP port), owns the world, advances it whenever the barrier lets it, writes each due
+//! autopilot its sensors, paces simulation time against the wall clock and silences an
+//! autopilot that keeps the world waiting longer than the timeout.
 
 use super::file::Autopilot;
 use super::lockstep::{Hold, Phase};
 use super::outputs::Outputs;
+use super::sockets::{Event, Sockets};
+pub use super::sockets::{Socket, bind};
 use super::{Fleet, Link, Notice};
 use crate::pacer::{self, Anchor, Pacing};
-use crate::server::{STOP_POLL, Shutdown, is_retry, on_stoppable_thread};
+use crate::server::{STOP_POLL, Shutdown, on_stoppable_thread};
 use crate::telemetry;
 use crate::wire::Encoder;
-use std::io::{self, Read, Write};
-use std::net::{SocketAddr, TcpListener, TcpStream, UdpSocket};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
+use std::io;
+use std::net::{SocketAddr, UdpSocket};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
-
-/// The fleet's sockets, bound before the SITL says it is ready.
-#[derive(Debug)]
-pub enum Socket {
-    Px4(TcpListener),
-    ArduPilot(UdpSocket),
-}
-
-impl Socket {
-    /// The port it is bound to (an ephemeral one when asked for port 0).
-    pub fn port(&self) -> io::Result<u16> {
-        match self {
-            Socket::Px4(listener) => listener.local_addr().map(|a| a.port()),
-            Socket::ArduPilot(socket) => socket.local_addr().map(|a| a.port()),
-        }
-    }
-}
 
 /// How the fleet runs.
 #[derive(Debug, Clone, Copy)]
@@ -50,35 +32,6 @@ pub struct FleetOptions {
 
 /// System id of the fleet's own STATUSTEXT.
 pub const FLEET_SYSTEM: u8 = 250;
-
-/// Wall time a write to a PX4 may block before its bytes are dropped (a stalled PX4 whose
-/// buffer is full must not stall the fleet).
-const WRITE_TIMEOUT: Duration = Duration::from_millis(200);
-
-/// What a socket thread read.
-enum Event {
-    Px4Connected {
-        i: usize,
-        connection: u64,
-        writer: TcpStream,
-        peer: SocketAddr,
-    },
-    Px4Bytes {
-        i: usize,
-        connection: u64,
-        bytes: Vec<u8>,
-    },
-    Px4Closed {
-        i: usize,
-        connection: u64,
-        why: String,
-    },
-    Datagram {
-        i: usize,
-        bytes: Vec<u8>,
-        from: SocketAddr,
-    },
-}
 
 fn unix_now_us() -> u64 {
     SystemTime::now()
@@ -95,156 +48,31 @@ pub async fn run(
     outputs: Outputs,
     mut shutdown: Shutdown,
 ) -> io::Result<(Fleet, String)> {
-    let (tx, rx) = mpsc::channel();
-    let mut udp = Vec::with_capacity(sockets.len());
-    for (i, socket) in sockets.into_iter().enumerate() {
-        match socket {
-            Socket::Px4(listener) => {
-                listener.set_nonblocking(false)?;
-                let tx = tx.clone();
-                std::thread::Builder::new()
-                    .name(format!("px4-{i}"))
-                    .spawn(move || accept_px4(i, listener, tx))?;
-                udp.push(None);
-            }
-            Socket::ArduPilot(socket) => {
-                socket.set_nonblocking(false)?;
-                let reader = socket.try_clone()?;
-                let tx = tx.clone();
-                std::thread::Builder::new()
-                    .name(format!("ardupilot-{i}"))
-                    .spawn(move || read_ardupilot(i, reader, tx))?;
-                udp.push(Some(socket));
-            }
-        }
-    }
-    drop(tx);
+    let sockets = Sockets::new(sockets)?;
     let gcs = match options.gcs {
         Some(target) => Some((UdpSocket::bind("0.0.0.0:0")?, target)),
         None => None,
     };
     let work = move |stop: &AtomicBool| {
-        let mut state = Serving::new(fleet, udp, gcs, options, outputs);
-        state.serve(&rx, stop);
+        let mut state = Serving::new(fleet, sockets, gcs, options, outputs);
+        let served = state.serve(stop);
         state.outputs.flush();
         let summary = state.summary();
-        (state.fleet, summary)
+        served.map(|()| (state.fleet, summary))
     };
-    let ((fleet, summary), _) =
-        on_stoppable_thread("fleet thread", &mut shutdown, work, async || {
-            std::future::pending::<()>().await
-        })
-        .await?;
+    let (served, _) = on_stoppable_thread("fleet thread", &mut shutdown, work, async || {
+        std::future::pending::<()>().await
+    })
+    .await?;
+    let (fleet, summary) = served?;
     tracing::info!("stopping on a signal");
     Ok((fleet, summary))
-}
-
-/// PX4 i's port: one connection at a time (a second is refused while one is active); each
-/// read goes to the fleet thread.
-fn accept_px4(i: usize, listener: TcpListener, tx: Sender<Event>) {
-    let active = Arc::new(AtomicBool::new(false));
-    let connections = Arc::new(AtomicU64::new(0));
-    loop {
-        let (stream, peer) = match listener.accept() {
-            Ok(accepted) => accepted,
-            Err(e) => {
-                tracing::warn!(error = %e, "accepting PX4 {i}'s connection failed");
-                std::thread::sleep(Duration::from_millis(50));
-                continue;
-            }
-        };
-        if active.swap(true, Ordering::SeqCst) {
-            tracing::warn!(%peer, port = listener.local_addr().map(|a| a.port()).unwrap_or(0), "refused a second PX4 connection: one PX4 is already connected on this port");
-            continue;
-        }
-        let connection = connections.fetch_add(1, Ordering::SeqCst) + 1;
-        let writer = match prepare(&stream) {
-            Ok(w) => w,
-            Err(e) => {
-                tracing::warn!(%peer, error = %e, "PX4 connection unusable: dropped");
-                active.store(false, Ordering::SeqCst);
-                continue;
-            }
-        };
-        let connected = Event::Px4Connected {
-            i,
-            connection,
-            writer,
-            peer,
-        };
-        if tx.send(connected).is_err() {
-            return;
-        }
-        let (tx, active) = (tx.clone(), Arc::clone(&active));
-        let spawned = std::thread::Builder::new()
-            .name(format!("px4-{i}-read"))
-            .spawn(move || {
-                let why = read_px4(i, connection, stream, &tx);
-                let _ = tx.send(Event::Px4Closed { i, connection, why });
-                active.store(false, Ordering::SeqCst);
-            });
-        if let Err(e) = spawned {
-            tracing::warn!(error = %e, "no thread for PX4 {i}'s connection");
-            return;
-        }
-    }
-}
-
-/// The writing half of a PX4 connection: no Nagle delay, writes that give up.
-fn prepare(stream: &TcpStream) -> io::Result<TcpStream> {
-    stream.set_nodelay(true)?;
-    let writer = stream.try_clone()?;
-    writer.set_write_timeout(Some(WRITE_TIMEOUT))?;
-    Ok(writer)
-}
-
-fn read_px4(i: usize, connection: u64, mut stream: TcpStream, tx: &Sender<Event>) -> String {
-    let mut buf = vec![0u8; 16_384];
-    loop {
-        match stream.read(&mut buf) {
-            Ok(0) => return "connection closed".into(),
-            Ok(n) => {
-                let bytes = buf[..n].to_vec();
-                if tx
-                    .send(Event::Px4Bytes {
-                        i,
-                        connection,
-                        bytes,
-                    })
-                    .is_err()
-                {
-                    return "fleet stopped".into();
-                }
-            }
-            Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
-            Err(e) => return format!("read failed: {e}"),
-        }
-    }
-}
-
-fn read_ardupilot(i: usize, socket: UdpSocket, tx: Sender<Event>) {
-    let mut buf = vec![0u8; 2048];
-    loop {
-        match socket.recv_from(&mut buf) {
-            Ok((n, from)) => {
-                let bytes = buf[..n].to_vec();
-                if tx.send(Event::Datagram { i, bytes, from }).is_err() {
-                    return;
-                }
-            }
-            Err(e) if is_retry(e.kind()) => {}
-            // E.g. an ICMP error reported on the socket: the loop goes on.
-            Err(e) => tracing::debug!(error = %e, "ArduPilot {i}: receive failed"),
-        }
-    }
 }
 
 /// The fleet thread's state.
 struct Serving {
     fleet: Fleet,
-    /// PX4 i's current connection: its number and writing half.
-    writers: Vec<Option<(u64, TcpStream)>>,
-    udp: Vec<Option<UdpSocket>>,
+    sockets: Sockets,
     /// What is written beside the flight after every step (`--track`).
     outputs: Outputs,
     gcs: Option<(UdpSocket, SocketAddr)>,
@@ -265,7 +93,7 @@ struct Serving {
 impl Serving {
     fn new(
         fleet: Fleet,
-        udp: Vec<Option<UdpSocket>>,
+        sockets: Sockets,
         gcs: Option<(UdpSocket, SocketAddr)>,
         options: FleetOptions,
         mut outputs: Outputs,
@@ -277,8 +105,7 @@ impl Serving {
         outputs.after_step(&fleet);
         Serving {
             fleet,
-            writers: (0..n).map(|_| None).collect(),
-            udp,
+            sockets,
             outputs,
             gcs,
             encoder: Encoder::default(),
@@ -294,24 +121,20 @@ impl Serving {
         }
     }
 
-    fn serve(&mut self, rx: &Receiver<Event>, stop: &AtomicBool) {
+    fn serve(&mut self, stop: &AtomicBool) -> io::Result<()> {
+        let mut events = Vec::new();
         while !stop.load(Ordering::Relaxed) {
-            match rx.recv_timeout(self.wait()) {
-                Ok(event) => {
-                    self.handle(event);
-                    // Everything already read, before stepping: fewer, larger batches.
-                    while let Ok(event) = rx.try_recv() {
-                        self.handle(event);
-                    }
-                }
-                Err(RecvTimeoutError::Timeout) => {}
-                Err(RecvTimeoutError::Disconnected) => return,
+            // Everything read in one wake-up is handled before the world steps.
+            self.sockets.poll(self.wait(), &mut events)?;
+            for event in events.drain(..) {
+                self.handle(event);
             }
             self.run_world();
             self.check_timeouts();
             self.send_notices();
             self.log_speed();
         }
+        Ok(())
     }
 
     /// How long to wait for a socket: until the next free step, the next timeout, or the
@@ -335,43 +158,20 @@ impl Serving {
 
     fn handle(&mut self, event: Event) {
         match event {
-            Event::Px4Connected {
-                i,
-                connection,
-                writer,
-                peer,
-            } => {
+            Event::Px4Connected { i, peer } => {
                 tracing::info!(%peer, vehicle = %self.fleet.members()[i].name, "PX4 connected");
-                self.writers[i] = Some((connection, writer));
                 self.fleet.px4_connected(i);
                 self.sent_at[i] = Instant::now();
                 self.flush(i);
             }
-            Event::Px4Bytes {
-                i,
-                connection,
-                bytes,
-            } => {
-                if self.is_current(i, connection) {
-                    self.fleet.px4_bytes(i, &bytes);
-                }
-            }
-            Event::Px4Closed { i, connection, why } => {
-                if self.is_current(i, connection) {
-                    self.writers[i] = None;
-                    self.fleet.px4_closed(i, &why);
-                }
-            }
+            Event::Px4Bytes { i, bytes } => self.fleet.px4_bytes(i, &bytes),
+            Event::Px4Closed { i, why } => self.fleet.px4_closed(i, &why),
             Event::Datagram { i, bytes, from } => {
                 if self.fleet.ardupilot_datagram(i, &bytes, from) {
                     self.reply_ardupilot(i);
                 }
             }
         }
-    }
-
-    fn is_current(&self, i: usize, connection: u64) -> bool {
-        matches!(&self.writers[i], Some((c, _)) if *c == connection)
     }
 
     /// Steps the world as far as the barrier lets it (and the free clock, when nobody is in
@@ -416,12 +216,12 @@ impl Serving {
                 if member.out.is_empty() {
                     return;
                 }
-                if let Some((_, w)) = &mut self.writers[i] {
-                    if let Err(e) = w.write_all(&member.out) {
-                        tracing::warn!(vehicle = %member.name, error = %e, "write to PX4 failed: bytes dropped");
-                    }
-                }
+                let closed = self.sockets.write_px4(i, &member.out, &member.name);
                 member.out.clear();
+                if let Some(why) = closed {
+                    tracing::warn!(vehicle = %member.name, why = %why, "write to PX4 failed");
+                    self.fleet.px4_closed(i, &why);
+                }
             }
             Link::ArduPilot(_) => self.reply_ardupilot(i),
         }
@@ -429,11 +229,11 @@ impl Serving {
 
     fn reply_ardupilot(&mut self, i: usize) {
         let member = &self.fleet.members()[i];
-        let (Link::ArduPilot(a), Some(socket)) = (&member.link, &self.udp[i]) else {
+        let Link::ArduPilot(a) = &member.link else {
             return;
         };
         if let Some(peer) = a.peer {
-            if let Err(e) = socket.send_to(a.reply(), peer) {
+            if let Err(e) = self.sockets.send_ardupilot(i, a.reply(), peer) {
                 tracing::debug!(vehicle = %member.name, error = %e, "reply to ArduPilot failed");
             }
         }
@@ -515,17 +315,3 @@ impl Serving {
 
 /// Wall time between two speed lines in the log.
 const SPEED_LOG: Duration = Duration::from_secs(10);
-
-/// Sockets of `fleet`'s autopilots, in its (name) order.
-pub fn bind(fleet: &Fleet) -> Result<Vec<Socket>, (String, SocketAddr, io::Error)> {
-    (fleet.members().iter())
-        .map(|m| match m.autopilot {
-            Autopilot::Px4 => TcpListener::bind(m.listen)
-                .map(Socket::Px4)
-                .map_err(|e| (m.name.clone(), m.listen, e)),
-            Autopilot::Ardupilot => UdpSocket::bind(m.listen)
-                .map(Socket::ArduPilot)
-                .map_err(|e| (m.name.clone(), m.listen, e)),
-        })
-        .collect()
-}
