@@ -10,9 +10,9 @@ use std::net::TcpStream;
 use std::process::{Child, Command};
 use std::time::{Duration, Instant};
 
-struct Fleet {
-    child: Child,
-    ports: Vec<u16>,
+pub(crate) struct Fleet {
+    pub(crate) child: Child,
+    pub(crate) ports: Vec<u16>,
 }
 
 /// A failing test must not leave the SITL running.
@@ -24,6 +24,11 @@ impl Drop for Fleet {
 }
 
 fn start_fleet(vehicles: &str, speed: &str) -> Fleet {
+    start_fleet_with(vehicles, speed, &[])
+}
+
+/// A PX4 fleet of `vehicles` on ephemeral ports, with more arguments.
+pub(crate) fn start_fleet_with(vehicles: &str, speed: &str, more: &[&str]) -> Fleet {
     let mut command = Command::new(env!("CARGO_BIN_EXE_flyloop-sitl"));
     command
         .args([
@@ -40,7 +45,8 @@ fn start_fleet(vehicles: &str, speed: &str) -> Fleet {
             "off",
             "--log-level",
             "warn",
-        ]);
+        ])
+        .args(more);
     let (child, line) = spawn_ready(&mut command);
     assert!(line.starts_with("flyloop-sitl ready mode=fleet"), "{line}");
     // members=px4-000:px4:PORT:SYSID,...

@@ -3,6 +3,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod fleet_paced_start;
+mod fleet_waits_for_every_px4;
 mod handler_fuzz;
 mod inject_failure;
 mod link_faults;

@@ -23,6 +23,7 @@ pub mod px4_member;
 pub mod server;
 pub mod sockets;
 pub mod track;
+pub mod uring;
 pub mod view_record;
 
 use crate::control_link::ControlLink;

@@ -48,12 +48,13 @@ pub async fn run(
     outputs: Outputs,
     mut shutdown: Shutdown,
 ) -> io::Result<(Fleet, String)> {
-    let sockets = Sockets::new(sockets)?;
     let gcs = match options.gcs {
         Some(target) => Some((UdpSocket::bind("0.0.0.0:0")?, target)),
         None => None,
     };
     let work = move |stop: &AtomicBool| {
+        // Made here: the io_uring in it belongs to the thread that uses it.
+        let sockets = Sockets::new(sockets)?;
         let mut state = Serving::new(fleet, sockets, gcs, options, outputs);
         let served = state.serve(stop);
         state.outputs.flush();
@@ -122,10 +123,13 @@ impl Serving {
     }
 
     fn serve(&mut self, stop: &AtomicBool) -> io::Result<()> {
-        let mut events = Vec::new();
+        let (mut events, mut awaited) = (Vec::new(), Vec::new());
         while !stop.load(Ordering::Relaxed) {
+            let l = self.fleet.lockstep();
+            awaited.clear();
+            awaited.extend((0..l.len()).filter(|&i| l.is_awaited(i)));
             // Everything read in one wake-up is handled before the world steps.
-            self.sockets.poll(self.wait(), &mut events)?;
+            self.sockets.poll(self.wait(), &awaited, &mut events)?;
             for event in events.drain(..) {
                 self.handle(event);
             }
@@ -163,6 +167,7 @@ impl Serving {
                 self.fleet.px4_connected(i);
                 self.sent_at[i] = Instant::now();
                 self.flush(i);
+                self.send_queued();
             }
             Event::Px4Bytes { i, bytes } => self.fleet.px4_bytes(i, &bytes),
             Event::Px4Closed { i, why } => self.fleet.px4_closed(i, &why),
@@ -196,6 +201,7 @@ impl Serving {
                 self.sent_at[i] = sent;
                 self.flush(i);
             }
+            self.send_queued();
             let t = self.fleet.lockstep().now_us();
             pacer::wait_for(self.options.pacing, &mut self.anchor, t, now);
             if !lockstep {
@@ -208,7 +214,20 @@ impl Serving {
         }
     }
 
-    /// Autopilot i's pending bytes to its socket.
+    /// The PX4 writes `flush` queued, all at once; a PX4 a write failed on is gone.
+    fn send_queued(&mut self) {
+        let mut closed = Vec::new();
+        self.sockets.send_queued(&mut closed);
+        for event in closed {
+            if let Event::Px4Closed { i, why } = &event {
+                let name = &self.fleet.members()[*i].name;
+                tracing::warn!(vehicle = %name, why = %why, "write to PX4 failed");
+            }
+            self.handle(event);
+        }
+    }
+
+    /// Autopilot i's pending bytes: a PX4's queued for `send_queued`, an ArduPilot's sent.
     fn flush(&mut self, i: usize) {
         let member = self.fleet.member_mut(i);
         match &member.link {
@@ -216,12 +235,8 @@ impl Serving {
                 if member.out.is_empty() {
                     return;
                 }
-                let closed = self.sockets.write_px4(i, &member.out, &member.name);
+                self.sockets.queue_px4(i, &member.out, &member.name);
                 member.out.clear();
-                if let Some(why) = closed {
-                    tracing::warn!(vehicle = %member.name, why = %why, "write to PX4 failed");
-                    self.fleet.px4_closed(i, &why);
-                }
             }
             Link::ArduPilot(_) => self.reply_ardupilot(i),
         }

@@ -8,12 +8,14 @@
 //! asleep in one wake-up.
 
 use super::file::Autopilot;
+use super::uring::{Item, Uring};
 use super::{Fleet, Member};
 use crate::server::is_retry;
 use mio::net::{TcpListener, TcpStream, UdpSocket};
 use mio::{Events, Interest, Poll, Token};
 use std::io::{self, Read, Write};
 use std::net::SocketAddr;
+use std::os::fd::{AsRawFd, RawFd};
 use std::time::Duration;
 
 /// The fleet's sockets, bound before the SITL says it is ready.
@@ -107,6 +109,9 @@ pub struct Sockets {
     events: Events,
     ports: Vec<Port>,
     buf: Vec<u8>,
+    /// PX4s with bytes queued since the last `send_queued`.
+    queued: Vec<usize>,
+    uring: Uring,
 }
 
 impl Sockets {
@@ -138,13 +143,37 @@ impl Sockets {
         Ok(Sockets {
             poll,
             events: Events::with_capacity(2 * ports.len().max(1)),
+            uring: Uring::new(ports.len()),
             ports,
             buf: vec![0; READ_BUFFER],
+            queued: Vec::new(),
         })
     }
 
-    /// Waits up to `timeout` for any socket, then reads everything that is there into `out`.
-    pub fn poll(&mut self, timeout: Duration, out: &mut Vec<Event>) -> io::Result<()> {
+    /// Waits up to `timeout` for any socket — or, while the world waits for the PX4s of
+    /// `awaited` only, for all of them to answer — then reads everything that is there into
+    /// `out`. Must be called on the thread that made `self` (its io_uring).
+    pub fn poll(
+        &mut self,
+        timeout: Duration,
+        awaited: &[usize],
+        out: &mut Vec<Event>,
+    ) -> io::Result<()> {
+        let px4s: Option<Vec<(usize, RawFd)>> = (awaited.iter())
+            .map(|&i| match &self.ports[i] {
+                Port::Px4 {
+                    connection: Some(c),
+                    ..
+                } => Some((i, c.stream.as_raw_fd())),
+                _ => None,
+            })
+            .collect();
+        let timeout = match px4s {
+            Some(fds) if !fds.is_empty() && self.uring.wait_readable(&fds, timeout).is_some() => {
+                Duration::ZERO
+            }
+            _ => timeout,
+        };
         match self.poll.poll(&mut self.events, Some(timeout)) {
             Ok(()) => {}
             Err(e) if e.kind() == io::ErrorKind::Interrupted => return Ok(()),
@@ -253,6 +282,7 @@ impl Sockets {
     fn close(&mut self, i: usize, why: String, out: &mut Vec<Event>) {
         if let Port::Px4 { connection, .. } = &mut self.ports[i] {
             if let Some(mut c) = connection.take() {
+                self.uring.disarm(i);
                 // Dropping the stream closes it, which also removes it from the poll.
                 let _ = self.poll.registry().deregister(&mut c.stream);
                 out.push(Event::Px4Closed { i, why });
@@ -260,30 +290,84 @@ impl Sockets {
         }
     }
 
-    /// Sends `bytes` to PX4 i (nothing if it is not connected). What its socket has no room
-    /// for waits for the socket to drain, up to PENDING_CAP; beyond that whole writes drop.
-    /// Returns why the connection closed, if the write closed it.
-    pub fn write_px4(&mut self, i: usize, bytes: &[u8], name: &str) -> Option<String> {
+    /// Queues `bytes` for PX4 i (nothing if it is not connected) until [`Self::send_queued`].
+    /// What its socket has no room for waits for the socket to drain, up to PENDING_CAP;
+    /// beyond that whole writes drop.
+    pub fn queue_px4(&mut self, i: usize, bytes: &[u8], name: &str) {
         let Port::Px4 {
             connection: Some(c),
             ..
         } = &mut self.ports[i]
         else {
-            return None;
+            return;
         };
         if c.pending.len() + bytes.len() > PENDING_CAP {
             if c.dropped == 0 {
                 tracing::warn!(vehicle = %name, "PX4 does not read its socket: sensor bytes dropped");
             }
             c.dropped += 1;
-            return None;
+            return;
         }
         c.pending.extend_from_slice(bytes);
-        let mut closed = Vec::new();
-        self.send_pending(i, &mut closed);
-        match closed.pop() {
-            Some(Event::Px4Closed { why, .. }) => Some(why),
-            _ => None,
+        if !self.queued.contains(&i) {
+            self.queued.push(i);
+        }
+    }
+
+    /// Sends what was queued, to every PX4 at once where it can (`BatchSend`); a connection
+    /// a write fails on is closed (a `Px4Closed` in `out`).
+    pub fn send_queued(&mut self, out: &mut Vec<Event>) {
+        let mut queued = std::mem::take(&mut self.queued);
+        let sent = if queued.len() >= 2 {
+            let items: Vec<Item<'_>> = (queued.iter())
+                .filter_map(|&i| match &self.ports[i] {
+                    Port::Px4 {
+                        connection: Some(c),
+                        ..
+                    } => Some((c.stream.as_raw_fd(), &c.pending[..])),
+                    _ => None,
+                })
+                .collect();
+            if items.len() == queued.len() {
+                self.uring.send(&items)
+            } else {
+                None
+            }
+        } else {
+            None
+        };
+        match sent {
+            Some(results) => {
+                for (&i, result) in queued.iter().zip(results) {
+                    self.sent(i, result, out);
+                }
+            }
+            None => {
+                for &i in &queued {
+                    self.send_pending(i, out);
+                }
+            }
+        }
+        queued.clear();
+        self.queued = queued;
+    }
+
+    /// What a batched write to PX4 i did: the rest goes as `send_pending` sends it.
+    fn sent(&mut self, i: usize, result: io::Result<usize>, out: &mut Vec<Event>) {
+        let Port::Px4 {
+            connection: Some(c),
+            ..
+        } = &mut self.ports[i]
+        else {
+            return;
+        };
+        match result {
+            Ok(n) => {
+                c.pending.drain(..n.min(c.pending.len()));
+                self.send_pending(i, out);
+            }
+            Err(e) if e.kind() == io::ErrorKind::WouldBlock => {}
+            Err(e) => self.close(i, format!("write failed: {e}"), out),
         }
     }
 
