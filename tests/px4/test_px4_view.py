@@ -75,8 +75,11 @@ def test_px4_takeoff_in_the_live_view_with_the_estimate_beside_the_truth(pair, t
     truth_at = np.interp(up, t_true, d_true)
     gap = np.abs(np.interp(up, t_est, d_est) - truth_at)
     # 0.06-0.09 m measured once PX4 answers the view's commands; regression: addressed to
-    # system 0, PX4 ignored them, the origin never came and the gap was 0.1-0.57 m by run.
-    assert gap.max() < 0.3, gap.max()
+    # system 0, PX4 ignored them, the origin never came and the gap was 0.1-0.57 m by run,
+    # all flight long. Percentiles, not the maximum: in one CI run on a slow machine (this
+    # test 177 s) the gap was ~0.04 m but for one moment of 0.40 m among 10,006 samples.
+    assert np.median(gap) < 0.1, np.median(gap)
+    assert np.percentile(gap, 99) < 0.3, np.percentile(gap, 99)
     assert -d_true.min() > TAKEOFF_ALT - 0.5
     _, n_estimate = series["/position/vehicle1/N/estimate"]
     assert np.isfinite(n_estimate).all()
