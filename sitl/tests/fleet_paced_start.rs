@@ -24,12 +24,18 @@ impl Drop for Fleet {
 }
 
 fn start_fleet(vehicles: &str, speed: &str) -> Fleet {
-    start_fleet_with(vehicles, speed, &[])
+    start_fleet_with(vehicles, speed, &[], &[])
 }
 
-/// A PX4 fleet of `vehicles` on ephemeral ports, with more arguments.
-pub(crate) fn start_fleet_with(vehicles: &str, speed: &str, more: &[&str]) -> Fleet {
+/// A PX4 fleet of `vehicles` on ephemeral ports, with more arguments and environment.
+pub(crate) fn start_fleet_with(
+    vehicles: &str,
+    speed: &str,
+    more: &[&str],
+    env: &[(&str, &str)],
+) -> Fleet {
     let mut command = Command::new(env!("CARGO_BIN_EXE_flyloop-sitl"));
+    command.envs(env.iter().copied());
     command
         .args([
             "--px4",

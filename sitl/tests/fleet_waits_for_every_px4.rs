@@ -3,9 +3,12 @@
 //! sensors to all PX4s at once. Pinned here over real TCP with plain clients in the PX4s'
 //! place: a step needs every answer, all get the next sensors, and a PX4 that hangs up
 //! while the world waits for it frees the others at once (its pending wait taken back),
-//! not after the autopilot timeout; a PX4 that comes back on the port flies again.
+//! not after the autopilot timeout; a PX4 that comes back on the port flies again. Each
+//! twice: with io_uring, and with it off (`FLYLOOP_IO_URING=off`, the fleet as where the
+//! kernel refuses io_uring).
 
 use crate::fleet_paced_start::start_fleet_with;
+use flyloop_sitl::fleet::uring::OFF;
 use flyloop_sitl::wire::{Encoder, StreamDecoder};
 use mavlink::dialects::common::{HIL_ACTUATOR_CONTROLS_DATA, HilActuatorControlsFlags, MavMessage};
 use std::io::{ErrorKind, Read, Write};
@@ -121,10 +124,19 @@ fn in_step(a: &mut FakePx4, b: &mut FakePx4, when: &str) {
     }
 }
 
+/// With io_uring where the kernel has it, and as without it.
+const MODES: [&[(&str, &str)]; 2] = [&[], &[OFF]];
+
 #[test]
 fn a_step_waits_for_every_px4_and_a_px4_that_hangs_up_frees_the_others_at_once() {
+    for env in MODES {
+        step_waits_for_every_px4(env);
+    }
+}
+
+fn step_waits_for_every_px4(env: &[(&str, &str)]) {
     // A timeout far longer than any wait below: a wait that long would be the timeout's.
-    let fleet = start_fleet_with("2", "0", &["--autopilot-timeout", "30"]);
+    let fleet = start_fleet_with("2", "0", &["--autopilot-timeout", "30"], env);
     let (mut a, mut b) = both_in_lockstep(&fleet.ports);
     for step in 0..8 {
         // A alone: the world waits for B.
@@ -169,7 +181,13 @@ fn a_step_waits_for_every_px4_and_a_px4_that_hangs_up_frees_the_others_at_once()
 
 #[test]
 fn a_px4_silenced_while_the_world_waited_for_it_rejoins_with_its_late_answer() {
-    let fleet = start_fleet_with("2", "0", &["--autopilot-timeout", "0.3"]);
+    for env in MODES {
+        silenced_px4_rejoins(env);
+    }
+}
+
+fn silenced_px4_rejoins(env: &[(&str, &str)]) {
+    let fleet = start_fleet_with("2", "0", &["--autopilot-timeout", "0.3"], env);
     let (mut a, mut b) = both_in_lockstep(&fleet.ports);
     for round in 0..3 {
         // B keeps the world waiting past the timeout: silenced, A flies on without it.

@@ -19,6 +19,10 @@
 
 use std::os::fd::RawFd;
 
+/// The environment variable and value that turn io_uring off: the fleet then runs as where
+/// the kernel refuses it (to compare, or where io_uring misbehaves).
+pub const OFF: (&str, &str) = ("FLYLOOP_IO_URING", "off");
+
 /// One write: a socket and the bytes for it.
 pub type Item<'a> = (RawFd, &'a [u8]);
 
@@ -54,7 +58,7 @@ impl Uring {
 
 #[cfg(target_os = "linux")]
 mod linux {
-    use super::Item;
+    use super::{Item, OFF};
     use io_uring::{IoUring, opcode, types};
     use std::io;
     use std::os::fd::RawFd;
@@ -110,6 +114,10 @@ mod linux {
     impl Uring {
         /// A ring for a fleet of `members` (made on the thread that will use it).
         pub fn new(members: usize) -> Self {
+            if std::env::var(OFF.0).is_ok_and(|v| v == OFF.1) {
+                tracing::info!("io_uring off ({}={}): the fleet writes each PX4's socket with its own system call and waits in epoll", OFF.0, OFF.1);
+                return Uring { ring: None };
+            }
             let entries = (2 * members).clamp(2, 4096).next_power_of_two() as u32;
             let ring = match build(entries) {
                 Ok((ring, waits)) => {
