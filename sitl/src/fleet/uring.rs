@@ -115,7 +115,11 @@ mod linux {
         /// A ring for a fleet of `members` (made on the thread that will use it).
         pub fn new(members: usize) -> Self {
             if std::env::var(OFF.0).is_ok_and(|v| v == OFF.1) {
-                tracing::info!("io_uring off ({}={}): the fleet writes each PX4's socket with its own system call and waits in epoll", OFF.0, OFF.1);
+                tracing::info!(
+                    "io_uring off ({}={}): the fleet writes each PX4's socket with its own system call and waits in epoll",
+                    OFF.0,
+                    OFF.1
+                );
                 return Uring { ring: None };
             }
             let entries = (2 * members).clamp(2, 4096).next_power_of_two() as u32;
