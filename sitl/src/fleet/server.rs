@@ -129,7 +129,8 @@ impl Serving {
             awaited.clear();
             awaited.extend((0..l.len()).filter(|&i| l.is_awaited(i)));
             // Everything read in one wake-up is handled before the world steps.
-            self.sockets.poll(self.wait(), &awaited, &mut events)?;
+            self.sockets
+                .poll(self.wait(&awaited), &awaited, &mut events)?;
             for event in events.drain(..) {
                 self.handle(event);
             }
@@ -141,9 +142,9 @@ impl Serving {
         Ok(())
     }
 
-    /// How long to wait for a socket: until the next free step, the next timeout, or the
-    /// next look at the stop flag.
-    fn wait(&self) -> Duration {
+    /// How long to wait for a socket: until the next free step, the next timeout of the
+    /// autopilots the world waits for (`awaited`), or the next look at the stop flag.
+    fn wait(&self, awaited: &[usize]) -> Duration {
         let now = Instant::now();
         let mut until = now + STOP_POLL;
         let l = self.fleet.lockstep();
@@ -152,7 +153,7 @@ impl Serving {
         if free && !lockstep {
             until = until.min(self.next_free);
         }
-        for i in (0..l.len()).filter(|&i| l.is_awaited(i)) {
+        for &i in awaited {
             until = until.min(self.sent_at[i] + self.options.timeout);
         }
         until

@@ -94,6 +94,23 @@ enum Port {
     ArduPilot(UdpSocket),
 }
 
+impl Port {
+    /// PX4's current connection, if this is a PX4's port and one is connected.
+    fn connection(&self) -> Option<&Connection> {
+        match self {
+            Port::Px4 { connection, .. } => connection.as_ref(),
+            Port::ArduPilot(_) => None,
+        }
+    }
+
+    fn connection_mut(&mut self) -> Option<&mut Connection> {
+        match self {
+            Port::Px4 { connection, .. } => connection.as_mut(),
+            Port::ArduPilot(_) => None,
+        }
+    }
+}
+
 /// Autopilot i's port has token 2i, its PX4 connection 2i + 1.
 fn port_token(i: usize) -> Token {
     Token(2 * i)
@@ -160,13 +177,7 @@ impl Sockets {
         out: &mut Vec<Event>,
     ) -> io::Result<()> {
         let px4s: Option<Vec<(usize, RawFd)>> = (awaited.iter())
-            .map(|&i| match &self.ports[i] {
-                Port::Px4 {
-                    connection: Some(c),
-                    ..
-                } => Some((i, c.stream.as_raw_fd())),
-                _ => None,
-            })
+            .map(|&i| Some((i, self.ports[i].connection()?.stream.as_raw_fd())))
             .collect();
         let timeout = match px4s {
             Some(fds) if !fds.is_empty() && self.uring.wait_readable(&fds, timeout).is_some() => {
@@ -179,20 +190,20 @@ impl Sockets {
             Err(e) if e.kind() == io::ErrorKind::Interrupted => return Ok(()),
             Err(e) => return Err(e),
         }
-        let ready: Vec<(Token, bool)> = (self.events.iter())
-            .map(|e| (e.token(), e.is_writable()))
-            .collect();
-        for (token, writable) in ready {
-            let i = token.0 / 2;
-            if token.0 % 2 == 0 {
+        // Taken out while its events are handled (they need `self`), put back after.
+        let events = std::mem::replace(&mut self.events, Events::with_capacity(0));
+        for event in &events {
+            let i = event.token().0 / 2;
+            if event.token().0 % 2 == 0 {
                 self.read_port(i, out);
             } else {
-                if writable {
+                if event.is_writable() {
                     self.send_pending(i, out);
                 }
                 self.read_connection(i, out);
             }
         }
+        self.events = events;
         Ok(())
     }
 
@@ -250,10 +261,7 @@ impl Sockets {
 
     /// Reads PX4 i's connection until it is drained; a closed or failed one is dropped.
     fn read_connection(&mut self, i: usize, out: &mut Vec<Event>) {
-        let Port::Px4 { connection, .. } = &mut self.ports[i] else {
-            return;
-        };
-        let Some(c) = connection else {
+        let Some(c) = self.ports[i].connection_mut() else {
             return;
         };
         let why = loop {
@@ -294,11 +302,7 @@ impl Sockets {
     /// What its socket has no room for waits for the socket to drain, up to PENDING_CAP;
     /// beyond that whole writes drop.
     pub fn queue_px4(&mut self, i: usize, bytes: &[u8], name: &str) {
-        let Port::Px4 {
-            connection: Some(c),
-            ..
-        } = &mut self.ports[i]
-        else {
+        let Some(c) = self.ports[i].connection_mut() else {
             return;
         };
         if c.pending.len() + bytes.len() > PENDING_CAP {
@@ -314,19 +318,14 @@ impl Sockets {
         }
     }
 
-    /// Sends what was queued, to every PX4 at once where it can (`BatchSend`); a connection
+    /// Sends what was queued, to every PX4 at once where it can ([`Uring::send`]); a connection
     /// a write fails on is closed (a `Px4Closed` in `out`).
     pub fn send_queued(&mut self, out: &mut Vec<Event>) {
         let mut queued = std::mem::take(&mut self.queued);
         let sent = if queued.len() >= 2 {
             let items: Vec<Item<'_>> = (queued.iter())
-                .filter_map(|&i| match &self.ports[i] {
-                    Port::Px4 {
-                        connection: Some(c),
-                        ..
-                    } => Some((c.stream.as_raw_fd(), &c.pending[..])),
-                    _ => None,
-                })
+                .filter_map(|&i| self.ports[i].connection())
+                .map(|c| (c.stream.as_raw_fd(), &c.pending[..]))
                 .collect();
             if items.len() == queued.len() {
                 self.uring.send(&items)
@@ -354,11 +353,7 @@ impl Sockets {
 
     /// What a batched write to PX4 i did: the rest goes as `send_pending` sends it.
     fn sent(&mut self, i: usize, result: io::Result<usize>, out: &mut Vec<Event>) {
-        let Port::Px4 {
-            connection: Some(c),
-            ..
-        } = &mut self.ports[i]
-        else {
+        let Some(c) = self.ports[i].connection_mut() else {
             return;
         };
         match result {
@@ -373,11 +368,7 @@ impl Sockets {
 
     /// Writes PX4 i's pending bytes until they are gone or its socket is full.
     fn send_pending(&mut self, i: usize, out: &mut Vec<Event>) {
-        let Port::Px4 {
-            connection: Some(c),
-            ..
-        } = &mut self.ports[i]
-        else {
+        let Some(c) = self.ports[i].connection_mut() else {
             return;
         };
         let mut sent = 0;
