@@ -211,3 +211,38 @@ fn silenced_px4_rejoins(env: &[(&str, &str)]) {
         in_step(&mut a, &mut b, &format!("round {round}"));
     }
 }
+
+#[test]
+fn a_silenced_px4_is_sent_sensors_again_until_it_answers() {
+    // Regression: a silenced PX4 was sent nothing until it answered, and a PX4 silenced under
+    // load that was itself waiting for sensors never answered ("poll timeout" for good).
+    for env in MODES {
+        silenced_px4_is_reminded(env);
+    }
+}
+
+fn silenced_px4_is_reminded(env: &[(&str, &str)]) {
+    let fleet = start_fleet_with("2", "0", &["--autopilot-timeout", "0.3"], env);
+    let (mut a, mut b) = both_in_lockstep(&fleet.ports);
+    // B has read its sensors and does not answer: silenced; A flies on without it.
+    let unanswered = b.last_sensor_us;
+    a.answer();
+    std::thread::sleep(Duration::from_millis(600));
+    assert!(a.sensors_within(Duration::from_secs(2)) >= 1, "A stopped");
+    for _ in 0..20 {
+        assert_eq!(a.step(Duration::from_secs(2)), 1, "A alone");
+    }
+    // B gets sensors again, at the world's time (A's steps), though it never answered.
+    assert!(
+        b.sensors_within(Duration::from_secs(2)) >= 1,
+        "a silent PX4 was sent nothing"
+    );
+    assert!(
+        b.last_sensor_us > unanswered,
+        "the reminder is not at the world's time"
+    );
+    // Its answer to them puts it back in lockstep.
+    b.answer();
+    a.answer();
+    in_step(&mut a, &mut b, "after the reminder");
+}

@@ -31,8 +31,10 @@ def pair(px4_dir, sitl_binary):
     work = fresh_dir("flyloop-px4-")
 
     class Pair:
-        def flyloop(self, *args: str) -> Flyloop:
-            f = Flyloop(sitl_binary, instance, work, *args)
+        number = instance  # PX4's instance (`px4 -i`): its ports before it starts
+
+        def flyloop(self, *args: str, speed=None) -> Flyloop:
+            f = Flyloop(sitl_binary, instance, work, *args, speed=speed)
             started.append(f)
             return f
 

@@ -23,28 +23,36 @@ from flight import free_port, rise  # noqa: E402
 
 def test_px4_takeoff_in_the_live_view_with_the_estimate_beside_the_truth(pair, tmp_path):
     truth_port = free_port()
-    flyloop = pair.flyloop("--view", f"127.0.0.1:{truth_port}")
+    # At real time, as docs/view.md watches it. At 4x, PX4 took most of a loaded machine's
+    # CPU and the viewer, starved, drew the flight ever further behind (93 s, and 147 s when
+    # opened after PX4 started), never showing the climb.
+    flyloop = pair.flyloop("--view", f"127.0.0.1:{truth_port}", speed=1)
     web, grpc = free_port(socket.SOCK_STREAM), free_port(socket.SOCK_STREAM)
-    px4 = pair.px4()
     view = subprocess.Popen(
         [
             sys.executable, "-m", "flyloop.view",
             "--listen", f"127.0.0.1:{truth_port}",
-            "--connect", f"127.0.0.1:{18570 + px4.instance}",
+            "--connect", f"127.0.0.1:{18570 + pair.number}",
             "--web-port", str(web), "--grpc-port", str(grpc),
-            "--save", str(tmp_path / "px4.rrd"), "--wait", "120",
+            "--save", str(tmp_path / "px4.rrd"), "--wait", "240",
         ],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )  # fmt: skip
     try:
         url = view.stdout.readline().split("open ", 1)[1].strip()
-        px4.heartbeat(60)
         browser = Browser()
         try:
+            # The page loaded before PX4 starts: it then takes the flight in as it comes.
+            # Opened once PX4 was up, on a loaded machine it first had a minute of stream to
+            # take in a chunk at a time, and it drew the vehicle 147 s behind, still on the
+            # ground when the test looked for the climb (docs/view.md, "How far behind").
+            browser.open(url)
+            assert browser.wait_for_world(timeout=120), "the viewer did not load"
+            px4 = pair.px4()
+            px4.heartbeat(60)
             # The vehicle on the ground first, then the takeoff (as docs/view.md says to
             # watch): a page that takes in the flight faster than it is screenshotted would
             # otherwise first be seen with the vehicle already up.
-            browser.open(url)
             ground, n_ground = browser.wait_for_vehicle(30, timeout=90)
             px4.arm_and_take_off(60)
             frame = px4.frame()

@@ -31,13 +31,16 @@ GROUND, PAD, TRAIL, TARGET, WIND = (
     (0, 170, 60),
     (0, 80, 220),
 )
-# The trail: a point every TRAIL_EVERY_S of simulated time, the last TRAIL_POINTS of them
-# (30 s), re-drawn with the vehicle's latest position at each new point. A point per pose
-# re-drawn whole ten times a second was most of a live view's bytes, and a browser that
-# could not ingest them fell minutes behind the flight.
+# The trail: a point every TRAIL_EVERY_S of simulated time at most, and only once the vehicle
+# has moved TRAIL_STEP_M from the last one; the last TRAIL_POINTS of them (30 s of flight),
+# re-drawn at each new point. A point per pose re-drawn whole ten times a second was most of a
+# live view's bytes, and a browser that could not ingest them fell minutes behind the flight;
+# a vehicle standing or hovering in place sends no trail at all (its chunks are what a loaded
+# browser takes in slowest: docs/view.md, "How far behind").
 TRAIL_POINTS = 300
 EULER = ("roll", "pitch", "yaw")
 TRAIL_EVERY_S = 0.1
+TRAIL_STEP_M = 0.05
 DRAW_SCALE = 3.0  # vehicles are drawn this many times their size (a 0.1 m arm is small)
 GROUND_HALF = 5.0  # m: the ground grid is ±this around home
 
@@ -283,8 +286,10 @@ class Scene:
     def _trail(self, path: str, p: list[float], color) -> None:
         now = self._now
         if now - self._trail_at.get(path, -math.inf) >= TRAIL_EVERY_S:
-            self._trail_at[path] = now
             trail = self._trails.setdefault(path, deque(maxlen=TRAIL_POINTS))
+            if trail and math.dist(trail[-1], p) < TRAIL_STEP_M:
+                return
+            self._trail_at[path] = now
             trail.append(p)
             self._log(f"{path}_trail", rr.LineStrips3D([list(trail)], colors=[color], radii=0.015))
 

@@ -74,6 +74,27 @@ def hub_pixels(png: bytes | str | Path) -> np.ndarray:
     return np.argwhere(mask) + [t0, l0]
 
 
+def world_drawn(png: bytes) -> bool:
+    """Whether the 3D view shows the ground (its grid, GROUND's grey, and the pad): the viewer
+    has loaded and taken in the view's static world, before any vehicle (not the viewer's
+    welcome page, nor its dark loading screen)."""
+    import io
+
+    from PIL import Image
+
+    from .scene import GROUND
+
+    img = np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(int)
+    h, w = img.shape[:2]
+    left, top, right, bottom = WORLD_PANEL
+    img = img[int(top * h) : int(bottom * h), int(left * w) : int(right * w)]
+    grid = (np.abs(img - np.array(GROUND)) < 25).all(axis=-1).sum()
+    dark = (img < 80).all(axis=-1).sum()
+    # Measured at 1280 x 720: the world drawn 5,306 grid and 917 dark pixels; the welcome
+    # page 2,129 and 4,894; the loading screen is nearly all dark.
+    return grid >= 3500 * (h * w) / (1280 * 720) and dark < grid
+
+
 class Browser:
     """One headless Chromium page at `size` (width, height)."""
 
@@ -104,6 +125,18 @@ class Browser:
         """The page as PNG. The software rasteriser on a loaded machine can take tens of
         seconds to finish a frame (playwright's default 30 s timed out at load 25)."""
         return self.page.screenshot(path=str(path) if path else None, timeout=timeout * 1000)
+
+    def wait_for_world(self, timeout: float = 90.0) -> bool:
+        """Screenshots until the 3D view shows the ground ([`world_drawn`]) or `timeout`
+        passes; whether it did. For a page opened before the data flows: it then takes the
+        flight in as it comes instead of a backlog (docs/view.md, "How far behind")."""
+        end = time.monotonic() + timeout
+        while True:
+            if world_drawn(self.screenshot()):
+                return True
+            if time.monotonic() > end:
+                return False
+            time.sleep(1.0)
 
     def wait_for_vehicle(
         self,

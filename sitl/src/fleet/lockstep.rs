@@ -12,7 +12,8 @@
 //!
 //! An autopilot is in one of four phases ([`Phase`]). Only `Lockstep` ones hold the world
 //! back; `Free` ones (PX4 starting up, before its first controls) get their sensors as the
-//! world passes their times; `Absent` and `Silent` ones get nothing, their motors off.
+//! world passes their times; `Absent` ones get nothing, `Silent` ones only a reminder now and
+//! then (the fleet's server sends it), their motors off.
 
 use std::collections::VecDeque;
 

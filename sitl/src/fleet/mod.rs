@@ -448,6 +448,27 @@ impl Fleet {
         self.notice(MavSeverity::MAV_SEVERITY_WARNING, text);
     }
 
+    /// Silent PX4 i, still connected, is sent sensors at the world's time (in its `out`):
+    /// a PX4 that waits for sensors — ones it never got, or it answered and the answer was
+    /// not heard — would otherwise never answer, and never rejoin (regression: a PX4
+    /// silenced under load said "poll timeout" for good). Its answer to them rejoins it.
+    /// Returns whether it was sent any (false for any other autopilot or phase).
+    pub fn remind(&mut self, i: usize) -> bool {
+        if self.lockstep.slot(i).phase != Phase::Silent {
+            return false;
+        }
+        let now = self.lockstep.now_us();
+        let k = self.world.kinematics(i);
+        let motors = self.world.vehicle(i).actuator_states();
+        let m = &mut self.members[i];
+        let Link::Px4(p) = &mut m.link else {
+            return false;
+        };
+        let faults = m.faults.as_mut().map(|f| (f, motors.as_slice()));
+        p.emit(&k, now, &mut m.out, faults);
+        true
+    }
+
     /// One step of the world if the barrier lets it (`free`: also with nobody in
     /// lockstep); the autopilots due get their sensors in their `out` (PX4) or reply
     /// (ArduPilot). Returns the autopilots due.

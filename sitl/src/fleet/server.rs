@@ -136,6 +136,7 @@ impl Serving {
             }
             self.run_world();
             self.check_timeouts();
+            self.remind_silent();
             self.send_notices();
             self.log_speed();
         }
@@ -275,6 +276,23 @@ impl Serving {
             self.next_free = self.next_free.max(now);
         }
         self.run_world();
+    }
+
+    /// Every timeout, each silent PX4 still connected gets sensors at the world's time
+    /// ([`Fleet::remind`]).
+    fn remind_silent(&mut self) {
+        let now = Instant::now();
+        let mut reminded = false;
+        for i in 0..self.fleet.members().len() {
+            if now >= self.sent_at[i] + self.options.timeout && self.fleet.remind(i) {
+                self.sent_at[i] = now;
+                self.flush(i);
+                reminded = true;
+            }
+        }
+        if reminded {
+            self.send_queued();
+        }
     }
 
     /// Notices as STATUSTEXT to the ground station.
