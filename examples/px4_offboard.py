@@ -48,6 +48,7 @@ MAV = mavutil.mavlink
 # PX4's custom modes (main mode << 16 | sub mode << 24).
 PX4_OFFBOARD = 6 << 16
 PX4_AUTO_LOITER = (4 << 16) | (3 << 24)
+PX4_AUTO_TAKEOFF = (4 << 16) | (2 << 24)
 # SET_ATTITUDE_TARGET type_mask: attitude ignored; body rates and thrust used.
 ATTITUDE_IGNORE = 128
 # SET_POSITION_TARGET_LOCAL_NED type_mask: position only (velocity, acceleration, yaw and yaw
@@ -222,8 +223,11 @@ class Px4Link:
         p = list(params) + [0.0] * (7 - len(params))
         self.mav.mav.command_long_send(self.target, 1, command, 0, *p)
 
-    def accepted(self, what: str, command: int, params: tuple, timeout: float, code: int) -> None:
-        """Sends a command (again every second) until PX4 accepts it."""
+    def accepted(
+        self, what: str, command: int, params: tuple, timeout: float, code: int, taken=None
+    ) -> None:
+        """Sends a command (again every second) until PX4 accepts it, or `taken(state)` says
+        PX4 acted on it though its acknowledgement has not come (yet)."""
         end = time.monotonic() + timeout
         last = "no answer"
         while time.monotonic() < end:
@@ -234,6 +238,8 @@ class Px4Link:
                 if m is None:
                     continue
                 self._take(m)
+                if taken is not None and taken(self.state):
+                    return
                 if m.get_type() == "COMMAND_ACK" and m.command == command:
                     if m.result == MAV.MAV_RESULT_ACCEPTED:
                         return
@@ -334,7 +340,11 @@ def take_off(link: Px4Link, args: argparse.Namespace) -> np.ndarray:
     link.accepted("arming", MAV.MAV_CMD_COMPONENT_ARM_DISARM, (1,), args.timeout, 2)
     phase("armed; taking off with PX4's takeoff")
     nan = float("nan")
-    link.accepted("takeoff", MAV.MAV_CMD_NAV_TAKEOFF, (-1, 0, 0, nan, nan, nan, nan), 30, 2)
+    # Never sent again once PX4 took it: PX4 takes a takeoff while it climbs too, with a new
+    # target MIS_TAKEOFF_ALT above where it is then (a late acknowledgement on a loaded
+    # machine once sent a vehicle to 10-14 m).
+    params = (-1, 0, 0, nan, nan, nan, nan)
+    link.accepted("takeoff", MAV.MAV_CMD_NAV_TAKEOFF, params, 30, 2, taken=taking_off)
     link.command(MAV.MAV_CMD_REQUEST_MESSAGE, MAV.MAVLINK_MSG_ID_HOME_POSITION)
     home_msg = link.mav.recv_match(type="HOME_POSITION", blocking=True, timeout=5)
     home = np.array([home_msg.x, home_msg.y, home_msg.z]) if home_msg else s.position.copy()
@@ -350,6 +360,13 @@ def take_off(link: Px4Link, args: argparse.Namespace) -> np.ndarray:
         60,
     )
     return home
+
+
+def taking_off(s: State) -> bool:
+    """PX4 armed in AUTO.TAKEOFF, or its land detector no longer says on the ground."""
+    in_takeoff = s.armed and s.custom_mode & 0xFFFF0000 == PX4_AUTO_TAKEOFF
+    climbing = s.landed_state in (MAV.MAV_LANDED_STATE_TAKEOFF, MAV.MAV_LANDED_STATE_IN_AIR)
+    return in_takeoff or climbing
 
 
 class Setpoints:

@@ -103,7 +103,9 @@ def test_a_silent_px4_does_not_hang_the_others_and_rejoins(started, sitl_binary,
     flying, stalled = px4s
     # Stopped before the other takes off: the world, and so the other PX4, waits 2 s of
     # wall time for it. Frozen so in mid-climb, the other PX4 held 9 m instead of its 5 m
-    # takeoff in 1 of 3 runs (with the fleet loop before io_uring too; cause not found).
+    # takeoff in 1 of 3 runs: the frozen world delayed the takeoff's acknowledgement past the
+    # 1 s after which Px4.takeoff sent it again, and PX4 takes a takeoff while it climbs,
+    # 5 m above where it is (Px4.takeoff now waits 5 s and sends no more once PX4 took it).
     stalled.heartbeat(60)
     stalled.proc.send_signal(signal.SIGSTOP)
     text = sitl.statustext("silent", 30)

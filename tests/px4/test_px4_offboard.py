@@ -28,9 +28,12 @@ def port(px4) -> str:
 
 
 def offboard(pair, *flyloop_args: str, waypoints=WAYPOINTS, hold=4.0, timeout=240):
-    """flyloop (with `flyloop_args`) and PX4, then the deployment script against PX4's
-    offboard port; returns the script's result and the flyloop process."""
-    flyloop = pair.flyloop(*flyloop_args)
+    """flyloop (with `flyloop_args`) and PX4 at real time, then the deployment script against
+    PX4's offboard port; returns the script's result and the flyloop process. Real time, as a
+    user flies it: at the tests' 4x the policy, in Python, must keep up with 200 steps/s of
+    wall time, and two busy processes beside it were enough to fail 1 flight in 3 (a hold
+    error of 0.95 m at waypoint 0; in a CI run, both flights, 8 and 4.7 m)."""
+    flyloop = pair.flyloop(*flyloop_args, speed=1)
     px4 = pair.px4()
     result = subprocess.run(
         command(port(px4), "--waypoints", waypoints, "--hold", str(hold), "--timeout", "90"),

@@ -78,7 +78,8 @@ def test_px4_takeoff_in_the_live_view_with_the_estimate_beside_the_truth(pair, t
     assert len(t_true) > 100 and len(t_est) > 100
     # Airborne (above 1 m): the estimate, moved into the truth's frame, beside the truth.
     # Where both were drawn (under load the view may stop with one stream behind the other).
-    up = t_est[(t_est <= t_true[-1]) & (-d_est > 1.0)]
+    inside = t_est[(t_est >= t_true[0]) & (t_est <= t_true[-1])]
+    up = inside[-np.interp(inside, t_true, d_true) > 1.0]
     assert len(up) > 50
     truth_at = np.interp(up, t_true, d_true)
     gap = np.abs(np.interp(up, t_est, d_est) - truth_at)
@@ -93,16 +94,20 @@ def test_px4_takeoff_in_the_live_view_with_the_estimate_beside_the_truth(pair, t
     assert np.isfinite(n_estimate).all()
 
     # docs/view.md's plot with PX4's own log (.ulg, written while armed): its estimate beside
-    # the truth (its local frame's origin is about home: 0.6 m allowed).
+    # the truth. Its local frame's origin is where its estimator started, about home: 1 m
+    # allowed (0.23 and 0.74 m seen at real time; a frame or unit misread would be metres).
     ulg = sorted((Path(px4.log.name).parent / "log").glob("*/*.ulg"))[-1]
     png = tmp_path / "px4_plot.png"
     plot = ["-m", "flyloop.plot", str(tmp_path / "px4.rrd"), "--ulg", str(ulg), "-o", str(png)]
     plotted = subprocess.run([sys.executable, *plot], capture_output=True, text=True, timeout=120)
     assert plotted.returncode == 0 and png.stat().st_size > 20_000, plotted.stderr
     t_ulg, d_ulg = series_of_ulg(ulg)["/position/vehicle1/D/estimate"]
-    up = t_ulg[(t_ulg >= t_true[0]) & (t_ulg <= t_true[-1]) & (-d_ulg > 1.0)]
+    # Airborne by the truth: PX4's estimate dips to 1.2 m up for a moment as it starts (the
+    # log holds it from 0.9 s), which once counted as airborne, 0.95-1.17 m from the truth.
+    inside = t_ulg[(t_ulg >= t_true[0]) & (t_ulg <= t_true[-1])]
+    up = inside[-np.interp(inside, t_true, d_true) > 1.0]
     assert len(up) > 100
     gap = np.abs(np.interp(up, t_ulg, d_ulg) - np.interp(up, t_true, d_true))
-    assert gap.max() < 0.6, gap.max()
+    assert gap.max() < 1.0, gap.max()
     assert n_ground >= 30, "no vehicle drawn"
     assert risen > 40, f"the vehicle did not take off on the screen: {tmp_path / 'px4.png'}"
