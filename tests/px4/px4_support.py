@@ -303,19 +303,22 @@ class Px4:
         self.target = hb.get_srcSystem()
         return hb
 
-    def accepted(self, command: int, send, timeout: float) -> None:
-        """Sends a command (again every second) until PX4 acknowledges it as accepted: a
-        datagram can be lost, and PX4 refuses some commands until its estimator is ready."""
+    def accepted(self, command: int, send, timeout: float, every=1.0, taken=None) -> None:
+        """Sends a command (again every `every` s) until PX4 acknowledges it as accepted, or
+        shows in a heartbeat that it acted on it (`taken(heartbeat)`): a datagram can be
+        lost, and PX4 refuses some commands until its estimator is ready."""
+
+        def done(m) -> bool:
+            if m.get_type() == "COMMAND_ACK":
+                return m.command == command and m.result == 0
+            return m.get_srcSystem() == self.target and taken(m)
+
+        types = "COMMAND_ACK" if taken is None else ["COMMAND_ACK", "HEARTBEAT"]
         end = time.monotonic() + timeout
         while time.monotonic() < end:
             send()
             try:
-                self.wait_for(
-                    f"command {command} accepted",
-                    lambda m: m.command == command and m.result == 0,
-                    1.0,
-                    "COMMAND_ACK",
-                )
+                self.wait_for(f"command {command} accepted", done, every, types)
                 return
             except AssertionError:
                 pass
@@ -334,21 +337,13 @@ class Px4:
         fleet test PX4s held 9.8 m and 13.9 m instead of 5 m)."""
         nan = float("nan")
         takeoff = mavutil.mavlink.MAV_CMD_NAV_TAKEOFF
-
-        def taken(m) -> bool:
-            if m.get_type() == "COMMAND_ACK":
-                return m.command == takeoff and m.result == 0
-            return m.get_srcSystem() == self.target and self.taking_off(m)
-
-        end = time.monotonic() + timeout
-        while time.monotonic() < end:
-            self.command(takeoff, -1, 0, 0, nan, nan, nan, nan)
-            try:
-                self.wait_for("the takeoff taken", taken, 5.0, ["COMMAND_ACK", "HEARTBEAT"])
-                return
-            except AssertionError:
-                pass
-        raise AssertionError(f"PX4 did not take the takeoff:\n{self.output()[-3000:]}")
+        self.accepted(
+            takeoff,
+            lambda: self.command(takeoff, -1, 0, 0, nan, nan, nan, nan),
+            timeout,
+            every=5.0,
+            taken=self.taking_off,
+        )
 
     def taking_off(self, hb) -> bool:
         """Armed in AUTO.TAKEOFF (PX4's custom mode: sub mode << 24 | main mode << 16)."""

@@ -21,6 +21,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "view"))
 from flight import free_port, rise  # noqa: E402
 
 
+def airborne(times, t_true, d_true):
+    """Those of `times` within the truth's span at which the truth is above 1 m. By the truth,
+    not the estimate: PX4's estimate dips to 1.2 m up for a moment as it starts (its log holds
+    it from 0.9 s), which once counted as airborne, 0.95-1.17 m from the truth."""
+    inside = times[(times >= t_true[0]) & (times <= t_true[-1])]
+    return inside[-np.interp(inside, t_true, d_true) > 1.0]
+
+
 def test_px4_takeoff_in_the_live_view_with_the_estimate_beside_the_truth(pair, tmp_path):
     truth_port = free_port()
     # At real time, as docs/view.md watches it. At 4x, PX4 took most of a loaded machine's
@@ -78,8 +86,7 @@ def test_px4_takeoff_in_the_live_view_with_the_estimate_beside_the_truth(pair, t
     assert len(t_true) > 100 and len(t_est) > 100
     # Airborne (above 1 m): the estimate, moved into the truth's frame, beside the truth.
     # Where both were drawn (under load the view may stop with one stream behind the other).
-    inside = t_est[(t_est >= t_true[0]) & (t_est <= t_true[-1])]
-    up = inside[-np.interp(inside, t_true, d_true) > 1.0]
+    up = airborne(t_est, t_true, d_true)
     assert len(up) > 50
     truth_at = np.interp(up, t_true, d_true)
     gap = np.abs(np.interp(up, t_est, d_est) - truth_at)
@@ -102,10 +109,7 @@ def test_px4_takeoff_in_the_live_view_with_the_estimate_beside_the_truth(pair, t
     plotted = subprocess.run([sys.executable, *plot], capture_output=True, text=True, timeout=120)
     assert plotted.returncode == 0 and png.stat().st_size > 20_000, plotted.stderr
     t_ulg, d_ulg = series_of_ulg(ulg)["/position/vehicle1/D/estimate"]
-    # Airborne by the truth: PX4's estimate dips to 1.2 m up for a moment as it starts (the
-    # log holds it from 0.9 s), which once counted as airborne, 0.95-1.17 m from the truth.
-    inside = t_ulg[(t_ulg >= t_true[0]) & (t_ulg <= t_true[-1])]
-    up = inside[-np.interp(inside, t_true, d_true) > 1.0]
+    up = airborne(t_ulg, t_true, d_true)
     assert len(up) > 100
     gap = np.abs(np.interp(up, t_ulg, d_ulg) - np.interp(up, t_true, d_true))
     assert gap.max() < 1.0, gap.max()

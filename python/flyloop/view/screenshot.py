@@ -50,8 +50,9 @@ def chromium_path() -> str:
 WORLD_PANEL = (0.0, 0.08, 0.58, 0.95)  # left, top, right, bottom as fractions
 
 
-def hub_pixels(png: bytes | str | Path) -> np.ndarray:
-    """(row, column) of the pixels in the hub's colour (shaded: magenta hues) in the 3D view."""
+def world_panel(png: bytes | str | Path) -> tuple[np.ndarray, tuple[int, int], tuple[int, int]]:
+    """The 3D view's pixels (rows, columns, RGB as int), the offset of its top-left corner in
+    the page, and the page's size (height, width)."""
     import io
 
     from PIL import Image
@@ -61,7 +62,12 @@ def hub_pixels(png: bytes | str | Path) -> np.ndarray:
     h, w = img.shape[:2]
     left, top, right, bottom = WORLD_PANEL
     t0, l0 = int(top * h), int(left * w)
-    img = img[t0 : int(bottom * h), l0 : int(right * w)]
+    return img[t0 : int(bottom * h), l0 : int(right * w)], (t0, l0), (h, w)
+
+
+def hub_pixels(png: bytes | str | Path) -> np.ndarray:
+    """(row, column) of the pixels in the hub's colour (shaded: magenta hues) in the 3D view."""
+    img, (t0, l0), _ = world_panel(png)
     r, g, b = img[..., 0], img[..., 1], img[..., 2]
     # HUB is (255, 0, 200): red and blue well above green, whatever the light.
     target = np.array(HUB)
@@ -78,16 +84,9 @@ def world_drawn(png: bytes) -> bool:
     """Whether the 3D view shows the ground (its grid, GROUND's grey, and the pad): the viewer
     has loaded and taken in the view's static world, before any vehicle (not the viewer's
     welcome page, nor its dark loading screen)."""
-    import io
-
-    from PIL import Image
-
     from .scene import GROUND
 
-    img = np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(int)
-    h, w = img.shape[:2]
-    left, top, right, bottom = WORLD_PANEL
-    img = img[int(top * h) : int(bottom * h), int(left * w) : int(right * w)]
+    img, _, (h, w) = world_panel(png)
     grid = (np.abs(img - np.array(GROUND)) < 25).all(axis=-1).sum()
     dark = (img < 80).all(axis=-1).sum()
     # Measured at 1280 x 720: the world drawn 5,306 grid and 917 dark pixels; the welcome
